@@ -1,0 +1,64 @@
+#include "core/base/log.hpp"
+
+#include <unistd.h>
+
+namespace vitrine {
+
+namespace {
+LogLevel gLevel = LogLevel::Info;
+}
+
+void setLogLevel(LogLevel level) { gLevel = level; }
+LogLevel logLevel() { return gLevel; }
+
+void log(LogLevel level, const std::string& message) {
+    if (level < gLevel) return;
+    static const char* kPrefix[] = {"debug: ", "", "warning: ", "error: "};
+    std::fprintf(stderr, "%s%s\n", kPrefix[static_cast<int>(level)], message.c_str());
+}
+
+Progress::Progress(std::string label, size_t total)
+    : mLabel(std::move(label)), mTotal(total), mTerminal(isatty(STDERR_FILENO) != 0),
+      mStart(std::chrono::steady_clock::now()), mLastDraw(mStart) {
+    if (gLevel <= LogLevel::Info && mTotal > 1) draw(true);
+}
+
+Progress::~Progress() { finish(); }
+
+void Progress::advance(size_t steps) {
+    mDone += steps;
+    if (mDone > mTotal) mDone = mTotal;
+    draw(false);
+}
+
+void Progress::finish() {
+    if (mFinished) return;
+    mFinished = true;
+    if (gLevel > LogLevel::Info || mTotal <= 1) return;
+    mDone = mTotal;
+    draw(true);
+    if (mTerminal) std::fputc('\n', stderr);
+}
+
+void Progress::draw(bool force) {
+    if (gLevel > LogLevel::Info || mTotal <= 1) return;
+    auto now = std::chrono::steady_clock::now();
+    double elapsed = std::chrono::duration<double>(now - mStart).count();
+    if (mTerminal) {
+        if (!force && now - mLastDraw < std::chrono::milliseconds(100) && mDone != mTotal) return;
+        mLastDraw = now;
+        const int width = 30;
+        int filled = static_cast<int>(width * mDone / mTotal);
+        std::string bar(filled, '#');
+        bar.resize(width, '.');
+        std::fprintf(stderr, "\r%s [%s] %zu/%zu  %.1fs", mLabel.c_str(), bar.c_str(), mDone, mTotal, elapsed);
+        std::fflush(stderr);
+    } else {
+        int quarter = static_cast<int>(4 * mDone / mTotal);
+        if (quarter == mLastQuarter) return;
+        mLastQuarter = quarter;
+        std::fprintf(stderr, "%s: %zu/%zu (%.1fs)\n", mLabel.c_str(), mDone, mTotal, elapsed);
+    }
+}
+
+} // namespace vitrine

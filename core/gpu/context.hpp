@@ -1,0 +1,113 @@
+#pragma once
+
+#include "core/gpu/vk_check.hpp"
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace vitrine {
+
+class Allocator;
+
+struct ContextOptions {
+    bool validation = false;  // enable VK_LAYER_KHRONOS_validation and count its messages
+    std::string device;       // index ("0") or a case-insensitive substring of the device name; empty: best
+    bool printValidation = true;
+};
+
+struct DeviceInfo {
+    uint32_t index = 0;
+    std::string name;
+    VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+    uint32_t apiVersion = 0;
+};
+
+// Headless Vulkan 1.3 instance + device + one graphics/compute queue. Owns the allocator and
+// the deferred-destruction queue: objects handed to destroyLater() are destroyed only once
+// every submission made before the call has completed on the GPU.
+class Context {
+public:
+    explicit Context(const ContextOptions& options = {});
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    static std::vector<DeviceInfo> listDevices();
+
+    VkInstance instance() const { return mInstance; }
+    VkPhysicalDevice physicalDevice() const { return mPhysicalDevice; }
+    VkDevice device() const { return mDevice; }
+    VkQueue queue() const { return mQueue; }
+    uint32_t queueFamily() const { return mQueueFamily; }
+    const VkPhysicalDeviceProperties& properties() const { return mProperties; }
+    const DeviceInfo& deviceInfo() const { return mDeviceInfo; }
+    Allocator& allocator() { return *mAllocator; }
+    bool validationEnabled() const { return mValidation; }
+
+    // Validation messages (warnings and errors) seen since the context was made. Tests fail on any.
+    size_t validationMessageCount() const;
+    std::vector<std::string> validationMessages() const;
+
+    void setName(uint64_t handle, VkObjectType type, const std::string& name) const;
+
+    // Submits a command buffer; returns the serial that completes with it.
+    uint64_t submit(VkCommandBuffer cmd);
+    void waitSerial(uint64_t serial);
+    void waitIdle();
+    uint64_t lastSubmitted() const { return mSubmitted; }
+
+    // Records with `record`, submits and waits. For uploads, read-backs and tests, not per-frame work.
+    void immediate(const std::function<void(VkCommandBuffer)>& record);
+
+    VkCommandBuffer allocateCommandBuffer();
+    void freeCommandBuffer(VkCommandBuffer cmd);
+
+    void destroyLater(std::function<void()> destroy);
+    // Runs the destructions whose submissions have completed.
+    void collectGarbage();
+
+    double timestampPeriodNs() const { return mProperties.limits.timestampPeriod; }
+
+private:
+    struct Pending {
+        uint64_t serial;
+        VkFence fence;
+    };
+    struct Deferred {
+        uint64_t serial;
+        std::function<void()> destroy;
+    };
+    void pollFences();
+
+    bool mValidation = false;
+    bool mPrintValidation = true;
+    VkInstance mInstance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT mMessenger = VK_NULL_HANDLE;
+    VkPhysicalDevice mPhysicalDevice = VK_NULL_HANDLE;
+    VkDevice mDevice = VK_NULL_HANDLE;
+    VkQueue mQueue = VK_NULL_HANDLE;
+    uint32_t mQueueFamily = 0;
+    VkPhysicalDeviceProperties mProperties{};
+    DeviceInfo mDeviceInfo;
+    VkCommandPool mCommandPool = VK_NULL_HANDLE;
+    PFN_vkSetDebugUtilsObjectNameEXT mSetName = nullptr;
+    std::unique_ptr<Allocator> mAllocator;
+
+    uint64_t mSubmitted = 0;
+    uint64_t mCompleted = 0;
+    std::deque<Pending> mPending;
+    std::vector<VkFence> mFreeFences;
+    std::deque<Deferred> mDeferred;
+
+    mutable std::mutex mMessageMutex;
+    std::vector<std::string> mMessages;
+    friend VkBool32 debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                                  const VkDebugUtilsMessengerCallbackDataEXT*, void*);
+};
+
+} // namespace vitrine

@@ -1,0 +1,450 @@
+#include "core/graph/executor.hpp"
+
+#include "core/base/error.hpp"
+#include "core/base/log.hpp"
+#include "core/gpu/context.hpp"
+#include "core/gpu/formats.hpp"
+#include "core/gpu/profiler.hpp"
+#include "core/gpu/transfer.hpp"
+#include "core/graph/lifetimes.hpp"
+#include "core/graph/registry.hpp"
+#include "core/shader/compiler.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+namespace vitrine {
+
+struct Executor::Pipeline {
+    struct Target {
+        uint32_t binding;
+        VkDescriptorType type;
+        std::string port;
+        bool output;
+    };
+    std::string shader;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    ShaderReflection reflection;
+    std::vector<Target> targets;
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+bool descriptorFits(VkDescriptorType type, Usage usage) {
+    switch (usage) {
+    case Usage::Sampled:
+        return type == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER || type == VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+    case Usage::StorageRead:
+    case Usage::StorageWrite:
+    case Usage::StorageReadWrite: return type == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    default: return false;
+    }
+}
+
+} // namespace
+
+// The ExecuteContext a pass sees while it is recorded.
+class PassContext final : public ExecuteContext {
+public:
+    PassContext(Executor& ex, uint32_t pass, VkCommandBuffer cmd) : mEx(ex), mPassIndex(pass), mCmd(cmd) {}
+
+    Context& gpu() override { return mEx.mCtx; }
+    VkCommandBuffer cmd() override { return mCmd; }
+    uint32_t frameIndex() const override { return mEx.mFrame; }
+    const Params& params() const override { return *pass().params; }
+    bool hasInput(const std::string& port) const override { return findUse(port, false) != nullptr; }
+    bool inputValid(const std::string& port) const override {
+        const PassUse* u = findUse(port, false);
+        return u && (!u->previous || mEx.mFrame > 0);
+    }
+    const GpuImage& input(const std::string& port) override { return imageOf(port, false); }
+    const GpuImage& output(const std::string& port) override { return imageOf(port, true); }
+
+    void upload(const std::string& port, const Image& pixels) override {
+        const PassUse* u = findUse(port, true);
+        if (!u || u->usage != Usage::TransferDst)
+            throw InternalError("node " + pass().id + ": upload to '" + port + "', which is not a TransferDst output");
+        mEx.mFrameStaging.push_back(recordUpload(mEx.mCtx, mCmd, imageOf(port, true), pixels));
+    }
+
+    void dispatch(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,
+                  uint32_t depth) override {
+        auto& pipelines = mEx.mPipelines[mPassIndex];
+        if (id >= pipelines.size()) throw InternalError("node " + pass().id + ": unknown pipeline " + std::to_string(id));
+        const Executor::Pipeline& p = *pipelines[id];
+        if (pushSize != p.reflection.pushConstantSize)
+            throw InternalError("node " + pass().id + ": pushes " + std::to_string(pushSize) + " bytes but " + p.shader +
+                                " declares a push-constant block of " + std::to_string(p.reflection.pushConstantSize));
+        VkDescriptorSet set = VK_NULL_HANDLE;
+        if (p.setLayout) {
+            VkDescriptorSetAllocateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+            info.descriptorPool = mEx.mDescriptorPool;
+            info.descriptorSetCount = 1;
+            info.pSetLayouts = &p.setLayout;
+            VK_CHECK(vkAllocateDescriptorSets(mEx.mCtx.device(), &info, &set));
+            std::vector<VkDescriptorImageInfo> images(p.targets.size());
+            std::vector<VkWriteDescriptorSet> writes;
+            for (size_t i = 0; i < p.targets.size(); ++i) {
+                const auto& t = p.targets[i];
+                const PassUse* u = findUse(t.port, t.output);
+                if (u) {
+                    const Executor::Physical& ph = mEx.mPhysical[mEx.physicalOf(u->resource, u->previous)];
+                    images[i] = {mEx.mSampler, ph.image.view(), ph.state.layout};
+                } else {
+                    images[i] = {mEx.mSampler, mEx.mDummy.view(), VK_IMAGE_LAYOUT_GENERAL};
+                }
+                VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+                w.dstSet = set;
+                w.dstBinding = t.binding;
+                w.descriptorCount = 1;
+                w.descriptorType = t.type;
+                w.pImageInfo = &images[i];
+                writes.push_back(w);
+            }
+            vkUpdateDescriptorSets(mEx.mCtx.device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+        }
+        vkCmdBindPipeline(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+        if (set) vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
+        if (pushSize) vkCmdPushConstants(mCmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushSize, push);
+        const uint32_t* ls = p.reflection.localSize;
+        vkCmdDispatch(mCmd, (width + ls[0] - 1) / ls[0], (height + ls[1] - 1) / ls[1], (depth + ls[2] - 1) / ls[2]);
+    }
+
+private:
+    const CompiledPass& pass() const { return mEx.mGraph.passes[mPassIndex]; }
+    const PassUse* findUse(const std::string& port, bool output) const {
+        for (const auto& u : pass().uses)
+            if (u.output == output && u.port == port) return &u;
+        return nullptr;
+    }
+    const GpuImage& imageOf(const std::string& port, bool output) {
+        const PassUse* u = findUse(port, output);
+        if (!u)
+            throw InternalError("node " + pass().id + " asks for " + (output ? "output" : "unconnected input") + " '" +
+                                port + "'");
+        return mEx.mPhysical[mEx.physicalOf(u->resource, u->previous)].image;
+    }
+
+    Executor& mEx;
+    uint32_t mPassIndex;
+    VkCommandBuffer mCmd;
+};
+
+Executor::Executor(Context& ctx, CompiledGraph& graph, ShaderCompiler& shaders) : mCtx(ctx), mGraph(graph) {
+    try {
+        create(shaders);
+    } catch (...) {
+        destroy();
+        throw;
+    }
+}
+
+void Executor::create(ShaderCompiler& shaders) {
+    Context& ctx = mCtx;
+    CompiledGraph& graph = mGraph;
+    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    si.magFilter = si.minFilter = VK_FILTER_LINEAR;
+    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    si.maxLod = VK_LOD_CLAMP_NONE;
+    VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &mSampler));
+
+    std::vector<VkDescriptorPoolSize> sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4096},
+                                               {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1024},
+                                               {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 4096},
+                                               {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 256},
+                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 256}};
+    VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pi.maxSets = 2048;
+    pi.poolSizeCount = static_cast<uint32_t>(sizes.size());
+    pi.pPoolSizes = sizes.data();
+    VK_CHECK(vkCreateDescriptorPool(ctx.device(), &pi, nullptr, &mDescriptorPool));
+
+    ImageDesc dummy;
+    dummy.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    dummy.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    mDummy = GpuImage(ctx, dummy, "graph.dummy");
+    ctx.immediate([&](VkCommandBuffer cmd) {
+        ImageSyncState s;
+        auto b = requireAccess(s, 0, accessOf(Usage::TransferDst, PassKind::Transfer));
+        VkImageMemoryBarrier2 vb = toVulkan(*b, mDummy.image(), VK_IMAGE_ASPECT_COLOR_BIT);
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.imageMemoryBarrierCount = 1;
+        dep.pImageMemoryBarriers = &vb;
+        vkCmdPipelineBarrier2(cmd, &dep);
+        VkClearColorValue zero{};
+        VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        vkCmdClearColorImage(cmd, mDummy.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1, &range);
+        vb = toVulkan({0, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                       VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT},
+                      mDummy.image(), VK_IMAGE_ASPECT_COLOR_BIT);
+        vkCmdPipelineBarrier2(cmd, &dep);
+    });
+
+    createImages();
+    createPipelines(shaders);
+    mProfiler = std::make_unique<GpuProfiler>(ctx, static_cast<uint32_t>(graph.passes.size()));
+}
+
+Executor::~Executor() { destroy(); }
+
+void Executor::destroy() {
+    mCtx.waitIdle();
+    mPhysical.clear();
+    mDummy = GpuImage();
+    mProfiler.reset();
+    VkDevice device = mCtx.device();
+    std::vector<std::unique_ptr<Pipeline>> all;
+    for (auto& list : mPipelines)
+        for (auto& p : list) all.push_back(std::move(p));
+    VkSampler sampler = mSampler;
+    VkDescriptorPool pool = mDescriptorPool;
+    VkDeviceMemory heap = mTransientHeap;
+    auto shared = std::make_shared<std::vector<std::unique_ptr<Pipeline>>>(std::move(all));
+    mCtx.destroyLater([device, shared, sampler, pool, heap] {
+        for (auto& p : *shared) {
+            if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
+            if (p->layout) vkDestroyPipelineLayout(device, p->layout, nullptr);
+            if (p->setLayout) vkDestroyDescriptorSetLayout(device, p->setLayout, nullptr);
+        }
+        if (sampler) vkDestroySampler(device, sampler, nullptr);
+        if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
+        if (heap) vkFreeMemory(device, heap, nullptr);
+    });
+    mSampler = VK_NULL_HANDLE;
+    mDescriptorPool = VK_NULL_HANDLE;
+    mTransientHeap = VK_NULL_HANDLE;
+    mPipelines.clear();
+    mCtx.collectGarbage();
+}
+
+uint32_t Executor::physicalOf(uint32_t resource, bool previous) const {
+    const GraphResource& r = mGraph.resources[resource];
+    if (!r.history) return mResourcePhysical[resource][0];
+    return mResourcePhysical[resource][(mFrame + (previous ? 1 : 0)) % 2];
+}
+
+void Executor::createImages() {
+    std::vector<AliasRequest> requests;
+    std::vector<uint32_t> transient;
+    uint32_t typeBits = ~0u;
+    for (uint32_t i = 0; i < mGraph.resources.size(); ++i) {
+        const GraphResource& r = mGraph.resources[i];
+        if (!r.transient()) continue;
+        VkMemoryRequirements req = GpuImage::requirements(mCtx, r.desc);
+        requests.push_back({req.size, req.alignment, r.firstPass, r.lastPass});
+        transient.push_back(i);
+        typeBits &= req.memoryTypeBits;
+    }
+    AliasPlan plan = planAliasing(requests);
+    mMemory.transientAliased = plan.heapSize;
+    mMemory.transientUnaliased = plan.unaliasedSize;
+    if (!transient.empty()) {
+        if (typeBits == 0) throw InternalError("transient textures share no memory type; cannot alias them");
+        VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        info.allocationSize = plan.heapSize;
+        info.memoryTypeIndex = mCtx.allocator().findMemoryType(typeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        VK_CHECK(vkAllocateMemory(mCtx.device(), &info, nullptr, &mTransientHeap));
+    }
+
+    mResourcePhysical.assign(mGraph.resources.size(), {UINT32_MAX, UINT32_MAX});
+    for (size_t k = 0; k < transient.size(); ++k) {
+        const GraphResource& r = mGraph.resources[transient[k]];
+        mPhysical.push_back({GpuImage(mCtx, r.desc, r.name, mTransientHeap, plan.offsets[k]), {}});
+        mResourcePhysical[transient[k]] = {static_cast<uint32_t>(mPhysical.size() - 1), UINT32_MAX};
+    }
+    for (uint32_t i = 0; i < mGraph.resources.size(); ++i) {
+        const GraphResource& r = mGraph.resources[i];
+        if (r.transient()) continue;
+        int copies = r.history ? 2 : 1;
+        for (int c = 0; c < copies; ++c) {
+            mPhysical.push_back({GpuImage(mCtx, r.desc, r.name + (r.history ? (c ? "[1]" : "[0]") : "")), {}});
+            mResourcePhysical[i][c] = static_cast<uint32_t>(mPhysical.size() - 1);
+            mMemory.persistent += GpuImage::requirements(mCtx, r.desc).size;
+        }
+    }
+}
+
+void Executor::createPipelines(ShaderCompiler& shaders) {
+    auto start = Clock::now();
+    VkDevice device = mCtx.device();
+    mPipelines.resize(mGraph.passes.size());
+    for (size_t pi = 0; pi < mGraph.passes.size(); ++pi) {
+        const CompiledPass& pass = mGraph.passes[pi];
+        for (const auto& request : pass.pipelines) {
+            CompiledShader shader =
+                request.source.empty()
+                    ? shaders.compile(request.shader, request.defines)
+                    : shaders.compileSource(request.shader, request.source, VK_SHADER_STAGE_COMPUTE_BIT, request.defines);
+            mPipelines[pi].push_back(std::make_unique<Pipeline>());
+            Pipeline* p = mPipelines[pi].back().get();
+            p->shader = request.shader;
+            p->reflection = shader.reflection;
+            std::vector<VkDescriptorSetLayoutBinding> bindings;
+            for (const auto& b : shader.reflection.bindings) {
+                std::string where = "shader " + request.shader + " (node " + pass.id + ", " + pass.schema->type + ")";
+                if (b.set != 0) throw InternalError(where + ": binding '" + b.name + "' is in set " + std::to_string(b.set) + "; nodes use set 0");
+                bool output = b.name.rfind("out_", 0) == 0;
+                bool input = b.name.rfind("in_", 0) == 0;
+                std::string port = b.name.substr(output ? 4 : 3);
+                if (!input && !output)
+                    throw InternalError(where + ": binding '" + b.name + "' must be named in_<input> or out_<output>");
+                Usage usage;
+                if (output) {
+                    const OutputPort* op = pass.schema->findOutput(port);
+                    if (!op) throw InternalError(where + ": binds '" + b.name + "' but " + pass.schema->type + " has no output '" + port + "'");
+                    usage = op->usage;
+                } else {
+                    const InputPort* ip = pass.schema->findInput(port);
+                    if (!ip) throw InternalError(where + ": binds '" + b.name + "' but " + pass.schema->type + " has no input '" + port + "'");
+                    usage = ip->usage;
+                }
+                if (!descriptorFits(b.type, usage))
+                    throw InternalError(where + ": binding '" + b.name + "' has a descriptor type that does not match the port's declared usage");
+                bindings.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+                p->targets.push_back({b.binding, b.type, port, output});
+            }
+            if (!bindings.empty()) {
+                VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+                li.bindingCount = static_cast<uint32_t>(bindings.size());
+                li.pBindings = bindings.data();
+                VK_CHECK(vkCreateDescriptorSetLayout(device, &li, nullptr, &p->setLayout));
+            }
+            VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, shader.reflection.pushConstantSize};
+            VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+            pl.setLayoutCount = p->setLayout ? 1 : 0;
+            pl.pSetLayouts = &p->setLayout;
+            pl.pushConstantRangeCount = range.size ? 1 : 0;
+            pl.pPushConstantRanges = &range;
+            VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &p->layout));
+
+            VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+            mi.codeSize = shader.spirv.size() * 4;
+            mi.pCode = shader.spirv.data();
+            VkShaderModule module;
+            VK_CHECK(vkCreateShaderModule(device, &mi, nullptr, &module));
+            VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+            ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+            ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+            ci.stage.module = module;
+            ci.stage.pName = "main";
+            ci.layout = p->layout;
+            VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &p->pipeline);
+            vkDestroyShaderModule(device, module, nullptr);
+            VK_CHECK(result);
+            mCtx.setName(reinterpret_cast<uint64_t>(p->pipeline), VK_OBJECT_TYPE_PIPELINE, pass.id + ":" + request.shader);
+        }
+    }
+    mPipelineMs = msSince(start);
+}
+
+void Executor::recordFrame(VkCommandBuffer cmd) {
+    mFrameStaging.clear();
+    mProfiler->begin(cmd);
+    std::vector<VkImageMemoryBarrier2> barriers;
+    auto flush = [&] {
+        if (barriers.empty()) return;
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.imageMemoryBarrierCount = static_cast<uint32_t>(barriers.size());
+        dep.pImageMemoryBarriers = barriers.data();
+        vkCmdPipelineBarrier2(cmd, &dep);
+        barriers.clear();
+    };
+    auto require = [&](uint32_t phys, const AccessInfo& access) {
+        Physical& p = mPhysical[phys];
+        if (auto b = requireAccess(p.state, phys, access))
+            barriers.push_back(toVulkan(*b, p.image.image(), aspectOf(p.image.desc().format)));
+    };
+
+    for (uint32_t i = 0; i < mGraph.resources.size(); ++i) {
+        const GraphResource& r = mGraph.resources[i];
+        if (!r.persistent && !r.history) mPhysical[mResourcePhysical[i][0]].state = ImageSyncState::discarded();
+    }
+    if (mFrame == 0) {
+        // History starts as zeros so a first-frame @prev read is defined (inputValid() says false).
+        std::vector<uint32_t> cleared;
+        for (uint32_t i = 0; i < mGraph.resources.size(); ++i)
+            if (mGraph.resources[i].history)
+                for (uint32_t phys : mResourcePhysical[i]) {
+                    require(phys, accessOf(Usage::TransferDst, PassKind::Transfer));
+                    cleared.push_back(phys);
+                }
+        flush();
+        for (uint32_t phys : cleared) {
+            VkClearColorValue zero{};
+            VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+            vkCmdClearColorImage(cmd, mPhysical[phys].image.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1, &range);
+        }
+    }
+
+    for (uint32_t pi = 0; pi < mGraph.passes.size(); ++pi) {
+        const CompiledPass& pass = mGraph.passes[pi];
+        for (const auto& u : pass.uses) require(physicalOf(u.resource, u.previous), accessOf(u.usage, pass.schema->pass));
+        flush();
+        mProfiler->beginScope(cmd, pi);
+        PassContext ctx(*this, pi, cmd);
+        pass.node->execute(ctx);
+        mProfiler->endScope(cmd, pi);
+    }
+}
+
+void Executor::run(const RunOptions& options) {
+    const FrameSettings& fs = mGraph.desc.frame;
+    const uint32_t frames = options.frames ? options.frames : fs.frames;
+    std::set<uint32_t> write(options.write.begin(), options.write.end());
+    if (options.write.empty()) {
+        for (uint32_t w : fs.write) write.insert(std::min(w, frames - 1));
+    }
+    std::unique_ptr<Progress> progress;
+    if (options.progress) progress = std::make_unique<Progress>("rendering", frames);
+    VkCommandBuffer cmd = mCtx.allocateCommandBuffer();
+    for (mFrame = 0; mFrame < frames; ++mFrame) {
+        auto recordStart = Clock::now();
+        VK_CHECK(vkResetCommandBuffer(cmd, 0));
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
+        VK_CHECK(vkResetDescriptorPool(mCtx.device(), mDescriptorPool, 0));
+        recordFrame(cmd);
+        VK_CHECK(vkEndCommandBuffer(cmd));
+        FrameTiming timing;
+        timing.cpuRecordMs = msSince(recordStart);
+        auto gpuStart = Clock::now();
+        mCtx.waitSerial(mCtx.submit(cmd));
+        timing.frameMs = msSince(gpuStart);
+        timing.passGpuMs = mProfiler->resolve(static_cast<uint32_t>(mGraph.passes.size()));
+        mTimings.push_back(std::move(timing));
+        if (write.count(mFrame) && options.onOutput) {
+            for (const auto& [name, resource] : mGraph.outputs) {
+                Physical& p = mPhysical[physicalOf(resource, false)];
+                options.onOutput(mFrame, name, readImage(mCtx, p.image, p.state.layout));
+            }
+        }
+        if (progress) progress->advance();
+    }
+    mFrame = frames - 1;
+    mCtx.freeCommandBuffer(cmd);
+}
+
+const GpuImage& Executor::image(const std::string& resource) const {
+    int r = mGraph.findResource(resource);
+    if (r < 0) throw UserError("no resource '" + resource + "' in the graph");
+    return mPhysical[physicalOf(static_cast<uint32_t>(r), false)].image;
+}
+
+Image Executor::read(const std::string& resource) {
+    int r = mGraph.findResource(resource);
+    if (r < 0) throw UserError("no resource '" + resource + "' in the graph");
+    if (mGraph.resources[r].transient())
+        throw UserError("resource '" + resource + "' is transient (its memory is reused within the frame); make it a graph output to read it");
+    Physical& p = mPhysical[physicalOf(static_cast<uint32_t>(r), false)];
+    return readImage(mCtx, p.image, p.state.layout);
+}
+
+} // namespace vitrine

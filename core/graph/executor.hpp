@@ -1,0 +1,88 @@
+#pragma once
+
+#include "core/graph/barriers.hpp"
+#include "core/graph/compiler.hpp"
+#include "core/image/image.hpp"
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace vitrine {
+
+class Context;
+class GpuProfiler;
+class ShaderCompiler;
+
+struct FrameTiming {
+    std::vector<double> passGpuMs; // per pass, from timestamp queries
+    double cpuRecordMs = 0.0;      // recording the command buffer
+    double frameMs = 0.0;          // submit to completion, wall clock
+};
+
+struct MemoryStats {
+    uint64_t transientAliased = 0;   // the one heap all transient textures share
+    uint64_t transientUnaliased = 0; // what they would take with one allocation each
+    uint64_t persistent = 0;         // history, persistent and extracted textures
+};
+
+struct RunOptions {
+    uint32_t frames = 0;              // 0: the graph's frame.frames
+    std::vector<uint32_t> write;      // empty: the graph's frame.write
+    bool progress = true;
+    // Called for every graph output of every written frame, after the frame completed.
+    std::function<void(uint32_t frame, const std::string& output, const Image& image)> onOutput;
+};
+
+// Phase 7: turns a CompiledGraph into Vulkan objects (physical images, the aliased transient
+// heap, pipelines from reflected SPIR-V) and runs frames: barriers from the tracked state of
+// each image, one timestamp scope per pass, read-back of the outputs of chosen frames.
+class Executor {
+public:
+    Executor(Context& ctx, CompiledGraph& graph, ShaderCompiler& shaders);
+    ~Executor();
+    Executor(const Executor&) = delete;
+    Executor& operator=(const Executor&) = delete;
+
+    void run(const RunOptions& options = {});
+
+    const std::vector<FrameTiming>& timings() const { return mTimings; }
+    const MemoryStats& memory() const { return mMemory; }
+    double pipelineMs() const { return mPipelineMs; }
+    // The image a resource had in the last frame run (for tests and debugging).
+    const GpuImage& image(const std::string& resource) const;
+    Image read(const std::string& resource);
+
+    struct Pipeline;
+    struct Physical {
+        GpuImage image;
+        ImageSyncState state;
+    };
+
+private:
+    friend class PassContext;
+    void create(ShaderCompiler& shaders);
+    void destroy();
+    void createImages();
+    void createPipelines(ShaderCompiler& shaders);
+    uint32_t physicalOf(uint32_t resource, bool previous) const;
+    void recordFrame(VkCommandBuffer cmd);
+
+    Context& mCtx;
+    CompiledGraph& mGraph;
+    std::vector<Physical> mPhysical;
+    std::vector<std::array<uint32_t, 2>> mResourcePhysical; // history resources use both
+    VkDeviceMemory mTransientHeap = VK_NULL_HANDLE;
+    std::vector<std::vector<std::unique_ptr<Pipeline>>> mPipelines; // per pass
+    VkSampler mSampler = VK_NULL_HANDLE;
+    VkDescriptorPool mDescriptorPool = VK_NULL_HANDLE;
+    GpuImage mDummy; // bound to unconnected optional inputs
+    std::unique_ptr<GpuProfiler> mProfiler;
+    std::vector<FrameTiming> mTimings;
+    MemoryStats mMemory;
+    double mPipelineMs = 0.0;
+    uint32_t mFrame = 0;
+    std::vector<GpuBuffer> mFrameStaging; // uploads recorded this frame
+};
+
+} // namespace vitrine

@@ -1,0 +1,40 @@
+#include "core/graph/node.hpp"
+
+#include "core/base/error.hpp"
+#include "core/graph/registry.hpp"
+
+namespace vitrine {
+
+const nlohmann::json& Params::at(const std::string& name) const {
+    auto it = mValues.find(name);
+    if (it == mValues.end()) throw InternalError("node " + mSchema.type + " reads undeclared param '" + name + "'");
+    return *it;
+}
+
+bool Params::getBool(const std::string& name) const { return at(name).get<bool>(); }
+int Params::getInt(const std::string& name) const { return at(name).get<int>(); }
+float Params::getFloat(const std::string& name) const { return at(name).get<float>(); }
+std::string Params::getString(const std::string& name) const { return at(name).get<std::string>(); }
+
+glm::vec2 Params::getVec2(const std::string& name) const {
+    const auto& v = at(name);
+    return {v[0].get<float>(), v[1].get<float>()};
+}
+glm::vec3 Params::getVec3(const std::string& name) const {
+    const auto& v = at(name);
+    return {v[0].get<float>(), v[1].get<float>(), v[2].get<float>()};
+}
+glm::vec4 Params::getVec4(const std::string& name) const {
+    const auto& v = at(name);
+    return {v[0].get<float>(), v[1].get<float>(), v[2].get<float>(), v[3].get<float>()};
+}
+
+int Params::getEnumIndex(const std::string& name) const {
+    const ParamSpec* spec = mSchema.findParam(name);
+    std::string value = getString(name);
+    for (size_t i = 0; spec && i < spec->choices.size(); ++i)
+        if (spec->choices[i] == value) return static_cast<int>(i);
+    throw InternalError("node " + mSchema.type + ": param '" + name + "' is not an enum value");
+}
+
+} // namespace vitrine

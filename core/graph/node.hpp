@@ -1,0 +1,96 @@
+#pragma once
+
+#include "core/gpu/resources.hpp"
+#include "core/image/image.hpp"
+#include "core/graph/graph_desc.hpp"
+#include "core/shader/compiler.hpp"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace vitrine {
+
+class Context;
+
+// Typed read access to a node's validated params (the loader filled in every default, so a
+// missing name here is a bug in the node, not in the user's graph).
+class Params {
+public:
+    Params(const nlohmann::json& values, const NodeSchema& schema) : mValues(values), mSchema(schema) {}
+    bool getBool(const std::string& name) const;
+    int getInt(const std::string& name) const;
+    float getFloat(const std::string& name) const;
+    glm::vec2 getVec2(const std::string& name) const;
+    glm::vec3 getVec3(const std::string& name) const;
+    glm::vec4 getVec4(const std::string& name) const;
+    std::string getString(const std::string& name) const;
+    // Index of an Enum param's value in its schema's choices.
+    int getEnumIndex(const std::string& name) const;
+
+private:
+    const nlohmann::json& at(const std::string& name) const;
+    const nlohmann::json& mValues;
+    const NodeSchema& mSchema;
+};
+
+using PipelineId = uint32_t;
+
+// Passed to Node::setup() once, when the graph is compiled (also by `vitrine validate`, with
+// no GPU). A node reads its params and input descriptions here, may adjust its output
+// descriptions, and declares the pipelines it will dispatch.
+class SetupContext {
+public:
+    virtual ~SetupContext() = default;
+    virtual const Params& params() const = 0;
+    virtual const FrameSettings& frame() const = 0;
+    virtual bool hasInput(const std::string& port) const = 0;
+    virtual const ImageDesc& input(const std::string& port) const = 0;
+    virtual ImageDesc& output(const std::string& port) = 0;
+    virtual PipelineId computePipeline(const std::string& shaderPath, const ShaderDefines& defines = {}) = 0;
+    // A compute pipeline from GLSL the node generated itself; `name` appears in errors.
+    virtual PipelineId computePipelineSource(const std::string& name, const std::string& source) = 0;
+    // Resolves a path param relative to the graph file's directory.
+    virtual std::filesystem::path resolvePath(const std::string& path) const = 0;
+    // Throws UserError naming the graph file and /nodes/<id>/params/<param>.
+    [[noreturn]] virtual void failParam(const std::string& param, const std::string& message) const = 0;
+};
+
+// Passed to Node::execute() every frame while the pass is recorded. All barriers and layout
+// transitions for the ports have been issued already.
+class ExecuteContext {
+public:
+    virtual ~ExecuteContext() = default;
+    virtual Context& gpu() = 0;
+    virtual VkCommandBuffer cmd() = 0;
+    virtual uint32_t frameIndex() const = 0;
+    virtual const Params& params() const = 0;
+    virtual bool hasInput(const std::string& port) const = 0;
+    // False when the input reads `x@prev` and no previous frame exists yet (it reads zeros).
+    virtual bool inputValid(const std::string& port) const = 0;
+    virtual const GpuImage& input(const std::string& port) = 0;
+    virtual const GpuImage& output(const std::string& port) = 0;
+    // Binds in_<port> / out_<port> by the shader's reflected names, pushes `push` (its size
+    // must equal the shader's push-constant block) and dispatches enough groups to cover
+    // width x height with the shader's local size.
+    virtual void dispatch(PipelineId pipeline, const void* push, uint32_t pushSize, uint32_t width,
+                          uint32_t height, uint32_t depth = 1) = 0;
+
+    // Records a copy of `pixels` into an output whose port usage is TransferDst.
+    virtual void upload(const std::string& port, const Image& pixels) = 0;
+
+    template <typename T> void dispatch(PipelineId pipeline, const T& push, uint32_t width, uint32_t height) {
+        dispatch(pipeline, &push, static_cast<uint32_t>(sizeof(T)), width, height, 1);
+    }
+};
+
+class Node {
+public:
+    virtual ~Node() = default;
+    virtual void setup(SetupContext& ctx) {}
+    virtual void execute(ExecuteContext& ctx) = 0;
+};
+
+} // namespace vitrine

@@ -1,0 +1,57 @@
+// post.tonemap: exposure and a tone curve, applied to the finished HDR image.
+#include "core/graph/node.hpp"
+#include "core/graph/registry.hpp"
+#include "shaders/post/tonemap.h"
+
+#include <cmath>
+
+namespace vitrine {
+namespace {
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "post.tonemap";
+    s.doc = "Exposure (EV) then a tone curve: ACES fit for display, or an exactly invertible Reinhard curve.";
+    s.inputs = {{"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"}};
+    OutputPort out;
+    out.name = "color";
+    out.formatFrom = "color";
+    out.size = SizeRule::ofInput("color");
+    out.doc = "Tone-mapped linear colour in [0, 1] (or linear HDR when inverse)";
+    s.outputs = {out};
+    s.params = {
+        {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {}, "Exposure in stops: colour is scaled by 2^exposure"},
+        {"operator", ParamType::Enum, "aces_fit", {}, {}, {"linear", "reinhard", "reinhard_max", "aces_fit"},
+         "Tone curve; reinhard and reinhard_max are exactly invertible"},
+        {"inverse", ParamType::Bool, false, {}, {}, {},
+         "Undo the curve and the exposure (invertible operators only): the round trip TAA relies on"},
+    };
+    return s;
+}
+
+class Tonemap final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        const auto& p = ctx.params();
+        if (p.getBool("inverse") && p.getString("operator") == "aces_fit")
+            ctx.failParam("inverse", "aces_fit is clamped and not invertible; use linear, reinhard or reinhard_max");
+        mPipeline = ctx.computePipeline("post/tonemap.comp");
+    }
+    void execute(ExecuteContext& ctx) override {
+        const auto& p = ctx.params();
+        gpu_types::TonemapPush push{};
+        push.exposureScale = std::exp2(p.getFloat("exposure"));
+        push.op = static_cast<uint32_t>(p.getEnumIndex("operator"));
+        push.inverse = p.getBool("inverse") ? 1u : 0u;
+        const ImageDesc& out = ctx.output("color").desc();
+        ctx.dispatch(mPipeline, push, out.width, out.height);
+    }
+
+private:
+    PipelineId mPipeline = 0;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Tonemap>(); });
+
+} // namespace
+} // namespace vitrine

@@ -1,0 +1,21 @@
+#ifndef PATTERN_ZONEPLATE_H
+#define PATTERN_ZONEPLATE_H
+#include "../common/shared.h"
+
+#define ZONEPLATE_SINE 0
+#define ZONEPLATE_BINARY 1
+
+#ifdef __cplusplus
+namespace vitrine::gpu_types {
+#endif
+VITRINE_PUSH_BEGIN(ZoneplatePush)
+    float maxFrequency; // cycles per pixel reached at the corners
+    uint supersample;   // N: N x N stratified samples per pixel, box filter
+    uint mode;          // ZONEPLATE_*
+    float pad;
+VITRINE_PUSH_END(zp)
+#ifdef __cplusplus
+static_assert(sizeof(ZoneplatePush) == 16);
+}
+#endif
+#endif

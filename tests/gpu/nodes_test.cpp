@@ -1,0 +1,186 @@
+// Each node against an independent CPU evaluation of the same maths, on the Vulkan device the
+// machine has (lavapipe in CI), with validation on.
+#include "tests/gpu/gpu_test.hpp"
+
+#include "core/base/error.hpp"
+#include "core/image/color.hpp"
+#include "core/image/io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+
+json checkerNode() {
+    // Supersampled edges give a spread of values between the two HDR colours.
+    return {{"type", "pattern.checker"},
+            {"params",
+             {{"cell_size", 5.0}, {"angle", 13.0}, {"supersample", 3},
+              {"color_a", {0.02, 0.1, 0.3, 1.0}}, {"color_b", {6.0, 2.5, 0.7, 1.0}}}}};
+}
+
+json graph(json nodes, json outputs, int w = 96, int h = 64) {
+    return {{"format", "vitrine-graph/1"}, {"frame", {{"width", w}, {"height", h}}}, {"nodes", nodes}, {"outputs", outputs}};
+}
+
+float cpuTonemap(float x, const std::string& op, float maxChannel) {
+    if (op == "reinhard") return x / (1.0f + x);
+    if (op == "reinhard_max") return x / (1.0f + maxChannel);
+    if (op == "aces_fit") return std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+    return x;
+}
+
+class Nodes : public GpuTest {};
+
+TEST_F(Nodes, TonemapMatchesCpuFormula) {
+    for (std::string op : {"linear", "reinhard", "reinhard_max", "aces_fit"}) {
+        const float exposure = 0.7f;
+        auto out = runGraph(graph({{"src", checkerNode()},
+                                   {"tm", {{"type", "post.tonemap"},
+                                           {"params", {{"operator", op}, {"exposure", exposure}}},
+                                           {"in", {{"color", "src.color"}}}}}},
+                                  {{"in", "src.color"}, {"out", "tm.color"}}));
+        const Image& in = out.at("in");
+        const Image& tm = out.at("out");
+        double worst = 0.0;
+        for (int y = 0; y < in.height; ++y)
+            for (int x = 0; x < in.width; ++x) {
+                const float* p = in.at(x, y);
+                float scaled[3], m = 0.0f;
+                for (int c = 0; c < 3; ++c) m = std::max(m, scaled[c] = p[c] * std::exp2(exposure));
+                for (int c = 0; c < 3; ++c) {
+                    double expected = cpuTonemap(scaled[c], op, m);
+                    worst = std::max(worst, std::fabs(expected - tm.at(x, y)[c]) / std::max(1.0, std::fabs(expected)));
+                }
+            }
+        EXPECT_LT(worst, 1e-5) << op;
+    }
+}
+
+TEST_F(Nodes, InvertibleCurvesRoundTrip) {
+    for (std::string op : {"reinhard", "reinhard_max"}) {
+        auto out = runGraph(graph(
+            {{"src", checkerNode()},
+             {"fwd", {{"type", "post.tonemap"}, {"params", {{"operator", op}, {"exposure", 1.5}}}, {"in", {{"color", "src.color"}}}}},
+             {"inv",
+              {{"type", "post.tonemap"},
+               {"params", {{"operator", op}, {"exposure", 1.5}, {"inverse", true}}},
+               {"in", {{"color", "fwd.color"}}}}}},
+            {{"in", "src.color"}, {"round", "inv.color"}}));
+        const Image& in = out.at("in");
+        const Image& round = out.at("round");
+        double worst = 0.0;
+        for (size_t i = 0; i < in.pixels.size(); ++i)
+            if (i % 4 != 3) worst = std::max(worst, static_cast<double>(std::fabs(in.pixels[i] - round.pixels[i]) / std::max(1e-3f, in.pixels[i])));
+        EXPECT_LT(worst, 1e-4) << op;
+    }
+}
+
+TEST_F(Nodes, AcesInverseIsAUserError) {
+    json g = graph({{"src", checkerNode()},
+                    {"tm", {{"type", "post.tonemap"}, {"params", {{"inverse", true}}}, {"in", {{"color", "src.color"}}}}}},
+                   {{"out", "tm.color"}});
+    try {
+        runGraph(g);
+        FAIL() << "expected a UserError";
+    } catch (const UserError& e) {
+        EXPECT_NE(std::string(e.what()).find("/nodes/tm/params/inverse"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(Nodes, ZoneplateAndCheckerMatchCpuAtPixelCentres) {
+    const int w = 80, h = 48;
+    auto out = runGraph(graph({{"zs", {{"type", "pattern.zoneplate"}, {"params", {{"mode", "sine"}, {"max_frequency", 0.9}}}}},
+                               {"zb", {{"type", "pattern.zoneplate"}, {"params", {{"mode", "binary"}, {"max_frequency", 0.4}}}}},
+                               {"ck", {{"type", "pattern.checker"}, {"params", {{"cell_size", 7.0}, {"angle", 30.0}}}}}},
+                              {{"sine", "zs.color"}, {"binary", "zb.color"}, {"checker", "ck.color"}}, w, h));
+    const double cx = w * 0.5, cy = h * 0.5, radius = std::sqrt(cx * cx + cy * cy), pi = 3.14159265358979;
+    int binaryMismatches = 0, checkerMismatches = 0;
+    double sineWorst = 0.0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
+            double r2 = dx * dx + dy * dy;
+            sineWorst = std::max(sineWorst, std::fabs(0.5 + 0.5 * std::cos(pi * 0.9 * r2 / radius) - out["sine"].at(x, y)[0]));
+            double b = std::cos(pi * 0.4 * r2 / radius) >= 0.0 ? 1.0 : 0.0;
+            binaryMismatches += std::fabs(b - out["binary"].at(x, y)[0]) > 1e-6;
+            double a = 30.0 * pi / 180.0, u = (std::cos(a) * dx + std::sin(a) * dy) / 7.0,
+                   v = (-std::sin(a) * dx + std::cos(a) * dy) / 7.0;
+            bool odd = ((static_cast<long>(std::floor(u)) + static_cast<long>(std::floor(v))) & 1) != 0;
+            checkerMismatches += std::fabs((odd ? 0.9 : 0.05) - out["checker"].at(x, y)[0]) > 1e-6;
+        }
+    EXPECT_LT(sineWorst, 2e-3); // GPU cos of a large argument in fp32
+    // Pixels whose centre sits on an edge may round either way in fp32.
+    EXPECT_LE(binaryMismatches, w * h / 200);
+    EXPECT_LE(checkerMismatches, w * h / 200);
+}
+
+TEST_F(Nodes, FxaaReducesZoneplateErrorAgainstSupersampledReference) {
+    const std::string dir = VITRINE_SOURCE_DIR "/graphs/";
+    std::vector<std::string> size = {"frame.width=320", "frame.height=180"};
+    Image fxaa = runGraphFile(dir + "fxaa_zoneplate.json", size).at("final");
+    Image none = runGraphFile(dir + "variants/no_fxaa.json", size).at("final");
+    Image truth = runGraphFile(dir + "variants/supersampled.json", size).at("final");
+    double eFxaa = rmse(fxaa, truth), eNone = rmse(none, truth);
+    RecordProperty("rmse_fxaa", std::to_string(eFxaa));
+    RecordProperty("rmse_no_aa", std::to_string(eNone));
+    std::printf("zone plate RMSE vs 16x16 supersampled: no AA %.4f, FXAA %.4f (%.1f%% lower)\n", eNone, eFxaa,
+                100.0 * (1.0 - eFxaa / eNone));
+    // The stated margin: FXAA removes at least 15 % of the aliasing error.
+    EXPECT_LT(eFxaa, 0.85 * eNone);
+}
+
+TEST_F(Nodes, FxaaLeavesFlatImagesAlone) {
+    auto out = runGraph(graph({{"flat", {{"type", "pattern.checker"},
+                                         {"params", {{"color_a", {0.4, 0.4, 0.4, 1.0}}, {"color_b", {0.4, 0.4, 0.4, 1.0}}}}}},
+                               {"fxaa", {{"type", "aa.fxaa"}, {"in", {{"color", "flat.color"}}}}}},
+                              {{"in", "flat.color"}, {"out", "fxaa.color"}}));
+    EXPECT_LT(maxAbsDiff(out["in"], out["out"]), 1e-6);
+}
+
+TEST_F(Nodes, OcioDisplayOnGpuMatchesOcioCpuProcessor) {
+    auto out = runGraph(graph({{"src", checkerNode()},
+                               {"disp", {{"type", "color.display"}, {"in", {{"color", "src.color"}}}}}},
+                              {{"in", "src.color"}, {"display", "disp.color"}}));
+    Image cpu = ColorConfig::builtin().toDisplay(out["in"]);
+    double worst = 0.0;
+    for (size_t i = 0; i < cpu.pixels.size(); ++i)
+        if (i % 4 != 3) worst = std::max(worst, std::fabs(static_cast<double>(cpu.pixels[i] - out["display"].pixels[i])) /
+                                                    std::max(1.0, std::fabs(static_cast<double>(cpu.pixels[i]))));
+    EXPECT_LT(worst, 1e-4);
+}
+
+TEST_F(Nodes, DebugViewSelectsChannelAndRange) {
+    auto out = runGraph(graph({{"src", checkerNode()},
+                               {"view", {{"type", "debug.view"},
+                                         {"params", {{"channel", "g"}, {"range", {0.5, 2.5}}}},
+                                         {"in", {{"texture", "src.color"}}}}}},
+                              {{"in", "src.color"}, {"view", "view.color"}}));
+    double worst = 0.0;
+    for (int y = 0; y < out["in"].height; ++y)
+        for (int x = 0; x < out["in"].width; ++x) {
+            double expected = std::clamp((out["in"].at(x, y)[1] - 0.5) / 2.0, 0.0, 1.0);
+            for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(expected - out["view"].at(x, y)[c]));
+        }
+    EXPECT_LT(worst, 1e-3); // rgba16f output
+}
+
+TEST_F(Nodes, ImageLoadUploadsTheFileExactly) {
+    Image img(17, 9);
+    for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = 0.001f * static_cast<float>(i * 37 % 1000) + 0.25f;
+    auto path = std::filesystem::temp_directory_path() / "vitrine_gpu_load_test.exr";
+    writeExr(path, img, ExrPixelType::Float);
+    auto out = runGraph(graph({{"load", {{"type", "image.load"}, {"params", {{"path", path.string()}}}}}},
+                              {{"img", "load.color"}}));
+    std::filesystem::remove(path);
+    ASSERT_EQ(out["img"].width, 17);
+    ASSERT_EQ(out["img"].height, 9);
+    EXPECT_EQ(maxAbsDiff(out["img"], img), 0.0);
+}
+
+} // namespace
+} // namespace vitrine::test

@@ -1,0 +1,57 @@
+#include "tools/vitrine/cli.hpp"
+
+#include "core/base/error.hpp"
+
+#include <algorithm>
+
+namespace vitrine::cli {
+
+std::string Args::get(const std::string& name, const std::string& fallback) const {
+    auto it = options.find(name);
+    return it == options.end() || it->second.empty() ? fallback : it->second.back();
+}
+
+const std::vector<std::string>& Args::all(const std::string& name) const {
+    static const std::vector<std::string> kNone;
+    auto it = options.find(name);
+    return it == options.end() ? kNone : it->second;
+}
+
+uint32_t Args::getUint(const std::string& name, uint32_t fallback) const {
+    if (!has(name)) return fallback;
+    std::string v = get(name);
+    if (v.empty() || !std::all_of(v.begin(), v.end(), ::isdigit) || v.size() > 9)
+        throw UserError("--" + name + ": expected a non-negative integer, got '" + v + "'");
+    return static_cast<uint32_t>(std::stoul(v));
+}
+
+Args parse(int argc, char** argv, const std::vector<std::string>& valued) {
+    Args a;
+    for (int i = 1; i < argc; ++i) {
+        std::string s = argv[i];
+        if (s.rfind("--", 0) == 0 && s.size() > 2) {
+            std::string name = s.substr(2), value;
+            auto eq = name.find('=');
+            bool hasValue = eq != std::string::npos;
+            if (hasValue) {
+                value = name.substr(eq + 1);
+                name = name.substr(0, eq);
+            }
+            bool takes = std::find(valued.begin(), valued.end(), name) != valued.end();
+            if (takes && !hasValue) {
+                if (i + 1 >= argc) throw UserError("--" + name + " needs a value");
+                value = argv[++i];
+            } else if (!takes && hasValue) {
+                throw UserError("--" + name + " takes no value");
+            }
+            a.options[name].push_back(value);
+        } else if (a.command.empty()) {
+            a.command = s;
+        } else {
+            a.positional.push_back(s);
+        }
+    }
+    return a;
+}
+
+} // namespace vitrine::cli

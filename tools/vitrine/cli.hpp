@@ -1,0 +1,31 @@
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace vitrine::cli {
+
+// Parsed command line: positional arguments, repeatable options (--set) and flags.
+struct Args {
+    std::string command;
+    std::vector<std::string> positional;
+    std::map<std::string, std::vector<std::string>> options;
+
+    bool has(const std::string& name) const { return options.count(name) != 0; }
+    std::string get(const std::string& name, const std::string& fallback = "") const;
+    const std::vector<std::string>& all(const std::string& name) const;
+    uint32_t getUint(const std::string& name, uint32_t fallback) const;
+};
+
+// Options that take a value; everything else starting with -- is a flag.
+Args parse(int argc, char** argv, const std::vector<std::string>& valued);
+
+int runCommand(const Args& args);
+int validateCommand(const Args& args);
+int nodesCommand(const Args& args);
+int benchCommand(const Args& args);
+int graphCommand(const Args& args);
+int devicesCommand(const Args& args);
+
+} // namespace vitrine::cli

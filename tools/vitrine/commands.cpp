@@ -1,0 +1,280 @@
+#include "core/base/error.hpp"
+#include "core/base/log.hpp"
+#include "core/gpu/context.hpp"
+#include "core/gpu/formats.hpp"
+#include "core/graph/compiler.hpp"
+#include "core/graph/executor.hpp"
+#include "core/graph/loader.hpp"
+#include "core/graph/registry.hpp"
+#include "core/image/io.hpp"
+#include "core/shader/compiler.hpp"
+#include "tools/vitrine/cli.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <set>
+
+namespace vitrine::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string graphArg(const Args& args) {
+    if (args.positional.size() != 1) throw UserError(args.command + ": expected one GRAPH file argument");
+    return args.positional[0];
+}
+
+CompiledGraph compileFromArgs(const Args& args) {
+    GraphDesc desc = loadGraph(graphArg(args), args.all("set"));
+    if (args.has("frames")) {
+        desc.frame.frames = std::max(1u, args.getUint("frames", 1));
+        for (auto& w : desc.frame.write) w = std::min(w, desc.frame.frames - 1);
+        if (!args.has("write-all")) desc.frame.write = {desc.frame.frames - 1};
+    }
+    return compileGraph(std::move(desc));
+}
+
+ContextOptions contextOptions(const Args& args) {
+    ContextOptions o;
+    o.device = args.get("device");
+    o.validation = args.has("validate");
+    return o;
+}
+
+// Files vitrine wrote into an output directory. A file that exists but is not listed was not
+// written by vitrine, and is not overwritten unless --overwrite says so.
+class OutputDir {
+public:
+    OutputDir(fs::path dir, bool overwrite) : mDir(std::move(dir)), mOverwrite(overwrite) {
+        std::error_code ec;
+        fs::create_directories(mDir, ec);
+        if (!fs::is_directory(mDir)) throw UserError(mDir.string() + ": cannot create the output directory");
+        std::ifstream in(mDir / kManifest);
+        for (std::string line; std::getline(in, line);)
+            if (!line.empty()) mWritten.insert(line);
+    }
+    fs::path claim(const std::string& name) {
+        fs::path p = mDir / name;
+        std::error_code ec;
+        fs::create_directories(p.parent_path(), ec);
+        if (fs::exists(p) && !mWritten.count(name) && !mOverwrite)
+            throw UserError(p.string() + ": exists and was not written by vitrine; pass --overwrite to replace it, "
+                                         "or choose another --out");
+        if (mWritten.insert(name).second) std::ofstream(mDir / kManifest, std::ios::app) << name << "\n";
+        return p;
+    }
+    const fs::path& dir() const { return mDir; }
+
+private:
+    static constexpr const char* kManifest = ".vitrine-outputs";
+    fs::path mDir;
+    bool mOverwrite;
+    std::set<std::string> mWritten;
+};
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string mib(uint64_t bytes) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f MiB", static_cast<double>(bytes) / (1024.0 * 1024.0));
+    return buf;
+}
+
+} // namespace
+
+int runCommand(const Args& args) {
+    CompiledGraph graph = compileFromArgs(args);
+    std::string exrMode = args.get("exr", "half");
+    if (exrMode != "half" && exrMode != "float" && exrMode != "none")
+        throw UserError("--exr: expected half, float or none, got '" + exrMode + "'");
+    fs::path outDir = args.get("out", (fs::path("out") / fs::path(graphArg(args)).stem()).string());
+    OutputDir out(outDir, args.has("overwrite"));
+
+    Context ctx(contextOptions(args));
+    logInfo("device: " + ctx.deviceInfo().name + "; " + std::to_string(graph.passes.size()) + " passes, " +
+            std::to_string(graph.desc.frame.width) + "x" + std::to_string(graph.desc.frame.height) + ", " +
+            std::to_string(graph.desc.frame.frames) + " frame(s)");
+    ShaderCompiler shaders;
+    Executor executor(ctx, graph, shaders);
+
+    const bool single = graph.desc.frame.write.size() == 1;
+    std::map<uint32_t, std::vector<std::pair<std::string, Image>>> frames;
+    RunOptions options;
+    options.progress = !args.has("quiet");
+    options.onOutput = [&](uint32_t frame, const std::string& name, const Image& image) {
+        char suffix[16];
+        std::snprintf(suffix, sizeof suffix, ".%04u", frame);
+        fs::path png = out.claim(name + (single ? "" : suffix) + ".png");
+        writePng(png, image);
+        if (exrMode != "none") frames[frame].push_back({name, image});
+    };
+    executor.run(options);
+    for (auto& [frame, layers] : frames) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame.%04u.exr", frame);
+        std::vector<ExrLayer> exr;
+        for (const auto& [layer, image] : layers) exr.push_back({layer, &image});
+        writeExr(out.claim(name), exr, exrMode == "float" ? ExrPixelType::Float : ExrPixelType::Half);
+    }
+    if (ctx.validationMessageCount() > 0) {
+        logWarning(std::to_string(ctx.validationMessageCount()) + " Vulkan validation message(s)");
+        return 2;
+    }
+    logInfo("wrote " + std::to_string(graph.outputs.size()) + " output(s) of " +
+            std::to_string(graph.desc.frame.write.size()) + " frame(s) to " + out.dir().string());
+    return 0;
+}
+
+int validateCommand(const Args& args) {
+    CompiledGraph graph = compileFromArgs(args);
+    std::printf("%s: ok: %zu passes, %zu textures, %zu output(s)", graphArg(args).c_str(), graph.passes.size(),
+                graph.resources.size(), graph.outputs.size());
+    if (!graph.culled.empty()) {
+        std::printf("; culled (no output needs them):");
+        for (const auto& c : graph.culled) std::printf(" %s", c.c_str());
+    }
+    std::printf("\n");
+    return 0;
+}
+
+int nodesCommand(const Args& args) {
+    const NodeRegistry& registry = NodeRegistry::global();
+    if (args.has("json")) {
+        std::cout << registry.toJson().dump(2) << "\n";
+        return 0;
+    }
+    for (const NodeSchema* s : registry.all()) {
+        std::printf("%s\n    %s\n", s->type.c_str(), s->doc.c_str());
+        for (const auto& in : s->inputs)
+            std::printf("    in  %-14s %s%s: %s\n", in.name.c_str(), toString(in.kind), in.optional ? " (optional)" : "",
+                        in.doc.c_str());
+        for (const auto& o : s->outputs)
+            std::printf("    out %-14s %s %s: %s\n", o.name.c_str(), toString(o.kind),
+                        o.formatFrom.empty() ? formatName(o.format).c_str() : ("as " + o.formatFrom).c_str(), o.doc.c_str());
+        for (const auto& p : s->params)
+            std::printf("    param %-12s %s = %s: %s\n", p.name.c_str(), toString(p.type), p.defaultValue.dump().c_str(),
+                        p.doc.c_str());
+    }
+    return 0;
+}
+
+int benchCommand(const Args& args) {
+    auto compileStart = std::chrono::steady_clock::now();
+    CompiledGraph graph = compileFromArgs(args);
+    double graphMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - compileStart).count();
+    const uint32_t frames = args.getUint("frames", 20);
+    const uint32_t warmup = args.getUint("warmup", 2);
+    if (frames == 0) throw UserError("--frames: expected at least 1");
+
+    Context ctx(contextOptions(args));
+    ShaderCompiler shaders;
+    Executor executor(ctx, graph, shaders);
+    RunOptions options;
+    options.frames = frames + warmup;
+    options.progress = !args.has("quiet");
+    executor.run(options);
+
+    const auto& timings = executor.timings();
+    nlohmann::json j;
+    j["graph"] = graphArg(args);
+    j["device"] = ctx.deviceInfo().name;
+    j["width"] = graph.desc.frame.width;
+    j["height"] = graph.desc.frame.height;
+    j["frames"] = frames;
+    j["warmup"] = warmup;
+    j["compile_ms"] = {{"graph", graphMs}, {"pipelines", executor.pipelineMs()}};
+    j["memory_bytes"] = {{"transient_aliased", executor.memory().transientAliased},
+                         {"transient_unaliased", executor.memory().transientUnaliased},
+                         {"persistent", executor.memory().persistent}};
+    std::vector<double> total, record;
+    j["passes"] = nlohmann::json::array();
+    for (size_t p = 0; p < graph.passes.size(); ++p) {
+        std::vector<double> ms;
+        for (size_t f = warmup; f < timings.size(); ++f) ms.push_back(timings[f].passGpuMs[p]);
+        j["passes"].push_back({{"id", graph.passes[p].id}, {"type", graph.passes[p].schema->type},
+                               {"gpu_ms_median", median(ms)},
+                               {"gpu_ms_min", *std::min_element(ms.begin(), ms.end())},
+                               {"gpu_ms_max", *std::max_element(ms.begin(), ms.end())}});
+    }
+    for (size_t f = warmup; f < timings.size(); ++f) {
+        double sum = 0;
+        for (double v : timings[f].passGpuMs) sum += v;
+        total.push_back(sum);
+        record.push_back(timings[f].cpuRecordMs);
+    }
+    j["gpu_ms_total_median"] = median(total);
+    j["cpu_record_ms_median"] = median(record);
+    if (ctx.validationMessageCount() > 0) j["validation_messages"] = ctx.validationMessageCount();
+
+    if (args.has("json")) {
+        std::string path = args.get("json");
+        if (path == "-") std::cout << j.dump(2) << "\n";
+        else std::ofstream(path) << j.dump(2) << "\n";
+    }
+    if (!args.has("json") || args.get("json") != "-") {
+        std::printf("%s on %s, %ux%u, median of %u frames (after %u warm-up)\n", graphArg(args).c_str(),
+                    ctx.deviceInfo().name.c_str(), graph.desc.frame.width, graph.desc.frame.height, frames, warmup);
+        std::printf("  %-20s %-20s %10s\n", "pass", "type", "GPU ms");
+        for (const auto& p : j["passes"])
+            std::printf("  %-20s %-20s %10.3f\n", p["id"].get<std::string>().c_str(), p["type"].get<std::string>().c_str(),
+                        p["gpu_ms_median"].get<double>());
+        std::printf("  %-41s %10.3f\n", "total GPU", median(total));
+        std::printf("  CPU record %.3f ms; compile: graph %.2f ms, pipelines %.1f ms\n", median(record), graphMs,
+                    executor.pipelineMs());
+        const MemoryStats& m = executor.memory();
+        std::printf("  transient memory: %s aliased, %s without aliasing (%.0f%%); persistent %s\n",
+                    mib(m.transientAliased).c_str(), mib(m.transientUnaliased).c_str(),
+                    m.transientUnaliased ? 100.0 * m.transientAliased / m.transientUnaliased : 100.0,
+                    mib(m.persistent).c_str());
+    }
+    return ctx.validationMessageCount() > 0 ? 2 : 0;
+}
+
+int graphCommand(const Args& args) {
+    CompiledGraph graph = compileFromArgs(args);
+    if (!args.has("dot")) throw UserError("graph: choose an output format: --dot");
+    std::printf("digraph vitrine {\n  rankdir=LR;\n  node [shape=box, fontname=\"monospace\"];\n");
+    for (size_t p = 0; p < graph.passes.size(); ++p)
+        std::printf("  p%zu [label=\"%zu: %s\\n%s\"];\n", p, p, graph.passes[p].id.c_str(),
+                    graph.passes[p].schema->type.c_str());
+    for (size_t r = 0; r < graph.resources.size(); ++r) {
+        const GraphResource& res = graph.resources[r];
+        std::string kind = res.history ? "history" : res.persistent ? "persistent" : res.extracted ? "output" : "transient";
+        std::printf("  r%zu [shape=ellipse, label=\"%s\\n%ux%u %s\\n%s, passes %u-%u\"];\n", r, res.name.c_str(),
+                    res.desc.width, res.desc.height, formatName(res.desc.format).c_str(), kind.c_str(), res.firstPass,
+                    res.lastPass);
+    }
+    for (size_t p = 0; p < graph.passes.size(); ++p)
+        for (const auto& u : graph.passes[p].uses) {
+            if (u.output) std::printf("  p%zu -> r%u;\n", p, u.resource);
+            else std::printf("  r%u -> p%zu [label=\"%s%s\"%s];\n", u.resource, p, u.port.c_str(),
+                             u.previous ? "@prev" : "", u.previous ? ", style=dashed" : "");
+        }
+    for (const auto& c : graph.culled) std::printf("  \"%s\" [style=dotted, label=\"%s (culled)\"];\n", c.c_str(), c.c_str());
+    std::printf("}\n");
+    return 0;
+}
+
+int devicesCommand(const Args& args) {
+    for (const auto& d : Context::listDevices()) {
+        const char* type = d.type == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU     ? "discrete"
+                           : d.type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU ? "integrated"
+                           : d.type == VK_PHYSICAL_DEVICE_TYPE_CPU            ? "cpu"
+                                                                              : "other";
+        std::printf("%u: %s (%s, Vulkan %u.%u)\n", d.index, d.name.c_str(), type, VK_API_VERSION_MAJOR(d.apiVersion),
+                    VK_API_VERSION_MINOR(d.apiVersion));
+    }
+    return 0;
+}
+
+} // namespace vitrine::cli
