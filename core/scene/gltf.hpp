@@ -1,0 +1,48 @@
+#pragma once
+
+// glTF 2.0 in and out. Loading goes through tinygltf behind checks of our own, so that a bad file is a
+// UserError naming the file, the element (`meshes[3].primitives[0].attributes.NORMAL`) and what was
+// expected, never a crash. Called by the scene nodes of the render graph and by `vitrine` tools.
+//
+// Supported on load: meshes (triangles, strips, fans; u8/u16/u32 indices; float or normalised-integer
+// attributes, sparse accessors), NORMAL (flat normals generated when absent, as glTF asks), TANGENT
+// (generated when absent, see tangents.hpp), TEXCOORD_0/1, COLOR_0 (rgb), `_AO` (vertex AO), the
+// metallic-roughness material with all its textures, samplers, the node hierarchy, cameras, node
+// animations (objects and cameras), KHR_texture_transform, KHR_materials_emissive_strength,
+// KHR_lights_punctual (the first directional light becomes the sun), KHR_mesh_quantization and
+// VITRINE_material_layers (VITRINE_material_layers.md). Skins, morph targets and point/line primitives
+// are ignored with a warning. Embedded (data: URI, GLB) and external buffers and images both work.
+//
+// How glTF maps onto the scene model:
+// - A metallic-roughness material is a one-layer stack: shininess = 1 − roughnessFactor × texel.g,
+//   metallic = metallicFactor × texel.b, cavity = the occlusion texture (1 + strength × (texel.r − 1)).
+// - Texture usage, hence colour space, comes from the slots that use it: baseColor and emissive are
+//   sRGB, everything else linear. A glTF texture used both ways becomes two scene textures.
+// - Every camera node yields a camera path named after the node: one key for a still camera, samples
+//   at 30 Hz over its animations otherwise. Paths written by exportGlb() come back exactly.
+// - Node matrices are decomposed into translation/rotation/scale (shear is lost).
+
+#include "core/scene/scene.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace vitrine::scene {
+
+inline constexpr const char* kLayersExtension = "VITRINE_material_layers";
+
+// Loads a .gltf (JSON, external or data: URI buffers) or a .glb (recognised by its magic, whatever the
+// file is called). The result is finalized and valid (Scene::validate() passes).
+Scene loadGltf(const std::filesystem::path& file);
+// Same, and collects what was ignored (unsupported features, extra attributes) into warnings.
+Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings);
+
+// Writes the scene as one self-contained .glb: geometry (one interleaved vertex buffer view), materials
+// with VITRINE_material_layers plus a plain metallic-roughness fallback made from layer 0, textures as
+// embedded PNG, cameras, camera paths as animated camera nodes, the sun as a KHR_lights_punctual light,
+// rooms and exact physical parameters in `extras`. loadGltf() of the result gives back a scene with the
+// same contentHash(). UserError when the file cannot be written.
+void exportGlb(const Scene& scene, const std::filesystem::path& file);
+
+} // namespace vitrine::scene

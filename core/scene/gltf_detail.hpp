@@ -1,0 +1,96 @@
+#pragma once
+
+// Internal to the glTF loader and exporter: the load context, typed JSON reads that fail with the
+// element's path, and the pieces shared between load and export (extension names, texture infos).
+
+#include "core/scene/scene.hpp"
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace tinygltf {
+class Model;
+}
+
+namespace vitrine::scene::gltf {
+
+using Json = nlohmann::json;
+
+inline constexpr const char* kTextureTransform = "KHR_texture_transform";
+inline constexpr const char* kEmissiveStrength = "KHR_materials_emissive_strength";
+inline constexpr const char* kLightsPunctual = "KHR_lights_punctual";
+inline constexpr const char* kMeshQuantization = "KHR_mesh_quantization";
+// Our key inside `extras` for what glTF has no place for (physical camera, rooms, camera paths).
+inline constexpr const char* kExtrasKey = "vitrine";
+
+// Everything the conversion steps share; fail() is how every step reports a bad file.
+struct LoadContext {
+    std::string file; // as the user named it
+    std::filesystem::path baseDir;
+    Json doc;
+    std::vector<uint8_t> glbBin; // GLB binary chunk, empty for .gltf
+    const tinygltf::Model* model = nullptr;
+    Scene* scene = nullptr;
+    std::vector<std::string>* warnings = nullptr;
+    // Scene texture made for glTF texture i with usage u, or -1 (see resolveTexture()).
+    std::vector<std::array<int32_t, 3>> textureByUsage;
+    int32_t defaultMaterial = -1;
+
+    [[noreturn]] void fail(const std::string& element, const std::string& what) const;
+    void warn(const std::string& element, const std::string& what) const;
+};
+
+// `element.key`, or `key` at the top level (element empty).
+std::string path(const std::string& element, const char* key);
+// Typed reads of obj[key] that fail with `element.key` when the type is wrong; absent → def.
+const Json* member(const Json& obj, const char* key);
+double number(const LoadContext& ctx, const Json& obj, const char* key, double def, const std::string& element);
+int64_t integer(const LoadContext& ctx, const Json& obj, const char* key, int64_t def, const std::string& element);
+bool boolean(const LoadContext& ctx, const Json& obj, const char* key, bool def, const std::string& element);
+std::string string(const LoadContext& ctx, const Json& obj, const char* key, const std::string& def,
+                   const std::string& element);
+// A fixed-length array of numbers into the first n components of def.
+glm::vec4 numbers(const LoadContext& ctx, const Json& obj, const char* key, int n, glm::vec4 def,
+                  const std::string& element);
+// obj[key] as an object (nullptr when absent); fails when present but not an object.
+const Json* object(const LoadContext& ctx, const Json& obj, const char* key, const std::string& element);
+// The number of elements of the top-level array `name` (0 when absent).
+size_t topLevelCount(const LoadContext& ctx, const char* name);
+// Fails unless value is an integer index in [0, topLevelCount(target)).
+uint32_t checkIndex(const LoadContext& ctx, const Json& value, const std::string& element, const char* target);
+
+// Step 1: read the file, unwrap a GLB, parse the JSON, and check everything tinygltf would index or read
+// without checking: required extensions, cross-references, byte ranges, external files.
+void readAndPreflight(LoadContext& ctx, const std::filesystem::path& file, std::vector<uint8_t>& bytes);
+
+// Accessors, fully bounds-checked. Values are converted to float (normalised integers per glTF) and
+// returned as `components` floats per element; element names the use for messages.
+struct AccessorValues {
+    size_t count = 0;
+    int components = 0;
+    std::vector<float> data;
+    glm::vec4 get(size_t i) const; // missing components are 0
+};
+AccessorValues readAccessor(const LoadContext& ctx, int accessor, const std::string& element,
+                            std::initializer_list<int> allowedComponents, bool floatOnly = false);
+std::vector<uint32_t> readIndices(const LoadContext& ctx, int accessor, const std::string& element);
+
+// Steps of the conversion, in order.
+void loadImagesAndTextures(LoadContext& ctx);
+void loadMaterials(LoadContext& ctx);
+void loadMeshes(LoadContext& ctx);
+void loadNodesAndScene(LoadContext& ctx);
+
+// A glTF textureInfo (with KHR_texture_transform) as a TextureRef of the given usage.
+TextureRef readTextureInfo(LoadContext& ctx, const Json& info, TextureUsage usage, const std::string& element);
+// ... and back; textureIndex is the glTF texture index the scene texture was written as.
+Json writeTextureInfo(const TextureRef& ref, int textureIndex);
+
+const char* usageName(TextureUsage usage);
+
+} // namespace vitrine::scene::gltf

@@ -1,0 +1,516 @@
+// exportGlb(): the scene as one self-contained .glb that loadGltf() reads back to the same contentHash().
+
+#include "core/scene/gltf.hpp"
+#include "core/scene/gltf_detail.hpp"
+
+#include "core/base/error.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <fstream>
+
+#include <glm/gtc/constants.hpp>
+#include <stb/stb_image_write.h>
+
+namespace vitrine::scene {
+
+namespace {
+
+using gltf::Json;
+
+constexpr int kFloat = 5126, kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+
+Json vec(const glm::vec3& v) {
+    return Json::array({v.x, v.y, v.z});
+}
+Json vec(const glm::vec4& v) {
+    return Json::array({v.x, v.y, v.z, v.w});
+}
+Json vec(const glm::quat& q) {
+    return Json::array({q.x, q.y, q.z, q.w});
+}
+
+// The shortest rotation taking unit vector a onto unit vector b.
+glm::quat rotationBetween(const glm::vec3& a, const glm::vec3& b) {
+    float d = glm::dot(a, b);
+    if (d < -0.999999f) {
+        glm::vec3 axis = std::abs(a.x) < 0.9f ? glm::cross(a, glm::vec3(1, 0, 0)) : glm::cross(a, glm::vec3(0, 1, 0));
+        return glm::angleAxis(glm::pi<float>(), glm::normalize(axis));
+    }
+    glm::vec3 c = glm::cross(a, b);
+    return glm::normalize(glm::quat(1.0f + d, c.x, c.y, c.z));
+}
+
+int filterCode(Filter f) {
+    return f == Filter::Nearest ? 9728 : 9729;
+}
+
+int minFilterCode(const Sampler& s) {
+    bool nearest = s.minFilter == Filter::Nearest;
+    switch (s.mipFilter) {
+    case MipFilter::None:
+        return nearest ? 9728 : 9729;
+    case MipFilter::Nearest:
+        return nearest ? 9984 : 9985;
+    default:
+        return nearest ? 9986 : 9987;
+    }
+}
+
+int wrapCode(Wrap w) {
+    return w == Wrap::ClampToEdge ? 33071 : w == Wrap::MirroredRepeat ? 33648 : 10497;
+}
+
+float channelMean(const Scene& scene, const TextureRef& ref, uint32_t channel) {
+    const TextureImage& image = scene.images[scene.textures[ref.texture].image];
+    uint64_t sum = 0;
+    size_t count = size_t(image.width) * image.height;
+    for (size_t p = 0; p < count; ++p)
+        sum += image.pixels[p * 4 + channel];
+    return count ? float(sum) / (255.0f * count) : 1.0f;
+}
+
+class Exporter {
+public:
+    explicit Exporter(const Scene& scene) : mScene(scene) {}
+
+    std::vector<uint8_t> run();
+
+private:
+    size_t append(const void* data, size_t size) {
+        while (mBin.size() % 4)
+            mBin.push_back(0);
+        size_t at = mBin.size();
+        mBin.resize(at + size);
+        if (size) std::memcpy(mBin.data() + at, data, size);
+        return at;
+    }
+    int view(size_t offset, size_t length, int stride = 0, int target = 0) {
+        Json v = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
+        if (stride) v["byteStride"] = stride;
+        if (target) v["target"] = target;
+        mDoc["bufferViews"].push_back(v);
+        return static_cast<int>(mDoc["bufferViews"].size()) - 1;
+    }
+    int accessor(int bufferView, size_t offset, int componentType, size_t count, const char* type) {
+        mDoc["accessors"].push_back({{"bufferView", bufferView},
+                                     {"byteOffset", offset},
+                                     {"componentType", componentType},
+                                     {"count", count},
+                                     {"type", type}});
+        return static_cast<int>(mDoc["accessors"].size()) - 1;
+    }
+    // Float data in a view of its own (animation keys).
+    int floats(const std::vector<float>& data, int components, const char* type, bool withBounds) {
+        size_t at = append(data.data(), data.size() * sizeof(float));
+        int a = accessor(view(at, data.size() * sizeof(float)), 0, kFloat, data.size() / components, type);
+        if (withBounds) {
+            Json mn = Json::array(), mx = Json::array();
+            for (int c = 0; c < components; ++c) {
+                float lo = data[c], hi = data[c];
+                for (size_t i = c; i < data.size(); i += components)
+                    lo = std::min(lo, data[i]), hi = std::max(hi, data[i]);
+                mn.push_back(lo);
+                mx.push_back(hi);
+            }
+            mDoc["accessors"][a]["min"] = mn;
+            mDoc["accessors"][a]["max"] = mx;
+        }
+        return a;
+    }
+
+    void meshes();
+    void images();
+    void materials();
+    Json material(const Material& m) const;
+    void cameras();
+    void nodesAndScene();
+    void animations();
+    void cameraPathAnimation(const CameraPath& path, int node);
+
+    const Scene& mScene;
+    Json mDoc;
+    std::vector<uint8_t> mBin;
+    std::vector<Json> mHelperNodes;
+};
+
+void Exporter::meshes() {
+    if (mScene.vertices.empty()) return;
+    size_t vat = append(mScene.vertices.data(), mScene.vertices.size() * sizeof(Vertex));
+    int vertexView = view(vat, mScene.vertices.size() * sizeof(Vertex), sizeof(Vertex), kArrayBuffer);
+    size_t iat = append(mScene.indices.data(), mScene.indices.size() * sizeof(uint32_t));
+    int indexView = view(iat, mScene.indices.size() * sizeof(uint32_t), 0, kElementArrayBuffer);
+    for (size_t m = 0; m < mScene.meshes.size(); ++m) {
+        const Mesh& mesh = mScene.meshes[m];
+        if (mesh.primitiveCount == 0) {
+            throw UserError("exportGlb: meshes[" + std::to_string(m) + "] '" + mesh.name +
+                            "' has no primitives; glTF cannot store an empty mesh");
+        }
+        Json jm = {{"primitives", Json::array()}};
+        if (!mesh.name.empty()) jm["name"] = mesh.name;
+        for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+            const Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
+            size_t base = size_t(p.vertexOffset) * sizeof(Vertex);
+            Aabb box;
+            for (uint32_t v = 0; v < p.vertexCount; ++v)
+                box.expand(mScene.vertices[p.vertexOffset + v].position);
+            int position = accessor(vertexView, base + offsetof(Vertex, position), kFloat, p.vertexCount, "VEC3");
+            mDoc["accessors"][position]["min"] = vec(box.min);
+            mDoc["accessors"][position]["max"] = vec(box.max);
+            Json attributes = {
+                {"POSITION", position},
+                {"NORMAL", accessor(vertexView, base + offsetof(Vertex, normal), kFloat, p.vertexCount, "VEC3")},
+                {"TANGENT", accessor(vertexView, base + offsetof(Vertex, tangent), kFloat, p.vertexCount, "VEC4")},
+                {"TEXCOORD_0", accessor(vertexView, base + offsetof(Vertex, uv0), kFloat, p.vertexCount, "VEC2")},
+                {"TEXCOORD_1", accessor(vertexView, base + offsetof(Vertex, uv1), kFloat, p.vertexCount, "VEC2")},
+                {"COLOR_0", accessor(vertexView, base + offsetof(Vertex, color), kFloat, p.vertexCount, "VEC3")},
+                {"_AO", accessor(vertexView, base + offsetof(Vertex, color) + 12, kFloat, p.vertexCount, "SCALAR")}};
+            int indices = accessor(indexView, size_t(p.firstIndex) * 4, kUnsignedInt, p.indexCount, "SCALAR");
+            jm["primitives"].push_back(
+                {{"attributes", attributes}, {"indices", indices}, {"material", p.material}, {"mode", 4}});
+        }
+        mDoc["meshes"].push_back(jm);
+    }
+}
+
+void Exporter::images() {
+    for (const TextureImage& image : mScene.images) {
+        std::vector<uint8_t> png;
+        auto write = [](void* context, void* data, int size) {
+            auto* out = static_cast<std::vector<uint8_t>*>(context);
+            out->insert(out->end(), static_cast<uint8_t*>(data), static_cast<uint8_t*>(data) + size);
+        };
+        if (!stbi_write_png_to_func(write, &png, int(image.width), int(image.height), 4, image.pixels.data(),
+                                    int(image.width) * 4)) {
+            throw InternalError("exportGlb: PNG encoding of image '" + image.name + "' failed");
+        }
+        Json j = {{"mimeType", "image/png"}, {"bufferView", view(append(png.data(), png.size()), png.size())}};
+        if (!image.name.empty()) j["name"] = image.name;
+        mDoc["images"].push_back(j);
+    }
+    std::vector<Sampler> samplers;
+    for (const Texture& t : mScene.textures) {
+        size_t s = std::find(samplers.begin(), samplers.end(), t.sampler) - samplers.begin();
+        if (s == samplers.size()) {
+            samplers.push_back(t.sampler);
+            mDoc["samplers"].push_back({{"magFilter", filterCode(t.sampler.magFilter)},
+                                        {"minFilter", minFilterCode(t.sampler)},
+                                        {"wrapS", wrapCode(t.sampler.wrapU)},
+                                        {"wrapT", wrapCode(t.sampler.wrapV)}});
+        }
+        Json j = {{"source", t.image}, {"sampler", s}};
+        if (!t.name.empty()) j["name"] = t.name;
+        j["extras"][gltf::kExtrasKey]["usage"] = gltf::usageName(t.usage);
+        mDoc["textures"].push_back(j);
+    }
+}
+
+Json Exporter::material(const Material& m) const {
+    using gltf::writeTextureInfo;
+    Json j;
+    if (!m.name.empty()) j["name"] = m.name;
+    const MaterialLayer& base = m.layers.front();
+
+    // The fallback for viewers without our extension: layer 0 in glTF's metallic-roughness terms.
+    // glTF keeps factors in [0, 1]; our layers may brighten a dark texture with a factor above 1.
+    Json pbr = {{"baseColorFactor", vec(glm::clamp(base.albedo.factor, 0.0f, 1.0f))}};
+    if (base.albedo.texture.valid())
+        pbr["baseColorTexture"] = writeTextureInfo(base.albedo.texture, base.albedo.texture.texture);
+    const ScalarParam& sh = base.shininess;
+    const ScalarParam& me = base.metallic;
+    bool packed = sh.texture.valid() && sh.texture == me.texture && sh.channel == 1 && sh.atZero == 1.0f &&
+                  me.channel == 2 && me.atZero == 0.0f;
+    if (packed) {
+        pbr["roughnessFactor"] = glm::clamp(1.0f - sh.factor, 0.0f, 1.0f);
+        pbr["metallicFactor"] = glm::clamp(me.factor, 0.0f, 1.0f);
+        pbr["metallicRoughnessTexture"] = writeTextureInfo(sh.texture, sh.texture.texture);
+    } else {
+        // Textures that glTF cannot express become their average value.
+        auto mean = [&](const ScalarParam& p) {
+            return p.texture.valid() ? p.evaluate(channelMean(mScene, p.texture, p.channel)) : p.factor;
+        };
+        pbr["roughnessFactor"] = glm::clamp(1.0f - mean(sh), 0.0f, 1.0f);
+        pbr["metallicFactor"] = glm::clamp(mean(me), 0.0f, 1.0f);
+    }
+    j["pbrMetallicRoughness"] = pbr;
+    if (base.normal.texture.valid()) {
+        j["normalTexture"] = writeTextureInfo(base.normal.texture, base.normal.texture.texture);
+        j["normalTexture"]["scale"] = base.normal.scale;
+    }
+    if (base.cavity.texture.valid() && base.cavity.factor == 1.0f && base.cavity.channel == 0) {
+        j["occlusionTexture"] = writeTextureInfo(base.cavity.texture, base.cavity.texture.texture);
+        j["occlusionTexture"]["strength"] = glm::clamp(1.0f - base.cavity.atZero, 0.0f, 1.0f);
+    }
+
+    if (m.emissiveFactor != glm::vec3(0.0f)) j["emissiveFactor"] = vec(m.emissiveFactor); // [0,1]: strength is apart
+    if (m.emissiveTexture.valid())
+        j["emissiveTexture"] = writeTextureInfo(m.emissiveTexture, m.emissiveTexture.texture);
+    if (m.emissiveStrength != 1.0f)
+        j["extensions"][gltf::kEmissiveStrength] = {{"emissiveStrength", m.emissiveStrength}};
+    if (m.alphaMode != AlphaMode::Opaque) j["alphaMode"] = m.alphaMode == AlphaMode::Mask ? "MASK" : "BLEND";
+    if (m.alphaCutoff != 0.5f) j["alphaCutoff"] = m.alphaCutoff;
+    if (m.doubleSided) j["doubleSided"] = true;
+
+    auto scalar = [](const ScalarParam& p) {
+        Json s = {{"factor", p.factor}, {"atZero", p.atZero}, {"channel", p.channel}};
+        if (p.texture.valid()) s["texture"] = writeTextureInfo(p.texture, p.texture.texture);
+        return s;
+    };
+    Json layers = Json::array();
+    for (size_t i = 0; i < m.layers.size(); ++i) {
+        const MaterialLayer& l = m.layers[i];
+        Json jl;
+        if (!l.name.empty()) jl["name"] = l.name;
+        jl["albedo"] = {{"factor", vec(l.albedo.factor)}};
+        if (l.albedo.texture.valid())
+            jl["albedo"]["texture"] = writeTextureInfo(l.albedo.texture, l.albedo.texture.texture);
+        jl["normal"] = {{"scale", l.normal.scale}};
+        if (l.normal.texture.valid())
+            jl["normal"]["texture"] = writeTextureInfo(l.normal.texture, l.normal.texture.texture);
+        jl["shininess"] = scalar(l.shininess);
+        jl["metallic"] = scalar(l.metallic);
+        jl["cavity"] = scalar(l.cavity);
+        if (l.overrides != kLayerAll) {
+            Json names = Json::array();
+            const char* kNames[] = {"albedo", "normal", "shininess", "metallic", "cavity"};
+            for (int b = 0; b < 5; ++b) {
+                if (l.overrides & (1u << b)) names.push_back(kNames[b]);
+            }
+            jl["overrides"] = names;
+        }
+        if (i > 0 || l.mask != LayerMask()) {
+            jl["mask"] = {{"factor", l.mask.factor}, {"channel", l.mask.channel}};
+            if (l.mask.texture.valid())
+                jl["mask"]["texture"] = writeTextureInfo(l.mask.texture, l.mask.texture.texture);
+        }
+        layers.push_back(jl);
+    }
+    j["extensions"][kLayersExtension] = {{"layers", layers}};
+    return j;
+}
+
+void Exporter::materials() {
+    for (const Material& m : mScene.materials)
+        mDoc["materials"].push_back(material(m));
+}
+
+void Exporter::cameras() {
+    for (const Camera& c : mScene.cameras) {
+        Json j;
+        if (!c.name.empty()) j["name"] = c.name;
+        if (c.projection == Projection::Orthographic) {
+            j["type"] = "orthographic";
+            j["orthographic"] = {{"xmag", c.xmag}, {"ymag", c.ymag}, {"znear", c.znear}, {"zfar", c.zfar}};
+        } else {
+            j["type"] = "perspective";
+            j["perspective"] = {{"yfov", c.yfov}, {"znear", c.znear}};
+            if (c.zfar > 0.0f) j["perspective"]["zfar"] = c.zfar;
+            if (c.aspectRatio > 0.0f) j["perspective"]["aspectRatio"] = c.aspectRatio;
+        }
+        j["extras"][gltf::kExtrasKey] = {
+            {"sensorWidthMm", c.sensorWidthMm},  {"sensorHeightMm", c.sensorHeightMm}, {"fNumber", c.fNumber},
+            {"focusDistance", c.focusDistance},  {"shutterTime", c.shutterTime},       {"iso", c.iso},
+            {"apertureBlades", c.apertureBlades}};
+        mDoc["cameras"].push_back(j);
+    }
+}
+
+void Exporter::nodesAndScene() {
+    for (const Node& n : mScene.nodes) {
+        Json j = Json::object();
+        if (!n.name.empty()) j["name"] = n.name;
+        if (n.local.translation != glm::vec3(0.0f)) j["translation"] = vec(n.local.translation);
+        if (n.local.rotation != glm::quat(1, 0, 0, 0)) j["rotation"] = vec(n.local.rotation);
+        if (n.local.scale != glm::vec3(1.0f)) j["scale"] = vec(n.local.scale);
+        if (!n.children.empty()) j["children"] = n.children;
+        if (n.mesh >= 0) j["mesh"] = n.mesh;
+        if (n.camera >= 0) j["camera"] = n.camera;
+        mDoc["nodes"].push_back(j);
+    }
+    Json roots = Json::array();
+    if (mScene.roots.empty()) {
+        std::vector<bool> child(mScene.nodes.size(), false);
+        for (const Node& n : mScene.nodes) {
+            for (uint32_t c : n.children)
+                child[c] = true;
+        }
+        for (size_t i = 0; i < child.size(); ++i) {
+            if (!child[i]) roots.push_back(i);
+        }
+    } else {
+        roots = mScene.roots;
+    }
+    Json ours = Json::object();
+    for (const CameraPath& path : mScene.cameraPaths) {
+        // A camera node the path animates; viewers show it as an animated camera.
+        Json j = {{"name", path.name},
+                  {"camera", path.camera},
+                  {"translation", vec(path.keys.front().position)},
+                  {"rotation", vec(path.keys.front().orientation)}};
+        j["extras"][gltf::kExtrasKey]["role"] = "cameraPath";
+        roots.push_back(mDoc["nodes"].size());
+        mDoc["nodes"].push_back(j);
+        cameraPathAnimation(path, static_cast<int>(mDoc["nodes"].size()) - 1);
+    }
+    if (mScene.hasSun) {
+        const Sun& sun = mScene.sun;
+        // A directional light shines down its node's -Z: rotate +Z onto the direction towards the sun.
+        glm::quat q = rotationBetween(glm::vec3(0, 0, 1), glm::normalize(sun.toSun));
+        Json j = {{"name", "sun"}, {"rotation", vec(q)}};
+        j["extensions"][gltf::kLightsPunctual] = {{"light", 0}};
+        j["extras"][gltf::kExtrasKey]["role"] = "sun";
+        roots.push_back(mDoc["nodes"].size());
+        mDoc["nodes"].push_back(j);
+        mDoc["extensions"][gltf::kLightsPunctual]["lights"] = Json::array(
+            {{{"name", "sun"}, {"type", "directional"}, {"color", vec(sun.color)}, {"intensity", sun.illuminance}}});
+        ours["sun"] = {{"toSun", vec(sun.toSun)},
+                       {"color", vec(sun.color)},
+                       {"illuminance", sun.illuminance},
+                       {"angularDiameter", sun.angularDiameter}};
+    }
+    if (!mScene.rooms.empty()) {
+        for (const Room& r : mScene.rooms) {
+            ours["rooms"].push_back({{"name", r.name}, {"min", vec(r.bounds.min)}, {"max", vec(r.bounds.max)}});
+        }
+    }
+    Json scene = Json::object();
+    if (!roots.empty()) scene["nodes"] = roots; // glTF forbids an empty list
+    if (!mScene.name.empty()) scene["name"] = mScene.name;
+    if (!ours.empty()) scene["extras"][gltf::kExtrasKey] = ours;
+    mDoc["scenes"] = Json::array({scene});
+    mDoc["scene"] = 0;
+}
+
+void Exporter::cameraPathAnimation(const CameraPath& path, int node) {
+    std::vector<float> times, positions, rotations;
+    Json fov = Json::array();
+    for (size_t k = 0; k < path.keys.size(); ++k) {
+        const CameraKey& key = path.keys[k];
+        times.push_back(key.time);
+        glm::vec3 tangent = path.tangent(k);
+        if (path.smooth) positions.insert(positions.end(), {tangent.x, tangent.y, tangent.z});
+        positions.insert(positions.end(), {key.position.x, key.position.y, key.position.z});
+        if (path.smooth) positions.insert(positions.end(), {tangent.x, tangent.y, tangent.z});
+        rotations.insert(rotations.end(), {key.orientation.x, key.orientation.y, key.orientation.z, key.orientation.w});
+        fov.push_back(key.yfov);
+    }
+    int input = floats(times, 1, "SCALAR", true);
+    Json samplers =
+        Json::array({{{"input", input},
+                      {"output", floats(positions, 3, "VEC3", false)},
+                      {"interpolation", path.smooth ? "CUBICSPLINE" : "LINEAR"}},
+                     {{"input", input}, {"output", floats(rotations, 4, "VEC4", false)}, {"interpolation", "LINEAR"}}});
+    Json channels = Json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "translation"}}}},
+                                 {{"sampler", 1}, {"target", {{"node", node}, {"path", "rotation"}}}}});
+    Json j = {{"name", path.name}, {"samplers", samplers}, {"channels", channels}};
+    j["extras"][gltf::kExtrasKey]["cameraPath"] = {
+        {"camera", path.camera}, {"smooth", path.smooth}, {"loop", path.loop}, {"yfov", fov}};
+    mDoc["animations"].push_back(j);
+}
+
+void Exporter::animations() {
+    for (size_t a = 0; a < mScene.animations.size(); ++a) {
+        const Animation& anim = mScene.animations[a];
+        Json samplers = Json::array();
+        for (size_t s = 0; s < anim.samplers.size(); ++s) {
+            const AnimationSampler& smp = anim.samplers[s];
+            if (smp.times.empty()) {
+                throw UserError("exportGlb: animations[" + std::to_string(a) + "].samplers[" + std::to_string(s) +
+                                "] has no keys; glTF cannot store it");
+            }
+            bool rotation = true;
+            for (const AnimationChannel& c : anim.channels) {
+                if (c.sampler == s) rotation = c.path == AnimationPath::Rotation;
+            }
+            std::vector<float> values;
+            for (const glm::vec4& v : smp.values)
+                values.insert(values.end(), {v.x, v.y, v.z, v.w});
+            if (!rotation) { // VEC3 on disk
+                std::vector<float> xyz;
+                for (size_t i = 0; i < values.size(); i += 4)
+                    xyz.insert(xyz.end(), {values[i], values[i + 1], values[i + 2]});
+                values = xyz;
+            }
+            const char* mode = smp.interpolation == Interpolation::Step     ? "STEP"
+                               : smp.interpolation == Interpolation::Linear ? "LINEAR"
+                                                                            : "CUBICSPLINE";
+            samplers.push_back({{"input", floats(smp.times, 1, "SCALAR", true)},
+                                {"output", floats(values, rotation ? 4 : 3, rotation ? "VEC4" : "VEC3", false)},
+                                {"interpolation", mode}});
+        }
+        Json channels = Json::array();
+        for (const AnimationChannel& c : anim.channels) {
+            const char* path = c.path == AnimationPath::Translation ? "translation"
+                               : c.path == AnimationPath::Rotation  ? "rotation"
+                                                                    : "scale";
+            channels.push_back({{"sampler", c.sampler}, {"target", {{"node", c.node}, {"path", path}}}});
+        }
+        Json j = {{"samplers", samplers}, {"channels", channels}};
+        if (!anim.name.empty()) j["name"] = anim.name;
+        if (anim.loop) j["extras"][gltf::kExtrasKey]["loop"] = true;
+        mDoc["animations"].push_back(j);
+    }
+}
+
+std::vector<uint8_t> Exporter::run() {
+    mDoc["asset"] = {{"version", "2.0"}, {"generator", "vitrine exportGlb"}};
+    meshes();
+    images();
+    materials();
+    cameras();
+    animations(); // before the camera-path animations that nodesAndScene() adds
+    nodesAndScene();
+
+    Json used = Json::array({std::string(kLayersExtension)});
+    bool transforms = false, strength = false;
+    for (const Material& m : mScene.materials)
+        strength = strength || m.emissiveStrength != 1.0f;
+    std::string text = mDoc.dump();
+    transforms = text.find(gltf::kTextureTransform) != std::string::npos;
+    if (transforms) used.push_back(gltf::kTextureTransform);
+    if (strength) used.push_back(gltf::kEmissiveStrength);
+    if (mScene.hasSun) used.push_back(gltf::kLightsPunctual);
+    mDoc["extensionsUsed"] = used;
+    while (mBin.size() % 4)
+        mBin.push_back(0);
+    if (!mBin.empty()) mDoc["buffers"] = Json::array({{{"byteLength", mBin.size()}}});
+
+    text = mDoc.dump();
+    while (text.size() % 4)
+        text.push_back(' ');
+    std::vector<uint8_t> out;
+    auto u32 = [&](uint32_t v) {
+        for (int i = 0; i < 4; ++i)
+            out.push_back(static_cast<uint8_t>(v >> (8 * i)));
+    };
+    size_t total = 12 + 8 + text.size() + (mBin.empty() ? 0 : 8 + mBin.size());
+    if (total > 0xffffffffull) throw UserError("exportGlb: the scene needs more than 4 GiB, which GLB cannot hold");
+    out.reserve(total);
+    u32(0x46546C67u); // "glTF"
+    u32(2);
+    u32(static_cast<uint32_t>(total));
+    u32(static_cast<uint32_t>(text.size()));
+    u32(0x4E4F534Au); // JSON
+    out.insert(out.end(), text.begin(), text.end());
+    if (!mBin.empty()) {
+        u32(static_cast<uint32_t>(mBin.size()));
+        u32(0x004E4942u); // BIN
+        out.insert(out.end(), mBin.begin(), mBin.end());
+    }
+    return out;
+}
+
+} // namespace
+
+void exportGlb(const Scene& scene, const std::filesystem::path& file) {
+    scene.validate();
+    std::vector<uint8_t> bytes = Exporter(scene).run();
+    std::ofstream out(file, std::ios::binary);
+    if (!out) throw UserError(file.string() + ": cannot open for writing");
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw UserError(file.string() + ": write failed (disk full?)");
+}
+
+} // namespace vitrine::scene

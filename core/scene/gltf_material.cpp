@@ -1,0 +1,369 @@
+// glTF images, samplers, textures and materials → scene textures and layered materials.
+
+#include "core/scene/gltf.hpp"
+#include "core/scene/gltf_detail.hpp"
+
+#include <set>
+
+#include <tiny_gltf.h>
+
+namespace vitrine::scene::gltf {
+
+const char* usageName(TextureUsage usage) {
+    switch (usage) {
+    case TextureUsage::Color:
+        return "color";
+    case TextureUsage::Normal:
+        return "normal";
+    default:
+        return "data";
+    }
+}
+
+namespace {
+
+Filter toFilter(int f) {
+    return f == TINYGLTF_TEXTURE_FILTER_NEAREST ? Filter::Nearest : Filter::Linear;
+}
+
+Wrap toWrap(int w) {
+    if (w == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE) return Wrap::ClampToEdge;
+    if (w == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) return Wrap::MirroredRepeat;
+    return Wrap::Repeat;
+}
+
+Sampler toSampler(const tinygltf::Sampler& s) {
+    Sampler out;
+    out.magFilter = toFilter(s.magFilter);
+    out.wrapU = toWrap(s.wrapS);
+    out.wrapV = toWrap(s.wrapT);
+    switch (s.minFilter) {
+    case TINYGLTF_TEXTURE_FILTER_NEAREST:
+        out.minFilter = Filter::Nearest;
+        out.mipFilter = MipFilter::None;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR:
+        out.mipFilter = MipFilter::None;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+        out.minFilter = Filter::Nearest;
+        out.mipFilter = MipFilter::Nearest;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+        out.mipFilter = MipFilter::Nearest;
+        break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+        out.minFilter = Filter::Nearest;
+        break;
+    default:
+        break; // LINEAR_MIPMAP_LINEAR or unspecified: trilinear
+    }
+    return out;
+}
+
+TextureImage toImage(const LoadContext& ctx, const tinygltf::Image& src, size_t index) {
+    std::string e = "images[" + std::to_string(index) + "]";
+    if (src.image.empty() || src.width <= 0 || src.height <= 0) {
+        ctx.fail(e, "could not be loaded or decoded" + (src.uri.empty() ? std::string() : " ('" + src.uri + "')") +
+                        "; expected a PNG or JPEG image");
+    }
+    int comps = src.component, bytesPer = src.bits == 16 ? 2 : 1;
+    if (comps < 1 || comps > 4 || (src.bits != 8 && src.bits != 16) ||
+        src.image.size() < size_t(src.width) * src.height * comps * bytesPer) {
+        ctx.fail(e, "decoded to an unexpected pixel format");
+    }
+    TextureImage out;
+    out.name = src.name;
+    out.width = static_cast<uint32_t>(src.width);
+    out.height = static_cast<uint32_t>(src.height);
+    out.pixels.resize(size_t(out.width) * out.height * 4);
+    for (size_t p = 0; p < size_t(out.width) * out.height; ++p) {
+        uint8_t c[4] = {0, 0, 0, 255};
+        for (int k = 0; k < comps; ++k) {
+            size_t at = (p * comps + k) * bytesPer;
+            // 16-bit PNG is big-endian in the file but stb returns native shorts: take the high byte.
+            c[k] = bytesPer == 2 ? static_cast<uint8_t>((src.image[at] | src.image[at + 1] << 8) >> 8) : src.image[at];
+        }
+        if (comps <= 2) { // grey or grey + alpha
+            c[3] = comps == 2 ? c[1] : 255;
+            c[1] = c[2] = c[0];
+        }
+        std::copy(c, c + 4, &out.pixels[p * 4]);
+    }
+    return out;
+}
+
+int32_t resolveTexture(LoadContext& ctx, uint32_t gltfIndex, TextureUsage usage) {
+    std::array<int32_t, 3>& byUsage = ctx.textureByUsage[gltfIndex];
+    int32_t& slot = byUsage[static_cast<int>(usage)];
+    if (slot >= 0) return slot;
+    bool unassigned = byUsage[0] < 0 && byUsage[1] < 0 && byUsage[2] < 0;
+    if (unassigned) {
+        ctx.scene->textures[gltfIndex].usage = usage;
+        slot = static_cast<int32_t>(gltfIndex);
+    } else {
+        Texture copy = ctx.scene->textures[gltfIndex];
+        copy.usage = usage;
+        slot = static_cast<int32_t>(ctx.scene->textures.size());
+        ctx.scene->textures.push_back(copy);
+    }
+    return slot;
+}
+
+void checkKeys(const LoadContext& ctx, const Json& obj, std::initializer_list<const char*> keys,
+               const std::string& element) {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+        bool known = it.key() == "extensions" || it.key() == "extras";
+        for (const char* k : keys)
+            known = known || it.key() == k;
+        if (!known) {
+            std::string list;
+            for (const char* k : keys)
+                list += (list.empty() ? "" : ", ") + std::string(k);
+            ctx.fail(element + "." + it.key(), "unknown key; expected one of: " + list);
+        }
+    }
+}
+
+uint32_t readChannel(const LoadContext& ctx, const Json& obj, const std::string& element) {
+    int64_t c = integer(ctx, obj, "channel", 0, element);
+    if (c < 0 || c > 3) ctx.fail(element + ".channel", std::to_string(c) + "; expected 0..3 (r, g, b, a)");
+    return static_cast<uint32_t>(c);
+}
+
+ScalarParam readScalar(LoadContext& ctx, const Json& layer, const char* key, ScalarParam def, const std::string& e) {
+    const Json* p = object(ctx, layer, key, e);
+    if (!p) return def;
+    std::string pe = e + "." + key;
+    checkKeys(ctx, *p, {"factor", "atZero", "channel", "texture"}, pe);
+    def.factor = static_cast<float>(number(ctx, *p, "factor", def.factor, pe));
+    def.atZero = static_cast<float>(number(ctx, *p, "atZero", def.atZero, pe));
+    def.channel = readChannel(ctx, *p, pe);
+    if (const Json* t = member(*p, "texture"))
+        def.texture = readTextureInfo(ctx, *t, TextureUsage::Data, pe + ".texture");
+    return def;
+}
+
+uint32_t readOverrides(const LoadContext& ctx, const Json& layer, const std::string& e) {
+    const Json* list = member(layer, "overrides");
+    if (!list) return kLayerAll;
+    if (!list->is_array()) ctx.fail(e + ".overrides", "expected an array of parameter names");
+    static const std::pair<const char*, uint32_t> kNames[] = {{"albedo", kLayerAlbedo},
+                                                              {"normal", kLayerNormal},
+                                                              {"shininess", kLayerShininess},
+                                                              {"metallic", kLayerMetallic},
+                                                              {"cavity", kLayerCavity}};
+    uint32_t bits = 0;
+    for (const Json& name : *list) {
+        uint32_t bit = 0;
+        for (const auto& [n, b] : kNames) {
+            if (name.is_string() && name.get<std::string>() == n) bit = b;
+        }
+        if (!bit) ctx.fail(e + ".overrides", name.dump() + "; expected albedo, normal, shininess, metallic or cavity");
+        bits |= bit;
+    }
+    return bits;
+}
+
+MaterialLayer readLayer(LoadContext& ctx, const Json& layer, const std::string& e) {
+    if (!layer.is_object()) ctx.fail(e, "expected a JSON object");
+    checkKeys(ctx, layer, {"name", "albedo", "normal", "shininess", "metallic", "cavity", "overrides", "mask"}, e);
+    MaterialLayer out;
+    out.name = string(ctx, layer, "name", "", e);
+    if (const Json* a = object(ctx, layer, "albedo", e)) {
+        checkKeys(ctx, *a, {"factor", "texture"}, e + ".albedo");
+        out.albedo.factor = numbers(ctx, *a, "factor", 4, glm::vec4(1.0f), e + ".albedo");
+        if (const Json* t = member(*a, "texture")) {
+            out.albedo.texture = readTextureInfo(ctx, *t, TextureUsage::Color, e + ".albedo.texture");
+        }
+    }
+    if (const Json* n = object(ctx, layer, "normal", e)) {
+        checkKeys(ctx, *n, {"scale", "texture"}, e + ".normal");
+        out.normal.scale = static_cast<float>(number(ctx, *n, "scale", 1.0, e + ".normal"));
+        if (const Json* t = member(*n, "texture")) {
+            out.normal.texture = readTextureInfo(ctx, *t, TextureUsage::Normal, e + ".normal.texture");
+        }
+    }
+    out.shininess = readScalar(ctx, layer, "shininess", ScalarParam{0.5f, 0.0f}, e);
+    out.metallic = readScalar(ctx, layer, "metallic", ScalarParam{0.0f, 0.0f}, e);
+    out.cavity = readScalar(ctx, layer, "cavity", ScalarParam{1.0f, 0.0f}, e);
+    out.overrides = readOverrides(ctx, layer, e);
+    if (const Json* m = object(ctx, layer, "mask", e)) {
+        checkKeys(ctx, *m, {"factor", "channel", "texture"}, e + ".mask");
+        out.mask.factor = static_cast<float>(number(ctx, *m, "factor", 1.0, e + ".mask"));
+        out.mask.channel = readChannel(ctx, *m, e + ".mask");
+        if (const Json* t = member(*m, "texture")) {
+            out.mask.texture = readTextureInfo(ctx, *t, TextureUsage::Data, e + ".mask.texture");
+        }
+    }
+    return out;
+}
+
+// The core metallic-roughness material as a one-layer stack (see gltf.hpp for the mapping).
+MaterialLayer readMetallicRoughness(LoadContext& ctx, const Json& m, const std::string& e) {
+    MaterialLayer layer;
+    layer.name = "base";
+    float roughness = 1.0f, metallic = 1.0f;
+    if (const Json* pbr = object(ctx, m, "pbrMetallicRoughness", e)) {
+        std::string pe = e + ".pbrMetallicRoughness";
+        layer.albedo.factor = numbers(ctx, *pbr, "baseColorFactor", 4, glm::vec4(1.0f), pe);
+        if (const Json* t = member(*pbr, "baseColorTexture")) {
+            layer.albedo.texture = readTextureInfo(ctx, *t, TextureUsage::Color, pe + ".baseColorTexture");
+        }
+        metallic = static_cast<float>(number(ctx, *pbr, "metallicFactor", 1.0, pe));
+        roughness = static_cast<float>(number(ctx, *pbr, "roughnessFactor", 1.0, pe));
+        if (const Json* t = member(*pbr, "metallicRoughnessTexture")) {
+            TextureRef ref = readTextureInfo(ctx, *t, TextureUsage::Data, pe + ".metallicRoughnessTexture");
+            layer.shininess.texture = ref;
+            layer.shininess.channel = 1;
+            layer.metallic.texture = ref;
+            layer.metallic.channel = 2;
+        }
+    }
+    layer.shininess.factor = 1.0f - roughness;
+    layer.shininess.atZero = 1.0f;
+    layer.metallic.factor = metallic;
+    if (const Json* n = object(ctx, m, "normalTexture", e)) {
+        layer.normal.texture = readTextureInfo(ctx, *n, TextureUsage::Normal, e + ".normalTexture");
+        layer.normal.scale = static_cast<float>(number(ctx, *n, "scale", 1.0, e + ".normalTexture"));
+    }
+    if (const Json* o = object(ctx, m, "occlusionTexture", e)) {
+        float strength = static_cast<float>(number(ctx, *o, "strength", 1.0, e + ".occlusionTexture"));
+        layer.cavity = ScalarParam{1.0f, 1.0f - strength, {}, 0};
+        layer.cavity.texture = readTextureInfo(ctx, *o, TextureUsage::Data, e + ".occlusionTexture");
+    }
+    return layer;
+}
+
+Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
+    Material out;
+    out.name = string(ctx, m, "name", "", e);
+    const Json* extensions = object(ctx, m, "extensions", e);
+    const Json* layers = extensions ? object(ctx, *extensions, kLayersExtension, e + ".extensions") : nullptr;
+    if (layers) {
+        std::string le = e + ".extensions." + kLayersExtension + ".layers";
+        const Json* list = member(*layers, "layers");
+        if (!list || !list->is_array() || list->empty()) ctx.fail(le, "expected a non-empty array of layers");
+        for (size_t i = 0; i < list->size(); ++i)
+            out.layers.push_back(readLayer(ctx, (*list)[i], le + "[" + std::to_string(i) + "]"));
+    } else {
+        out.layers.push_back(readMetallicRoughness(ctx, m, e));
+    }
+    out.emissiveFactor = glm::vec3(numbers(ctx, m, "emissiveFactor", 3, glm::vec4(0.0f), e));
+    if (const Json* t = member(m, "emissiveTexture")) {
+        out.emissiveTexture = readTextureInfo(ctx, *t, TextureUsage::Color, e + ".emissiveTexture");
+    }
+    if (extensions) {
+        if (const Json* s = object(ctx, *extensions, kEmissiveStrength, e + ".extensions")) {
+            out.emissiveStrength =
+                static_cast<float>(number(ctx, *s, "emissiveStrength", 1.0, e + ".extensions." + kEmissiveStrength));
+        }
+    }
+    std::string mode = string(ctx, m, "alphaMode", "OPAQUE", e);
+    if (mode == "OPAQUE")
+        out.alphaMode = AlphaMode::Opaque;
+    else if (mode == "MASK")
+        out.alphaMode = AlphaMode::Mask;
+    else if (mode == "BLEND")
+        out.alphaMode = AlphaMode::Blend;
+    else
+        ctx.fail(e + ".alphaMode", "'" + mode + "'; expected OPAQUE, MASK or BLEND");
+    out.alphaCutoff = static_cast<float>(number(ctx, m, "alphaCutoff", 0.5, e));
+    out.doubleSided = boolean(ctx, m, "doubleSided", false, e);
+    return out;
+}
+
+} // namespace
+
+TextureRef readTextureInfo(LoadContext& ctx, const Json& info, TextureUsage usage, const std::string& e) {
+    if (!info.is_object()) ctx.fail(e, "expected a textureInfo object {\"index\": ...}");
+    const Json* index = member(info, "index");
+    if (!index) ctx.fail(e + ".index", "missing; expected an index into textures");
+    uint32_t gltfIndex = checkIndex(ctx, *index, e + ".index", "textures");
+    TextureRef ref;
+    int64_t uvSet = integer(ctx, info, "texCoord", 0, e);
+    if (const Json* ext = object(ctx, info, "extensions", e)) {
+        if (const Json* tt = object(ctx, *ext, kTextureTransform, e + ".extensions")) {
+            std::string te = e + ".extensions." + kTextureTransform;
+            ref.transform.offset = glm::vec2(numbers(ctx, *tt, "offset", 2, glm::vec4(0.0f), te));
+            ref.transform.scale = glm::vec2(numbers(ctx, *tt, "scale", 2, glm::vec4(1.0f), te));
+            ref.transform.rotation = static_cast<float>(number(ctx, *tt, "rotation", 0.0, te));
+            uvSet = integer(ctx, *tt, "texCoord", uvSet, te); // the extension overrides textureInfo.texCoord
+        }
+    }
+    if (uvSet < 0 || uvSet > 1) {
+        ctx.fail(e + ".texCoord",
+                 std::to_string(uvSet) + "; expected 0 or 1 (vitrine keeps TEXCOORD_0 and TEXCOORD_1)");
+    }
+    ref.uvSet = static_cast<uint32_t>(uvSet);
+    ref.texture = resolveTexture(ctx, gltfIndex, usage);
+    return ref;
+}
+
+Json writeTextureInfo(const TextureRef& ref, int textureIndex) {
+    Json info = {{"index", textureIndex}};
+    if (ref.uvSet != 0) info["texCoord"] = ref.uvSet;
+    if (!ref.transform.isIdentity()) {
+        info["extensions"][kTextureTransform] = {{"offset", {ref.transform.offset.x, ref.transform.offset.y}},
+                                                 {"scale", {ref.transform.scale.x, ref.transform.scale.y}},
+                                                 {"rotation", ref.transform.rotation}};
+    }
+    return info;
+}
+
+void loadImagesAndTextures(LoadContext& ctx) {
+    const tinygltf::Model& model = *ctx.model;
+    Scene& scene = *ctx.scene;
+    for (size_t i = 0; i < model.images.size(); ++i)
+        scene.images.push_back(toImage(ctx, model.images[i], i));
+
+    std::vector<Sampler> samplers;
+    for (const tinygltf::Sampler& s : model.samplers)
+        samplers.push_back(toSampler(s));
+
+    const Json* docTextures = member(ctx.doc, "textures");
+    ctx.textureByUsage.assign(model.textures.size(), {-1, -1, -1});
+    for (size_t i = 0; i < model.textures.size(); ++i) {
+        const tinygltf::Texture& t = model.textures[i];
+        std::string e = "textures[" + std::to_string(i) + "]";
+        if (t.source < 0) {
+            ctx.fail(e + ".source", "missing; expected an image index (texture-source extensions such as "
+                                    "KHR_texture_basisu are not supported)");
+        }
+        Texture texture;
+        texture.name = t.name;
+        texture.image = static_cast<uint32_t>(t.source);
+        if (t.sampler >= 0) texture.sampler = samplers[t.sampler];
+        // exportGlb() records the usage so that a texture no material uses still comes back the same.
+        if (const Json* extras = object(ctx, (*docTextures)[i], "extras", e)) {
+            if (const Json* ours = object(ctx, *extras, kExtrasKey, e + ".extras")) {
+                std::string usage = string(ctx, *ours, "usage", "", e + ".extras.vitrine");
+                for (TextureUsage u : {TextureUsage::Color, TextureUsage::Normal, TextureUsage::Data}) {
+                    if (usage == usageName(u)) {
+                        texture.usage = u;
+                        ctx.textureByUsage[i][static_cast<int>(u)] = static_cast<int32_t>(i);
+                    }
+                }
+            }
+        }
+        scene.textures.push_back(texture);
+    }
+}
+
+void loadMaterials(LoadContext& ctx) {
+    const Json* materials = member(ctx.doc, "materials");
+    if (materials && !materials->is_array()) ctx.fail("materials", "expected an array");
+    for (size_t i = 0; materials && i < materials->size(); ++i) {
+        std::string e = "materials[" + std::to_string(i) + "]";
+        if (!(*materials)[i].is_object()) ctx.fail(e, "expected a JSON object");
+        ctx.scene->materials.push_back(readMaterial(ctx, (*materials)[i], e));
+    }
+    for (size_t i = 0; i < ctx.textureByUsage.size(); ++i) {
+        const auto& u = ctx.textureByUsage[i];
+        if (u[0] < 0 && u[1] < 0 && u[2] < 0) {
+            ctx.warn("textures[" + std::to_string(i) + "]", "no material uses it; kept as linear data");
+        }
+    }
+}
+
+} // namespace vitrine::scene::gltf

@@ -1,0 +1,180 @@
+// glTF meshes → the scene's flat vertex/index arrays and primitive ranges.
+
+#include "core/scene/gltf_detail.hpp"
+#include "core/scene/tangents.hpp"
+
+#include <cmath>
+#include <numeric>
+
+#include <tiny_gltf.h>
+
+namespace vitrine::scene::gltf {
+
+namespace {
+
+uint32_t defaultMaterial(LoadContext& ctx) {
+    if (ctx.defaultMaterial < 0) {
+        // glTF's default material: every property at its default, i.e. white, metallic 1, roughness 1.
+        Material m;
+        m.name = "default";
+        MaterialLayer layer;
+        layer.name = "base";
+        layer.shininess = ScalarParam{0.0f, 1.0f};
+        layer.metallic = ScalarParam{1.0f, 0.0f};
+        m.layers.push_back(layer);
+        ctx.defaultMaterial = static_cast<int32_t>(ctx.scene->materials.size());
+        ctx.scene->materials.push_back(m);
+    }
+    return static_cast<uint32_t>(ctx.defaultMaterial);
+}
+
+// Triangle strips and fans as lists (glTF's winding rules).
+std::vector<uint32_t> toTriangleList(const LoadContext& ctx, std::vector<uint32_t> in, int mode, const std::string& e) {
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (in.size() % 3 != 0) {
+            ctx.fail(e + ".indices",
+                     "count " + std::to_string(in.size()) + " is not a multiple of 3; expected whole triangles");
+        }
+        return in;
+    }
+    std::vector<uint32_t> out;
+    for (size_t k = 0; k + 2 < in.size(); ++k) {
+        if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+            bool even = k % 2 == 0;
+            out.insert(out.end(), {in[k + (even ? 0 : 1)], in[k + (even ? 1 : 0)], in[k + 2]});
+        } else {
+            out.insert(out.end(), {in[0], in[k + 1], in[k + 2]});
+        }
+    }
+    return out;
+}
+
+void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, const std::string& e) {
+    int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    if (mode <= TINYGLTF_MODE_LINE_STRIP) {
+        ctx.warn(e, "points and lines are not drawn; primitive skipped");
+        return;
+    }
+    if (mode > TINYGLTF_MODE_TRIANGLE_FAN) ctx.fail(e + ".mode", std::to_string(mode) + "; expected 0..6");
+
+    auto find = [&](const char* name) {
+        auto it = p.attributes.find(name);
+        return it == p.attributes.end() ? -1 : it->second;
+    };
+    int positionAccessor = find("POSITION");
+    if (positionAccessor < 0) ctx.fail(e + ".attributes", "no POSITION; expected vertex positions");
+    AccessorValues positions = readAccessor(ctx, positionAccessor, e + ".attributes.POSITION", {3});
+    size_t n = positions.count;
+    auto read = [&](const char* name, std::initializer_list<int> comps) {
+        AccessorValues v;
+        int accessor = find(name);
+        if (accessor < 0) return v;
+        v = readAccessor(ctx, accessor, e + ".attributes." + name, comps);
+        if (v.count != n) {
+            ctx.fail(e + ".attributes." + name,
+                     std::to_string(v.count) + " elements; expected " + std::to_string(n) + " like POSITION");
+        }
+        return v;
+    };
+    AccessorValues normals = read("NORMAL", {3});
+    AccessorValues tangents = read("TANGENT", {4});
+    AccessorValues uv0 = read("TEXCOORD_0", {2});
+    AccessorValues uv1 = read("TEXCOORD_1", {2});
+    AccessorValues colors = read("COLOR_0", {3, 4});
+    AccessorValues ao = read("_AO", {1});
+    for (const auto& [name, accessor] : p.attributes) {
+        static const char* kKnown[] = {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0", "_AO"};
+        if (std::find(std::begin(kKnown), std::end(kKnown), name) == std::end(kKnown)) {
+            ctx.warn(e + ".attributes." + name, "not used by vitrine; ignored");
+        }
+    }
+    if (!p.targets.empty()) ctx.warn(e + ".targets", "morph targets are not supported; ignored");
+
+    std::vector<uint32_t> indices(n);
+    if (p.indices >= 0) {
+        indices = readIndices(ctx, p.indices, e + ".indices");
+    } else {
+        std::iota(indices.begin(), indices.end(), 0u);
+    }
+    for (size_t k = 0; k < indices.size(); ++k) {
+        if (indices[k] >= n) {
+            ctx.fail(e + ".indices", "index " + std::to_string(indices[k]) + " at position " + std::to_string(k) +
+                                         " is out of range; expected < " + std::to_string(n) + " (the POSITION count)");
+        }
+    }
+    indices = toTriangleList(ctx, std::move(indices), mode, e);
+    if (indices.empty()) {
+        ctx.warn(e, "has no triangles; skipped");
+        return;
+    }
+
+    std::vector<Vertex> vertices(n);
+    for (size_t i = 0; i < n; ++i) {
+        Vertex& v = vertices[i];
+        v.position = glm::vec3(positions.get(i));
+        if (normals.count) {
+            glm::vec3 nrm = glm::vec3(normals.get(i));
+            float len = glm::length(nrm);
+            // Only visibly wrong lengths are fixed, so that unit normals come back bit-exact.
+            v.normal = std::abs(len - 1.0f) <= 1e-5f ? nrm : len > 0.0f ? nrm / len : glm::vec3(0, 1, 0);
+        }
+        if (tangents.count) v.tangent = tangents.get(i);
+        if (uv0.count) v.uv0 = glm::vec2(uv0.get(i));
+        if (uv1.count) v.uv1 = glm::vec2(uv1.get(i));
+        if (colors.count) v.color = glm::vec4(glm::vec3(colors.get(i)), 1.0f);
+        if (ao.count) v.color.a = ao.get(i).x;
+    }
+    if (!normals.count) {
+        // glTF: "When normals are not specified, client implementations MUST calculate flat normals",
+        // which needs a vertex per triangle corner; the file's tangents are then meaningless too.
+        std::vector<Vertex> flat;
+        flat.reserve(indices.size());
+        for (size_t t = 0; t < indices.size(); t += 3) {
+            Vertex a = vertices[indices[t]], b = vertices[indices[t + 1]], c = vertices[indices[t + 2]];
+            glm::vec3 fn = glm::cross(b.position - a.position, c.position - a.position);
+            float len = glm::length(fn);
+            fn = len > 0.0f ? fn / len : glm::vec3(0, 1, 0);
+            a.normal = b.normal = c.normal = fn;
+            flat.insert(flat.end(), {a, b, c});
+        }
+        vertices = std::move(flat);
+        std::iota(indices.begin(), indices.end(), 0u);
+    }
+    if (!tangents.count || !normals.count) generateTangents(vertices, indices);
+
+    Scene& scene = *ctx.scene;
+    if (p.material >= 0 && static_cast<size_t>(p.material) < scene.materials.size()) {
+        if (!uv0.count && usesUvSet(scene.materials[p.material], 0))
+            ctx.warn(e, "its material samples TEXCOORD_0, which it lacks; (0, 0) used");
+        if (!uv1.count && usesUvSet(scene.materials[p.material], 1))
+            ctx.warn(e, "its material samples TEXCOORD_1, which it lacks; (0, 0) used");
+    }
+    Primitive prim;
+    prim.firstIndex = static_cast<uint32_t>(scene.indices.size());
+    prim.indexCount = static_cast<uint32_t>(indices.size());
+    prim.vertexOffset = static_cast<uint32_t>(scene.vertices.size());
+    prim.vertexCount = static_cast<uint32_t>(vertices.size());
+    prim.material = p.material >= 0 ? static_cast<uint32_t>(p.material) : defaultMaterial(ctx);
+    scene.indices.insert(scene.indices.end(), indices.begin(), indices.end());
+    scene.vertices.insert(scene.vertices.end(), vertices.begin(), vertices.end());
+    scene.primitives.push_back(prim);
+}
+
+} // namespace
+
+void loadMeshes(LoadContext& ctx) {
+    const tinygltf::Model& model = *ctx.model;
+    for (size_t i = 0; i < model.meshes.size(); ++i) {
+        Mesh mesh;
+        mesh.name = model.meshes[i].name;
+        mesh.firstPrimitive = static_cast<uint32_t>(ctx.scene->primitives.size());
+        for (size_t j = 0; j < model.meshes[i].primitives.size(); ++j) {
+            loadPrimitive(ctx, model.meshes[i].primitives[j],
+                          "meshes[" + std::to_string(i) + "].primitives[" + std::to_string(j) + "]");
+        }
+        mesh.primitiveCount = static_cast<uint32_t>(ctx.scene->primitives.size()) - mesh.firstPrimitive;
+        ctx.scene->meshes.push_back(mesh);
+    }
+}
+
+} // namespace vitrine::scene::gltf

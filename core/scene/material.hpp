@@ -1,0 +1,163 @@
+#pragma once
+
+// Textures and layered materials (MUSEUM_SPEC §1–2). A material is a stack of layers; each layer has the
+// five UE4-style parameters (albedo, normal, shininess, metallic, cavity), each a constant times an
+// optional texture, and every texture reference carries its own UV transform. Layers above the first
+// blend over the result below them by a mask, one parameter at a time. The on-disk form is the glTF
+// extension described in VITRINE_material_layers.md.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace vitrine::scene {
+
+// Pixels of a texture: always 8-bit RGBA, row-major, top row first. Deliberately not vitrine::Image
+// (float RGBA): a 1K texture is 4 MiB here instead of 16 MiB, sources are 8-bit anyway, and the GPU
+// side uploads RGBA8 / RGBA8_SRGB as is. Mips are built on the GPU (normal maps without renormalising,
+// for Toksvig), so only level 0 is stored.
+struct TextureImage {
+    std::string name;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    std::vector<uint8_t> pixels; // width * height * 4
+
+    uint8_t* at(uint32_t x, uint32_t y) { return &pixels[(static_cast<size_t>(y) * width + x) * 4]; }
+    const uint8_t* at(uint32_t x, uint32_t y) const { return &pixels[(static_cast<size_t>(y) * width + x) * 4]; }
+};
+
+// What a texture holds decides how it is decoded: colour is sRGB-encoded (albedo, emissive), the rest
+// is linear data. Normal maps are told apart from other data because their mips are built differently.
+enum class TextureUsage : uint8_t { Color, Normal, Data };
+enum class ColorSpace : uint8_t { Linear, Srgb };
+
+enum class Filter : uint8_t { Nearest, Linear };
+enum class MipFilter : uint8_t { None, Nearest, Linear };
+enum class Wrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+
+struct Sampler {
+    Filter magFilter = Filter::Linear;
+    Filter minFilter = Filter::Linear;
+    MipFilter mipFilter = MipFilter::Linear;
+    Wrap wrapU = Wrap::Repeat;
+    Wrap wrapV = Wrap::Repeat;
+
+    bool operator==(const Sampler&) const = default;
+};
+
+struct Texture {
+    std::string name;
+    uint32_t image = 0; // index into Scene::images; several textures may share one image
+    Sampler sampler;
+    TextureUsage usage = TextureUsage::Data;
+
+    ColorSpace colorSpace() const { return usage == TextureUsage::Color ? ColorSpace::Srgb : ColorSpace::Linear; }
+};
+
+// KHR_texture_transform semantics: uv' = T(offset) · R(rotation) · S(scale) · uv, rotation in radians
+// counter-clockwise in UV space (which is clockwise on the image, whose v points down).
+struct UvTransform {
+    glm::vec2 offset{0.0f};
+    glm::vec2 scale{1.0f};
+    float rotation = 0.0f;
+
+    bool isIdentity() const { return offset == glm::vec2(0.0f) && scale == glm::vec2(1.0f) && rotation == 0.0f; }
+    glm::mat3 matrix() const; // column-major, for a shader's mat3 (or its first two rows)
+    glm::vec2 apply(glm::vec2 uv) const { return glm::vec2(matrix() * glm::vec3(uv, 1.0f)); }
+    bool operator==(const UvTransform&) const = default;
+};
+
+// A use of a texture by one parameter.
+struct TextureRef {
+    int32_t texture = -1; // index into Scene::textures; -1 = none
+    uint32_t uvSet = 0;   // 0 = Vertex::uv0, 1 = Vertex::uv1
+    UvTransform transform;
+
+    bool valid() const { return texture >= 0; }
+    bool operator==(const TextureRef&) const = default;
+};
+
+// value = mix(atZero, factor, texel[channel]); texel = 1 without a texture, so the value is factor.
+// atZero = 0 gives glTF's "factor × texel". A roughness channel read as shininess = 1 − r·roughness
+// is mix(1, 1 − r, texel): atZero = 1, factor = 1 − r. glTF occlusion with strength s read as cavity is
+// mix(1 − s, 1, texel).
+struct ScalarParam {
+    float factor = 0.0f;
+    float atZero = 0.0f;
+    TextureRef texture;
+    uint32_t channel = 0; // 0..3 = r, g, b, a
+
+    float evaluate(float texel) const { return atZero + (factor - atZero) * texel; }
+    bool operator==(const ScalarParam&) const = default;
+};
+
+// Base colour: factor × texel (texture sRGB-decoded first). alpha is coverage for AlphaMode::Mask.
+struct ColorParam {
+    glm::vec4 factor{1.0f};
+    TextureRef texture;
+    bool operator==(const ColorParam&) const = default;
+};
+
+// Tangent-space normal map, glTF encoding: rgb = n · 0.5 + 0.5 with x along the tangent and y along the
+// bitangent ("OpenGL" green). n.xy is multiplied by scale. No texture = the interpolated vertex normal.
+struct NormalParam {
+    float scale = 1.0f;
+    TextureRef texture;
+    bool operator==(const NormalParam&) const = default;
+};
+
+// Bits of MaterialLayer::overrides.
+enum LayerParamBits : uint32_t {
+    kLayerAlbedo = 1u << 0,
+    kLayerNormal = 1u << 1,
+    kLayerShininess = 1u << 2,
+    kLayerMetallic = 1u << 3,
+    kLayerCavity = 1u << 4,
+    kLayerAll = 0x1fu,
+};
+
+// How much of a layer shows over the layers below: weight = clamp(factor × texel[channel], 0, 1), or
+// clamp(factor) without a texture. The first layer has no mask (weight 1).
+struct LayerMask {
+    float factor = 1.0f;
+    TextureRef texture;
+    uint32_t channel = 0;
+    bool operator==(const LayerMask&) const = default;
+};
+
+struct MaterialLayer {
+    std::string name;
+    ColorParam albedo;
+    NormalParam normal;
+    ScalarParam shininess{0.5f, 0.0f};
+    ScalarParam metallic{0.0f, 0.0f};
+    ScalarParam cavity{1.0f, 0.0f};
+    // Parameters this layer blends over the result below (p = mix(below, this, weight)); the others pass
+    // through untouched. Layer 0 defines all five whatever this says.
+    uint32_t overrides = kLayerAll;
+    LayerMask mask;
+
+    bool operator==(const MaterialLayer&) const = default;
+};
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+struct Material {
+    std::string name;
+    std::vector<MaterialLayer> layers; // at least one; layers[0] is the base
+    glm::vec3 emissiveFactor{0.0f};    // linear
+    float emissiveStrength = 1.0f;     // KHR_materials_emissive_strength; emitted = factor × strength × texel
+    TextureRef emissiveTexture;        // sRGB
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    float alphaCutoff = 0.5f;
+    bool doubleSided = false;
+
+    bool operator==(const Material&) const = default;
+};
+
+// True when any texture of the material samples the given UV set (0 or 1).
+bool usesUvSet(const Material& material, uint32_t uvSet);
+
+} // namespace vitrine::scene

@@ -1,0 +1,32 @@
+#pragma once
+
+// `scene.museum`: the built-in procedural museum, made from code alone (no asset files) and deterministic
+// from its seed. Built by the scene.museum node of the render graph and by tests.
+//
+// What it holds (metres, +Y up): a 32 × 14 × 9 m gallery hall with a polished chequered marble floor, an
+// arcade of fluted columns and arches on each side, tall south windows with mullions and louvred
+// skylights through which the sun falls in patches and shafts; three side galleries (west: sculpture,
+// east: metals, north: paintings) through framed doorways; baseboards, cornices, framed procedural
+// paintings, benches, thin railings; exhibits on pedestals that span the material space (mirror sphere,
+// brushed steel, gold with a dirt layer, rough stone bust, draped cloth, lacquered wood, a finely
+// engraved plate that aliases); a walking robot (dynamic, animated). Rooms are recorded as named boxes;
+// camera paths "walkthrough", "dolly" and "static"; one sun.
+
+#include "core/scene/scene.hpp"
+
+#include <cstdint>
+
+namespace vitrine::scene {
+
+struct MuseumOptions {
+    // Changes the procedural textures, painting contents, small placement jitter and the robot's gait.
+    uint64_t seed = 1;
+    // Edge of every procedural texture in texels (power of two, 16..4096). 1024 matches the demo's
+    // assets; tests use less where texture detail does not matter.
+    uint32_t textureSize = 1024;
+};
+
+// UserError when an option is out of range. The result is finalized and valid.
+Scene buildMuseum(const MuseumOptions& options = {});
+
+} // namespace vitrine::scene

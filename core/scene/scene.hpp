@@ -1,0 +1,245 @@
+#pragma once
+
+// The CPU side of a scene: flat arrays ready for GPU upload (one vertex buffer, one index buffer, draw
+// ranges), layered materials (MUSEUM_SPEC §2), a node hierarchy with animations, cameras, camera paths,
+// the sun and the rooms that later receive cubemap probes. Filled by loadGltf() (gltf.hpp) or
+// buildMuseum() (museum.hpp); read by the scene nodes of the render graph and by the bakers.
+//
+// Conventions: right-handed, +Y up, metres, seconds, radians (glTF's). Colours are linear unless a
+// texture says Srgb. Quaternions are stored as glm::quat; on disk they are x, y, z, w (glTF order).
+
+#include "core/scene/animation.hpp"
+#include "core/scene/material.hpp"
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+namespace vitrine::scene {
+
+// Axis-aligned box; empty() until a point is added.
+struct Aabb {
+    glm::vec3 min{std::numeric_limits<float>::max()};
+    glm::vec3 max{std::numeric_limits<float>::lowest()};
+
+    bool empty() const { return min.x > max.x; }
+    void expand(const glm::vec3& p) {
+        min = glm::min(min, p);
+        max = glm::max(max, p);
+    }
+    void expand(const Aabb& b) {
+        if (!b.empty()) {
+            expand(b.min);
+            expand(b.max);
+        }
+    }
+    bool contains(const glm::vec3& p) const {
+        return glm::all(glm::greaterThanEqual(p, min)) && glm::all(glm::lessThanEqual(p, max));
+    }
+    glm::vec3 center() const { return 0.5f * (min + max); }
+    glm::vec3 extent() const { return max - min; }
+    Aabb transformed(const glm::mat4& m) const;
+};
+
+// One vertex exactly as the GPU reads it: 18 floats, no padding, so a storage buffer with scalar
+// (or std430 with float arrays) layout or a vertex buffer with stride 72 maps it 1:1.
+struct Vertex {
+    glm::vec3 position{0.0f};
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    // xyz: unit tangent along +u of uv0; w = ±1 with bitangent = cross(normal, tangent.xyz) * w (glTF).
+    glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};
+    glm::vec2 uv0{0.0f};
+    // Lightmap coordinates. The museum makes them unique per static mesh (non-overlapping charts in
+    // [0,1]², one atlas per mesh, each static mesh instanced once); glTF files bring their own
+    // TEXCOORD_1, or (0, 0).
+    glm::vec2 uv1{0.0f};
+    // rgb: linear vertex colour (glTF COLOR_0, multiplies base colour). a: vertex ambient occlusion,
+    // 1 = unoccluded (glTF attribute _AO). COLOR_0's own alpha is not kept: vitrine has no translucency.
+    glm::vec4 color{1.0f};
+};
+static_assert(sizeof(Vertex) == 72, "Vertex must stay tightly packed: the GPU side mirrors it");
+
+// A draw: an indexed triangle list with one material. Indices are relative to vertexOffset, so a
+// primitive draws with vkCmdDrawIndexed(indexCount, 1, firstIndex, vertexOffset, 0).
+struct Primitive {
+    uint32_t firstIndex = 0;
+    uint32_t indexCount = 0;
+    uint32_t vertexOffset = 0;
+    uint32_t vertexCount = 0;
+    uint32_t material = 0;
+    Aabb bounds; // object space
+};
+
+// A mesh is a contiguous range of Scene::primitives.
+struct Mesh {
+    std::string name;
+    uint32_t firstPrimitive = 0;
+    uint32_t primitiveCount = 0;
+    Aabb bounds; // object space, set by Scene::finalize()
+};
+
+struct Transform {
+    glm::vec3 translation{0.0f};
+    glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f}; // w, x, y, z in glm's constructor
+    glm::vec3 scale{1.0f};
+
+    glm::mat4 matrix() const;
+};
+
+struct Node {
+    std::string name;
+    Transform local;
+    int32_t parent = -1; // set by Scene::finalize()
+    std::vector<uint32_t> children;
+    int32_t mesh = -1;
+    int32_t camera = -1; // a lens in Scene::cameras, posed by this node
+    // True when an animation moves this node or one of its ancestors (set by Scene::finalize()).
+    // Static meshes get lightmaps; dynamic ones are lit by probes only.
+    bool dynamic = false;
+};
+
+// A mesh placed in the world by a node; one per node that has a mesh and is reachable from a root.
+struct MeshInstance {
+    uint32_t node = 0;
+    uint32_t mesh = 0;
+    glm::mat4 world{1.0f}; // at rest (no animation); per-frame values come from Scene::evaluate()
+    bool dynamic = false;
+    Aabb worldBounds; // at rest
+};
+
+enum class Projection : uint8_t { Perspective, Orthographic };
+
+// A lens. yfov/near/far are what the rasteriser needs; the physical fields feed exposure, depth of
+// field and bokeh (MUSEUM_SPEC §7). Defaults describe a full-frame DSLR with a ~28 mm lens at f/4.
+struct Camera {
+    std::string name;
+    Projection projection = Projection::Perspective;
+    float yfov = 0.8f;              // radians, vertical
+    float aspectRatio = 0.0f;       // 0: use the frame's
+    float znear = 0.05f;            // metres
+    float zfar = 0.0f;              // metres; 0 = infinite far plane (glTF)
+    float xmag = 1.0f, ymag = 1.0f; // orthographic half-extents (metres)
+    float sensorWidthMm = 36.0f;
+    float sensorHeightMm = 24.0f;
+    float fNumber = 4.0f;
+    float focusDistance = 5.0f;       // metres
+    float shutterTime = 1.0f / 60.0f; // seconds
+    float iso = 100.0f;
+    uint32_t apertureBlades = 7;
+
+    // Derived from yfov and the sensor so that the two can never disagree.
+    float focalLengthMm() const;
+};
+
+// One key of a camera path.
+struct CameraKey {
+    float time = 0.0f;
+    glm::vec3 position{0.0f};
+    glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f}; // camera looks down its local -Z, +Y up (glTF)
+    float yfov = 0.8f;
+};
+
+// A named camera move ("walkthrough", "dolly", "static"). Positions follow a Catmull-Rom spline through
+// the keys when smooth (C1, no overshoot handles to author), else straight lines; orientations slerp;
+// yfov is linear. Times outside the keys clamp, or wrap when loop is set.
+struct CameraPath {
+    std::string name;
+    uint32_t camera = 0; // the lens in Scene::cameras (near/far/physical); yfov comes from the keys
+    bool smooth = true;
+    bool loop = false;
+    std::vector<CameraKey> keys;
+
+    float duration() const { return keys.empty() ? 0.0f : keys.back().time - keys.front().time; }
+    // Velocity (m/s) at a key: the Catmull-Rom tangent when smooth (one-sided at the ends), 0 otherwise.
+    // glTF export writes it as the CUBICSPLINE in- and out-tangent, which reproduces the same curve.
+    glm::vec3 tangent(size_t key) const;
+};
+
+// A camera ready for a frame: matrices follow Vulkan's clip conventions.
+struct CameraState {
+    glm::vec3 position{0.0f};
+    glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f};
+    Camera lens; // lens.yfov is the path's value at this time
+    glm::mat4 world{1.0f};
+    glm::mat4 view{1.0f};
+
+    // Right-handed view space in, Vulkan clip space out: y points down, depth 0 (near) .. 1 (far), or
+    // 1 .. 0 when reverseZ. frameAspect = width / height, used when lens.aspectRatio is 0.
+    glm::mat4 projection(float frameAspect, bool reverseZ = false) const;
+};
+
+// The single directional light (MUSEUM_SPEC §3).
+struct Sun {
+    glm::vec3 toSun{0.0f, 1.0f, 0.0f}; // unit vector from the scene towards the sun
+    glm::vec3 color{1.0f};             // linear, max component 1
+    float illuminance = 100000.0f;     // lux on a surface facing the sun; the shader's π convention is its own
+    float angularDiameter = 0.00931f;  // radians (0.53°): shadow penumbra
+};
+
+// A named box of space; the probe placement gives each a cubemap with this influence volume.
+struct Room {
+    std::string name;
+    Aabb bounds;
+};
+
+// World transforms of every node and instance at one time.
+struct ScenePose {
+    std::vector<glm::mat4> nodeWorld;     // index = node
+    std::vector<glm::mat4> instanceWorld; // index = instance
+};
+
+struct Scene {
+    std::string name;
+
+    std::vector<Vertex> vertices;
+    std::vector<uint32_t> indices;
+    std::vector<Primitive> primitives;
+    std::vector<Mesh> meshes;
+
+    std::vector<Material> materials;
+    std::vector<Texture> textures;
+    std::vector<TextureImage> images;
+
+    std::vector<Node> nodes;
+    std::vector<uint32_t> roots; // nodes of the displayed scene
+    std::vector<MeshInstance> instances;
+    std::vector<Camera> cameras;
+    std::vector<CameraPath> cameraPaths;
+    std::vector<Animation> animations;
+
+    Sun sun;
+    bool hasSun = false;
+    std::vector<Room> rooms;
+    Aabb bounds; // world, at rest, set by finalize()
+
+    // Derives parent links, dynamic flags, instances, primitive/mesh bounds and scene bounds from the
+    // primary data. Loaders and builders call it last; call it again after editing nodes or meshes.
+    void finalize();
+
+    // Checks every cross-reference and the texture colour spaces; InternalError names the element.
+    // Loaders guarantee it; builders and tests call it.
+    void validate() const;
+
+    // Node and instance world transforms with every animation applied at time t (seconds).
+    ScenePose evaluate(double t) const;
+
+    // The named camera path at time t. UserError naming the path and listing the known ones if absent.
+    CameraState cameraAt(std::string_view path, double t) const;
+    const CameraPath* findCameraPath(std::string_view path) const;
+
+    // 64-bit hash of all content (geometry, materials, textures, nodes, cameras, paths, animations,
+    // sun, rooms) but not of derived data. Equal scenes hash equal on every run and build; used by
+    // determinism tests and as a key of bake caches.
+    uint64_t contentHash() const;
+
+    size_t triangleCount() const { return indices.size() / 3; }
+    // CPU bytes of geometry and texture pixels: what an upload will roughly cost.
+    size_t memoryBytes() const;
+};
+
+} // namespace vitrine::scene

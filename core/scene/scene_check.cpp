@@ -1,0 +1,276 @@
+// Scene::contentHash() and Scene::validate(): the two whole-scene walks.
+
+#include "core/scene/hash.hpp"
+#include "core/scene/scene.hpp"
+
+#include "core/base/error.hpp"
+
+#include <string>
+
+namespace vitrine::scene {
+
+namespace {
+
+void hashRef(Hasher& h, const TextureRef& r) {
+    h.value(r.texture);
+    h.value(r.uvSet);
+    h.value(r.transform.offset);
+    h.value(r.transform.scale);
+    h.value(r.transform.rotation);
+}
+
+void hashScalar(Hasher& h, const ScalarParam& p) {
+    h.value(p.factor);
+    h.value(p.atZero);
+    h.value(p.channel);
+    hashRef(h, p.texture);
+}
+
+void hashMaterial(Hasher& h, const Material& m) {
+    h.string(m.name);
+    h.value(m.layers.size());
+    for (const MaterialLayer& l : m.layers) {
+        h.string(l.name);
+        h.value(l.albedo.factor);
+        hashRef(h, l.albedo.texture);
+        h.value(l.normal.scale);
+        hashRef(h, l.normal.texture);
+        hashScalar(h, l.shininess);
+        hashScalar(h, l.metallic);
+        hashScalar(h, l.cavity);
+        h.value(l.overrides);
+        h.value(l.mask.factor);
+        h.value(l.mask.channel);
+        hashRef(h, l.mask.texture);
+    }
+    h.value(m.emissiveFactor);
+    h.value(m.emissiveStrength);
+    hashRef(h, m.emissiveTexture);
+    h.value(m.alphaMode);
+    h.value(m.alphaCutoff);
+    h.value(m.doubleSided);
+}
+
+void hashCamera(Hasher& h, const Camera& c) {
+    h.string(c.name);
+    h.value(c.projection);
+    for (float v : {c.yfov, c.aspectRatio, c.znear, c.zfar, c.xmag, c.ymag, c.sensorWidthMm, c.sensorHeightMm,
+                    c.fNumber, c.focusDistance, c.shutterTime, c.iso}) {
+        h.value(v);
+    }
+    h.value(c.apertureBlades);
+}
+
+} // namespace
+
+bool usesUvSet(const Material& m, uint32_t uvSet) {
+    auto uses = [&](const TextureRef& r) { return r.valid() && r.uvSet == uvSet; };
+    for (const MaterialLayer& l : m.layers) {
+        if (uses(l.albedo.texture) || uses(l.normal.texture) || uses(l.shininess.texture) || uses(l.metallic.texture) ||
+            uses(l.cavity.texture) || uses(l.mask.texture)) {
+            return true;
+        }
+    }
+    return uses(m.emissiveTexture);
+}
+
+uint64_t Scene::contentHash() const {
+    Hasher h;
+    h.string(name);
+    h.array(vertices);
+    h.array(indices);
+    h.value(primitives.size());
+    for (const Primitive& p : primitives) {
+        for (uint32_t v : {p.firstIndex, p.indexCount, p.vertexOffset, p.vertexCount, p.material})
+            h.value(v);
+    }
+    h.value(meshes.size());
+    for (const Mesh& m : meshes) {
+        h.string(m.name);
+        h.value(m.firstPrimitive);
+        h.value(m.primitiveCount);
+    }
+    h.value(materials.size());
+    for (const Material& m : materials)
+        hashMaterial(h, m);
+    h.value(textures.size());
+    for (const Texture& t : textures) {
+        h.string(t.name);
+        h.value(t.image);
+        h.value(t.sampler);
+        h.value(t.usage);
+    }
+    h.value(images.size());
+    for (const TextureImage& image : images) {
+        h.string(image.name);
+        h.value(image.width);
+        h.value(image.height);
+        h.array(image.pixels);
+    }
+    h.value(nodes.size());
+    for (const Node& n : nodes) {
+        h.string(n.name);
+        h.value(n.local.translation);
+        h.value(n.local.rotation);
+        h.value(n.local.scale);
+        h.array(n.children);
+        h.value(n.mesh);
+        h.value(n.camera);
+    }
+    h.array(roots);
+    h.value(cameras.size());
+    for (const Camera& c : cameras)
+        hashCamera(h, c);
+    h.value(cameraPaths.size());
+    for (const CameraPath& p : cameraPaths) {
+        h.string(p.name);
+        h.value(p.camera);
+        h.value(p.smooth);
+        h.value(p.loop);
+        h.array(p.keys);
+    }
+    h.value(animations.size());
+    for (const Animation& a : animations) {
+        h.string(a.name);
+        h.value(a.loop);
+        h.value(a.samplers.size());
+        for (const AnimationSampler& s : a.samplers) {
+            h.value(s.interpolation);
+            h.array(s.times);
+            h.array(s.values);
+        }
+        h.value(a.channels.size());
+        for (const AnimationChannel& ch : a.channels) {
+            h.value(ch.node); // field by field: the struct has padding bytes
+            h.value(ch.path);
+            h.value(ch.sampler);
+        }
+    }
+    h.value(hasSun);
+    if (hasSun) h.value(sun);
+    h.value(rooms.size());
+    for (const Room& r : rooms) {
+        h.string(r.name);
+        h.value(r.bounds);
+    }
+    return h.result();
+}
+
+namespace {
+
+class Checker {
+public:
+    explicit Checker(const Scene& scene) : mScene(scene) {}
+
+    [[noreturn]] void fail(const std::string& element, const std::string& what) const {
+        throw InternalError("scene '" + mScene.name + "': " + element + ": " + what);
+    }
+    void index(const std::string& element, int64_t value, size_t count, const char* what) const {
+        if (value < 0 || static_cast<size_t>(value) >= count) {
+            fail(element,
+                 "index " + std::to_string(value) + " out of range (" + std::to_string(count) + " " + what + ")");
+        }
+    }
+    void ref(const std::string& element, const TextureRef& r, TextureUsage usage, uint32_t channel = 0) const {
+        if (!r.valid()) return;
+        index(element + ".texture", r.texture, mScene.textures.size(), "textures");
+        if (r.uvSet > 1) fail(element + ".uvSet", "expected 0 or 1, got " + std::to_string(r.uvSet));
+        TextureUsage actual = mScene.textures[r.texture].usage;
+        // Alpha is never sRGB-encoded, so data may come from a colour texture's alpha channel.
+        bool ok = actual == usage || (usage == TextureUsage::Data && actual == TextureUsage::Color && channel == 3);
+        if (!ok) fail(element, "textures[" + std::to_string(r.texture) + "] has the wrong usage (colour space)");
+    }
+    void scalar(const std::string& element, const ScalarParam& p) const {
+        if (p.channel > 3) fail(element + ".channel", "expected 0..3");
+        ref(element, p.texture, TextureUsage::Data, p.channel);
+    }
+
+private:
+    const Scene& mScene;
+};
+
+} // namespace
+
+void Scene::validate() const {
+    Checker c(*this);
+    for (size_t i = 0; i < primitives.size(); ++i) {
+        const Primitive& p = primitives[i];
+        std::string e = "primitives[" + std::to_string(i) + "]";
+        if (uint64_t(p.firstIndex) + p.indexCount > indices.size() || p.indexCount % 3 != 0) {
+            c.fail(e, "index range is outside the index buffer or not whole triangles");
+        }
+        if (uint64_t(p.vertexOffset) + p.vertexCount > vertices.size()) c.fail(e, "vertex range is outside");
+        c.index(e + ".material", p.material, materials.size(), "materials");
+        for (uint32_t k = 0; k < p.indexCount; ++k) {
+            if (indices[p.firstIndex + k] >= p.vertexCount) c.fail(e, "an index exceeds the vertex range");
+        }
+    }
+    for (size_t i = 0; i < meshes.size(); ++i) {
+        if (uint64_t(meshes[i].firstPrimitive) + meshes[i].primitiveCount > primitives.size()) {
+            c.fail("meshes[" + std::to_string(i) + "]", "primitive range is outside");
+        }
+    }
+    for (size_t i = 0; i < images.size(); ++i) {
+        if (images[i].pixels.size() != size_t(images[i].width) * images[i].height * 4) {
+            c.fail("images[" + std::to_string(i) + "]", "pixel count does not match width × height × 4");
+        }
+    }
+    for (size_t i = 0; i < textures.size(); ++i) {
+        c.index("textures[" + std::to_string(i) + "].image", textures[i].image, images.size(), "images");
+    }
+    for (size_t i = 0; i < materials.size(); ++i) {
+        const Material& m = materials[i];
+        std::string e = "materials[" + std::to_string(i) + "]";
+        if (m.layers.empty()) c.fail(e, "has no layers");
+        for (size_t l = 0; l < m.layers.size(); ++l) {
+            const MaterialLayer& layer = m.layers[l];
+            std::string le = e + ".layers[" + std::to_string(l) + "]";
+            c.ref(le + ".albedo", layer.albedo.texture, TextureUsage::Color);
+            c.ref(le + ".normal", layer.normal.texture, TextureUsage::Normal);
+            c.scalar(le + ".shininess", layer.shininess);
+            c.scalar(le + ".metallic", layer.metallic);
+            c.scalar(le + ".cavity", layer.cavity);
+            if (layer.mask.channel > 3) c.fail(le + ".mask.channel", "expected 0..3");
+            c.ref(le + ".mask", layer.mask.texture, TextureUsage::Data, layer.mask.channel);
+            if ((layer.overrides & ~uint32_t(kLayerAll)) != 0) c.fail(le + ".overrides", "unknown bits");
+        }
+        c.ref(e + ".emissiveTexture", m.emissiveTexture, TextureUsage::Color);
+    }
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        const Node& n = nodes[i];
+        std::string e = "nodes[" + std::to_string(i) + "]";
+        if (n.mesh >= 0) c.index(e + ".mesh", n.mesh, meshes.size(), "meshes");
+        if (n.camera >= 0) c.index(e + ".camera", n.camera, cameras.size(), "cameras");
+        for (uint32_t child : n.children)
+            c.index(e + ".children", child, nodes.size(), "nodes");
+    }
+    for (uint32_t r : roots)
+        c.index("roots", r, nodes.size(), "nodes");
+    for (size_t i = 0; i < cameraPaths.size(); ++i) {
+        const CameraPath& p = cameraPaths[i];
+        std::string e = "cameraPaths[" + std::to_string(i) + "] '" + p.name + "'";
+        c.index(e + ".camera", p.camera, cameras.size(), "cameras");
+        if (p.keys.empty()) c.fail(e, "has no keys");
+        for (size_t k = 1; k < p.keys.size(); ++k) {
+            if (p.keys[k].time < p.keys[k - 1].time) c.fail(e, "key times decrease");
+        }
+    }
+    for (size_t i = 0; i < animations.size(); ++i) {
+        const Animation& a = animations[i];
+        std::string e = "animations[" + std::to_string(i) + "]";
+        for (size_t s = 0; s < a.samplers.size(); ++s) {
+            const AnimationSampler& smp = a.samplers[s];
+            size_t per = smp.interpolation == Interpolation::CubicSpline ? 3 : 1;
+            if (smp.values.size() != smp.times.size() * per) {
+                c.fail(e + ".samplers[" + std::to_string(s) + "]", "value count does not match the key count");
+            }
+        }
+        for (size_t ch = 0; ch < a.channels.size(); ++ch) {
+            std::string ce = e + ".channels[" + std::to_string(ch) + "]";
+            c.index(ce + ".node", a.channels[ch].node, nodes.size(), "nodes");
+            c.index(ce + ".sampler", a.channels[ch].sampler, a.samplers.size(), "samplers");
+        }
+    }
+}
+
+} // namespace vitrine::scene

@@ -1,0 +1,194 @@
+// Malformed files give a UserError naming the file, the element and what was expected; never a crash.
+
+#include "core/scene/gltf.hpp"
+
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+namespace vitrine::scene {
+namespace {
+
+using test::expectUserError;
+using test::Json;
+
+class GltfErrors : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mDir = test::scratchDir();
+        mDoc = test::readJson(test::dataDir() / "quad.gltf");
+        mBuffer = test::dataUriBytes(mDoc["buffers"][0]["uri"]);
+    }
+    // Writes doc as name in the scratch directory and returns its path.
+    std::filesystem::path write(const std::string& name, const Json& doc) {
+        test::writeText(mDir / name, doc.dump(2));
+        return mDir / name;
+    }
+    std::vector<uint8_t> glb() const {
+        Json doc = mDoc;
+        doc["buffers"][0] = {{"byteLength", mBuffer.size()}};
+        return test::makeGlb(doc.dump(), mBuffer);
+    }
+
+    std::filesystem::path mDir;
+    Json mDoc;
+    std::vector<uint8_t> mBuffer;
+};
+
+TEST_F(GltfErrors, BadJson) {
+    expectUserError([] { loadGltf(test::dataDir() / "bad_json.gltf"); }, {"bad_json.gltf", "JSON", "not valid JSON"});
+}
+
+TEST_F(GltfErrors, MissingAndEmptyFiles) {
+    expectUserError([&] { loadGltf(mDir / "nothing.gltf"); }, {"nothing.gltf", "cannot open"});
+    test::writeText(mDir / "empty.gltf", "");
+    expectUserError([&] { loadGltf(mDir / "empty.gltf"); }, {"empty.gltf", "is empty"});
+}
+
+TEST_F(GltfErrors, TruncatedGlb) {
+    std::vector<uint8_t> bytes = glb();
+    std::vector<uint8_t> cut(bytes.begin(), bytes.begin() + bytes.size() / 2);
+    test::writeBytes(mDir / "cut.glb", cut);
+    expectUserError([&] { loadGltf(mDir / "cut.glb"); }, {"cut.glb", "GLB header", "truncated"});
+
+    // Cut inside the binary chunk with the header's total length patched to match: the chunk itself is short.
+    std::vector<uint8_t> shortBin(bytes.begin(), bytes.end() - 16);
+    uint32_t length = static_cast<uint32_t>(shortBin.size());
+    for (int i = 0; i < 4; ++i)
+        shortBin[8 + i] = static_cast<uint8_t>(length >> (8 * i));
+    test::writeBytes(mDir / "short_bin.glb", shortBin);
+    expectUserError([&] { loadGltf(mDir / "short_bin.glb"); }, {"short_bin.glb", "GLB chunk 1 (BIN)", "truncated"});
+
+    // Every truncation is an error, and never a crash. (A new file each time: rewriting one file makes
+    // ext4 flush it on close, which is slow.)
+    for (size_t size = 0; size < bytes.size(); size += 5) {
+        auto file = mDir / ("cut_" + std::to_string(size) + ".glb");
+        test::writeBytes(file, std::vector<uint8_t>(bytes.begin(), bytes.begin() + size));
+        EXPECT_THROW(loadGltf(file), UserError) << "size " << size;
+    }
+}
+
+TEST_F(GltfErrors, MissingBufferFile) {
+    mDoc["buffers"][0]["uri"] = "missing.bin";
+    auto file = write("missing_buffer.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"missing_buffer.gltf", "buffers[0].uri", "'missing.bin' not found"});
+}
+
+TEST_F(GltfErrors, MissingTextureFile) {
+    mDoc["images"][0] = {{"uri", "missing.png"}};
+    auto file = write("missing_texture.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"missing_texture.gltf", "images[0].uri", "'missing.png' not found"});
+}
+
+TEST_F(GltfErrors, UndecodableTexture) {
+    test::writeText(mDir / "not_a.png", "this is not a PNG");
+    mDoc["images"][0] = {{"uri", "not_a.png"}};
+    auto file = write("bad_texture.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"bad_texture.gltf"});
+}
+
+TEST_F(GltfErrors, AccessorBeyondItsBufferView) {
+    mDoc["accessors"][0]["count"] = 100;
+    auto file = write("accessor_range.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"accessor_range.gltf", "meshes[0].primitives[0].attributes.POSITION",
+                                              "accessors[0]", "exceed bufferViews[0]", "expected the accessor to fit"});
+}
+
+TEST_F(GltfErrors, AbsurdCountsFailBeforeAllocating) {
+    mDoc["accessors"][0]["count"] = 1099511627776ull; // 2^40 elements
+    auto file = write("huge.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"huge.gltf", "attributes.POSITION", "exceed bufferViews[0]"});
+    mDoc["accessors"][0].erase("bufferView"); // all zeros: legal glTF, but not this many
+    file = write("huge_zeros.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"huge_zeros.gltf", "attributes.POSITION", "without a bufferView"});
+}
+
+TEST_F(GltfErrors, AccessorIndexOutOfRange) {
+    mDoc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 42;
+    auto file = write("accessor_index.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"accessor_index.gltf", "meshes[0].primitives[0].attributes.NORMAL",
+                                              "index 42 out of range", "6 accessors"});
+}
+
+TEST_F(GltfErrors, VertexIndexOutOfRange) {
+    std::vector<uint8_t> bin = mBuffer;
+    bin[128 + 2 * 4] = 7; // the fifth index (u16 at byte 136) becomes 7; the quad has 4 vertices
+    test::writeBytes(mDir / "quad.bin", bin);
+    mDoc["buffers"][0]["uri"] = "quad.bin";
+    auto file = write("index_range.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); },
+                    {"index_range.gltf", "meshes[0].primitives[0].indices", "index 7 at position 4", "expected < 4"});
+}
+
+TEST_F(GltfErrors, BufferViewBeyondItsBuffer) {
+    mDoc["bufferViews"][5]["byteLength"] = 1000;
+    auto file = write("view_range.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"view_range.gltf", "bufferViews[5]", "exceed buffers[0]"});
+}
+
+TEST_F(GltfErrors, UnsupportedRequiredExtension) {
+    mDoc["extensionsRequired"] = {"KHR_texture_transform", "KHR_draco_mesh_compression"};
+    auto file = write("required.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); },
+                    {"required.gltf", "extensionsRequired[1]", "KHR_draco_mesh_compression", "not supported"});
+    // Merely used (not required) unknown extensions are fine.
+    mDoc.erase("extensionsRequired");
+    mDoc["extensionsUsed"].push_back("EXT_something_else");
+    EXPECT_NO_THROW(loadGltf(write("used.gltf", mDoc)));
+}
+
+TEST_F(GltfErrors, MaterialTextureIndexOutOfRange) {
+    mDoc["materials"][0]["normalTexture"]["index"] = 9;
+    auto file = write("texture_index.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); },
+                    {"texture_index.gltf", "materials[0].normalTexture.index", "out of range"});
+}
+
+TEST_F(GltfErrors, AnimationOutputCount) {
+    mDoc["accessors"][5]["count"] = 1;
+    auto file = write("animation.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"animation.gltf", "animations[0].samplers[0].output", "expected 2"});
+}
+
+TEST_F(GltfErrors, LayerExtensionTypos) {
+    Json doc = test::readJson(test::dataDir() / "layered.gltf");
+    Json& layer = doc["materials"][0]["extensions"]["VITRINE_material_layers"]["layers"][1];
+    layer["albdo"] = layer["albedo"];
+    auto file = write("typo.gltf", doc);
+    expectUserError([&] { loadGltf(file); },
+                    {"typo.gltf", "materials[0].extensions.VITRINE_material_layers.layers[1].albdo", "unknown key"});
+    layer.erase("albdo");
+    layer["overrides"] = {"albedo", "roughness"};
+    file = write("override.gltf", doc);
+    expectUserError([&] { loadGltf(file); }, {"layers[1].overrides", "\"roughness\"", "expected albedo"});
+    layer["overrides"] = {"albedo"};
+    layer["mask"]["channel"] = 4;
+    file = write("channel.gltf", doc);
+    expectUserError([&] { loadGltf(file); }, {"layers[1].mask.channel", "expected 0..3"});
+}
+
+TEST_F(GltfErrors, HierarchyMustBeATree) {
+    mDoc["nodes"][4]["children"] = {3}; // 3 → 4 → 3
+    auto file = write("cycle.gltf", mDoc);
+    expectUserError([&] { loadGltf(file); }, {"cycle.gltf", "nodes[", "expected a tree"});
+}
+
+// Byte flips anywhere in a valid GLB load or fail with a UserError; nothing else may escape.
+TEST_F(GltfErrors, CorruptedBytesNeverCrash) {
+    std::vector<uint8_t> bytes = glb();
+    for (size_t at = 0; at < bytes.size(); at += 3) {
+        std::vector<uint8_t> bad = bytes;
+        bad[at] ^= static_cast<uint8_t>(0x5a + at);
+        auto file = mDir / ("flip_" + std::to_string(at) + ".glb");
+        test::writeBytes(file, bad);
+        try {
+            loadGltf(file);
+        } catch (const UserError&) {
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << "byte " << at << ": not a UserError: " << e.what();
+        }
+    }
+}
+
+} // namespace
+} // namespace vitrine::scene

@@ -1,0 +1,206 @@
+// scene.museum: deterministic, complete, and built so that the renderer's features have something to do.
+
+#include "core/scene/museum.hpp"
+
+#include "test_util.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <set>
+
+#include <gtest/gtest.h>
+
+namespace vitrine::scene {
+namespace {
+
+class Museum : public ::testing::Test {
+protected:
+    // One default museum for all the content checks: building it takes about a second.
+    static void SetUpTestSuite() { sMuseum = std::make_unique<Scene>(buildMuseum()); }
+    static void TearDownTestSuite() { sMuseum.reset(); }
+    static const Scene& museum() { return *sMuseum; }
+
+    static inline std::unique_ptr<Scene> sMuseum;
+};
+
+TEST_F(Museum, IsDeterministicFromTheSeed) {
+    EXPECT_EQ(buildMuseum().contentHash(), museum().contentHash());
+    MuseumOptions other;
+    other.seed = 2;
+    EXPECT_NE(buildMuseum(other).contentHash(), museum().contentHash());
+}
+
+TEST_F(Museum, RejectsBadOptions) {
+    MuseumOptions bad;
+    bad.textureSize = 1000;
+    test::expectUserError([&] { buildMuseum(bad); }, {"scene.museum", "textureSize 1000", "power of two"});
+}
+
+TEST_F(Museum, HasTheRequiredElements) {
+    const Scene& s = museum();
+    EXPECT_NO_THROW(s.validate());
+    ASSERT_GE(s.rooms.size(), 3u);
+    std::set<std::string> names;
+    for (const Room& r : s.rooms) {
+        names.insert(r.name);
+        EXPECT_FALSE(r.bounds.empty()) << r.name;
+        EXPECT_GT(r.bounds.extent().x * r.bounds.extent().z, 50.0f) << r.name; // rooms, not closets
+    }
+    EXPECT_EQ(names.size(), s.rooms.size()) << "room names must be unique";
+    for (const char* path : {"walkthrough", "dolly", "static"})
+        EXPECT_NE(s.findCameraPath(path), nullptr) << path;
+    EXPECT_GT(s.findCameraPath("walkthrough")->duration(), 30.0f);
+    EXPECT_TRUE(s.hasSun);
+    EXPECT_GT(s.sun.toSun.y, 0.3f);
+
+    // Plausible size: 100k–300k triangles, metres.
+    EXPECT_GE(s.triangleCount(), 100000u);
+    EXPECT_LE(s.triangleCount(), 300000u);
+    EXPECT_GT(s.bounds.extent().x, 30.0f);
+    EXPECT_LT(s.bounds.extent().x, 100.0f);
+    EXPECT_NEAR(s.bounds.min.y, 0.0f, 0.01f);
+
+    for (const TextureImage& image : s.images) {
+        EXPECT_GE(image.width, 1024u) << image.name;
+        EXPECT_GE(image.height, 1024u) << image.name;
+    }
+    size_t masked = 0;
+    for (const Material& m : s.materials) {
+        if (m.layers.size() >= 2 && m.layers[1].mask.texture.valid()) ++masked;
+    }
+    EXPECT_GE(masked, 3u) << "layered materials with texture masks";
+}
+
+TEST_F(Museum, RobotIsDynamicAndMoves) {
+    const Scene& s = museum();
+    ASSERT_FALSE(s.animations.empty());
+    std::vector<size_t> dynamic;
+    for (size_t i = 0; i < s.instances.size(); ++i) {
+        if (s.instances[i].dynamic) dynamic.push_back(i);
+    }
+    EXPECT_GE(dynamic.size(), 5u) << "a robot of several parts";
+    ScenePose a = s.evaluate(0.0), b = s.evaluate(1.0);
+    for (size_t i : dynamic)
+        EXPECT_NE(a.instanceWorld[i], b.instanceWorld[i]) << s.meshes[s.instances[i].mesh].name;
+    for (size_t i = 0; i < s.instances.size(); ++i) {
+        if (!s.instances[i].dynamic) {
+            EXPECT_EQ(a.instanceWorld[i], b.instanceWorld[i]);
+        }
+    }
+    // It loops: one lap later it is where it was.
+    float lap = s.animations[0].endTime() - s.animations[0].startTime();
+    ScenePose c = s.evaluate(1.0 + lap);
+    for (size_t i : dynamic) {
+        EXPECT_NEAR(glm::distance(glm::vec3(b.instanceWorld[i][3]), glm::vec3(c.instanceWorld[i][3])), 0.0f, 1e-3f);
+    }
+}
+
+TEST_F(Museum, VerticesAreWellFormed) {
+    const Scene& s = museum();
+    std::vector<bool> lightmapped(s.meshes.size(), false);
+    for (const MeshInstance& in : s.instances)
+        lightmapped[in.mesh] = !in.dynamic;
+    for (size_t m = 0; m < s.meshes.size(); ++m) {
+        const Mesh& mesh = s.meshes[m];
+        for (uint32_t p = 0; p < mesh.primitiveCount; ++p) {
+            const Primitive& prim = s.primitives[mesh.firstPrimitive + p];
+            for (uint32_t v = 0; v < prim.vertexCount; ++v) {
+                const Vertex& x = s.vertices[prim.vertexOffset + v];
+                ASSERT_NEAR(glm::length(x.normal), 1.0f, 1e-3f) << mesh.name;
+                ASSERT_NEAR(glm::length(glm::vec3(x.tangent)), 1.0f, 1e-3f) << mesh.name;
+                ASSERT_NEAR(glm::dot(glm::vec3(x.tangent), x.normal), 0.0f, 1e-3f) << mesh.name;
+                ASSERT_TRUE(x.color.a > 0.0f && x.color.a <= 1.0f) << mesh.name;
+                if (lightmapped[m]) {
+                    ASSERT_TRUE(x.uv1.x >= 0.0f && x.uv1.x <= 1.0f && x.uv1.y >= 0.0f && x.uv1.y <= 1.0f) << mesh.name;
+                }
+            }
+        }
+    }
+}
+
+// The camera paths stay inside the building: every sample lies in a room or a doorway.
+TEST_F(Museum, CameraPathsStayIndoors) {
+    const Scene& s = museum();
+    std::vector<Aabb> spaces;
+    for (const Room& r : s.rooms) {
+        Aabb inner = r.bounds;
+        inner.min += glm::vec3(0.2f, 0.0f, 0.2f);
+        inner.max -= glm::vec3(0.2f, 0.0f, 0.2f);
+        spaces.push_back(inner);
+    }
+    // Doorways between the hall and the galleries (1.5 m either side of an axis, 0.4 m walls).
+    spaces.push_back(Aabb{{-16.6f, 0.0f, -1.3f}, {-15.8f, 3.5f, 1.3f}});
+    spaces.push_back(Aabb{{15.8f, 0.0f, -1.3f}, {16.6f, 3.5f, 1.3f}});
+    spaces.push_back(Aabb{{-1.3f, 0.0f, 6.8f}, {1.3f, 3.5f, 7.6f}});
+    for (const CameraPath& path : s.cameraPaths) {
+        for (float t = path.keys.front().time; t <= path.keys.back().time; t += 0.1f) {
+            glm::vec3 p = s.cameraAt(path.name, t).position;
+            bool inside = std::any_of(spaces.begin(), spaces.end(), [&](const Aabb& b) { return b.contains(p); });
+            EXPECT_TRUE(inside) << path.name << " at " << t << " s: (" << p.x << ", " << p.y << ", " << p.z << ")";
+        }
+    }
+}
+
+bool rayHitsTriangle(const glm::vec3& o, const glm::vec3& d, const glm::vec3& a, const glm::vec3& b,
+                     const glm::vec3& c) {
+    glm::vec3 e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+    float det = glm::dot(e1, p);
+    if (std::abs(det) < 1e-12f) return false;
+    glm::vec3 t = o - a;
+    float u = glm::dot(t, p) / det;
+    if (u < 0.0f || u > 1.0f) return false;
+    glm::vec3 q = glm::cross(t, e1);
+    float v = glm::dot(d, q) / det;
+    return v >= 0.0f && u + v <= 1.0f && glm::dot(e2, q) / det > 1e-4f;
+}
+
+bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, const Aabb& box) {
+    glm::vec3 t0 = (box.min - o) / d, t1 = (box.max - o) / d;
+    glm::vec3 lo = glm::min(t0, t1), hi = glm::max(t0, t1);
+    return std::max(std::max(lo.x, lo.y), lo.z) <= std::min(std::min(hi.x, hi.y), hi.z) &&
+           std::min(std::min(hi.x, hi.y), hi.z) > 0.0f;
+}
+
+// Sunlight reaches the hall floor through the openings in patches: some floor points see the sun,
+// most do not (a closed roof would give none, a missing one all).
+TEST_F(Museum, SunlightFallsInPatches) {
+    const Scene& s = museum();
+    glm::vec3 toSun = glm::normalize(s.sun.toSun);
+    ScenePose pose = s.evaluate(0.0);
+    auto lit = [&](const glm::vec3& origin) {
+        for (size_t i = 0; i < s.instances.size(); ++i) {
+            const Mesh& mesh = s.meshes[s.instances[i].mesh];
+            const glm::mat4& w = pose.instanceWorld[i];
+            for (uint32_t p = 0; p < mesh.primitiveCount; ++p) {
+                const Primitive& prim = s.primitives[mesh.firstPrimitive + p];
+                if (!rayHitsBox(origin, toSun, prim.bounds.transformed(w))) continue;
+                for (uint32_t k = 0; k < prim.indexCount; k += 3) {
+                    glm::vec3 v[3];
+                    for (int j = 0; j < 3; ++j) {
+                        v[j] = glm::vec3(
+                            w * glm::vec4(s.vertices[prim.vertexOffset + s.indices[prim.firstIndex + k + j]].position,
+                                          1.0f));
+                    }
+                    if (rayHitsTriangle(origin, toSun, v[0], v[1], v[2])) return false;
+                }
+            }
+        }
+        return true;
+    };
+    int litCount = 0, total = 0;
+    for (float x = -15.0f; x <= 15.0f; x += 0.5f) {
+        for (float z = -6.5f; z <= 6.5f; z += 0.5f) {
+            litCount += lit({x + 0.37f, 0.01f, z + 0.21f}) ? 1 : 0;
+            ++total;
+        }
+    }
+    float fraction = float(litCount) / total;
+    EXPECT_GT(fraction, 0.03f) << litCount << " of " << total;
+    EXPECT_LT(fraction, 0.5f) << litCount << " of " << total;
+    // Outside the building, under the open sky, the sun is never blocked from above.
+    EXPECT_TRUE(lit({0.0f, 0.01f, -30.0f}));
+}
+
+} // namespace
+} // namespace vitrine::scene
