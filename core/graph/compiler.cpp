@@ -64,6 +64,23 @@ public:
         mPass.pipelines.push_back({name, {}, source});
         return static_cast<PipelineId>(mPass.pipelines.size() - 1);
     }
+    void setObject(const std::string& port, std::shared_ptr<PortObject> object) override {
+        for (const auto& u : mPass.uses)
+            if (u.output && u.port == port && !mGraph.resources[u.resource].isTexture()) {
+                mGraph.resources[u.resource].object = std::move(object);
+                return;
+            }
+        throw InternalError("node " + mDecl.id + " sets an object on '" + port + "', which is not an object output");
+    }
+    std::shared_ptr<PortObject> object(const std::string& port) const override {
+        for (const auto& u : mPass.uses)
+            if (!u.output && u.port == port && !mGraph.resources[u.resource].isTexture()) {
+                const GraphResource& r = mGraph.resources[u.resource];
+                if (!r.object) throw InternalError("node " + mDecl.id + ": the producer of '" + r.name + "' set no object");
+                return r.object;
+            }
+        throw InternalError("node " + mDecl.id + " asks for object input '" + port + "', which is not connected");
+    }
     std::filesystem::path resolvePath(const std::string& path) const override {
         std::filesystem::path p(path);
         return p.is_absolute() ? p : mGraph.desc.directory / p;
@@ -125,6 +142,7 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
             GraphResource res;
             res.name = decl.id + "." + out.name;
             res.producer = passIndex;
+            res.kind = out.kind;
             res.persistent = out.persistent;
             res.desc.format = out.format;
             if (!out.formatFrom.empty()) {
@@ -160,7 +178,7 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
 
         // Input format checks, now that producers are resolved.
         for (const auto& u : p.uses) {
-            if (u.output || u.previous) continue;
+            if (u.output || u.previous || !g.resources[u.resource].isTexture()) continue;
             const InputPort* in = decl.schema->findInput(u.port);
             VkFormat f = g.resources[u.resource].desc.format;
             if (in->formats.empty() || std::find(in->formats.begin(), in->formats.end(), f) != in->formats.end()) continue;
@@ -173,6 +191,9 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
 
         Setup setup(g, p, decl);
         p.node->setup(setup);
+        for (const auto& u : p.uses)
+            if (u.output && !g.resources[u.resource].isTexture() && !g.resources[u.resource].object)
+                throw InternalError("node " + decl.id + " (" + decl.schema->type + ") set no object on output '" + u.port + "'");
     }
 
     // @prev inputs: bind to the producer's resource and mark it as history.
@@ -213,6 +234,10 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
         }
     }
     for (auto& r : g.resources) {
+        if (!r.isTexture()) {
+            r.desc = ImageDesc{};
+            continue;
+        }
         // Any texture can be inspected (debug.view, read-back), so every one is sampleable.
         r.desc.usage |= VK_IMAGE_USAGE_SAMPLED_BIT;
         if (r.history) r.desc.usage |= VK_IMAGE_USAGE_TRANSFER_DST_BIT; // cleared before its first frame

@@ -14,6 +14,7 @@ class NodeRegistry;
 // One texture the graph produces: `node.port`.
 struct GraphResource {
     std::string name;
+    PortKind kind = PortKind::Texture; // other kinds carry `object`, no image
     uint32_t producer = 0; // pass index
     ImageDesc desc;        // usage flags accumulated from every use
     uint32_t firstPass = 0;
@@ -21,7 +22,9 @@ struct GraphResource {
     bool persistent = false; // survives across frames (declared by the output port)
     bool history = false;    // someone reads it as @prev: two images, ping-ponged per frame
     bool extracted = false;  // a graph output: read back after the frame, so never aliased
-    bool transient() const { return !persistent && !history && !extracted; }
+    std::shared_ptr<PortObject> object; // set by the producer's setup() for non-texture kinds
+    bool isTexture() const { return kind == PortKind::Texture; }
+    bool transient() const { return isTexture() && !persistent && !history && !extracted; }
 };
 
 struct PassUse {

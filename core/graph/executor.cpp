@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <set>
 
 namespace vitrine {
@@ -20,7 +21,7 @@ struct Executor::Pipeline {
     struct Target {
         uint32_t binding;
         VkDescriptorType type;
-        std::string port;
+        std::string port; // empty for the `Uniforms` block
         bool output;
     };
     std::string shader;
@@ -46,6 +47,8 @@ bool descriptorFits(VkDescriptorType type, Usage usage) {
     default: return false;
     }
 }
+
+constexpr VkDeviceSize kUniformRingSize = 4u << 20;
 
 } // namespace
 
@@ -73,6 +76,24 @@ public:
         mEx.mFrameStaging.push_back(recordUpload(mEx.mCtx, mCmd, imageOf(port, true), pixels));
     }
 
+    PortObject& object(const std::string& port) override {
+        for (int output = 0; output < 2; ++output) {
+            const PassUse* u = findUse(port, output != 0);
+            if (u && mEx.mGraph.resources[u->resource].object) return *mEx.mGraph.resources[u->resource].object;
+        }
+        throw InternalError("node " + pass().id + " asks for object port '" + port + "', which carries none");
+    }
+    ShaderCompiler& shaders() override { return mEx.mShaders; }
+    void setUniforms(const void* data, uint32_t size) override {
+        VkDeviceSize offset = (mEx.mUniformHead + mEx.mUniformAlign - 1) / mEx.mUniformAlign * mEx.mUniformAlign;
+        if (offset + size > kUniformRingSize)
+            throw InternalError("node " + pass().id + ": uniform data of this frame exceeds " + std::to_string(kUniformRingSize) + " bytes");
+        std::memcpy(static_cast<uint8_t*>(mEx.mUniformRing.mapped()) + offset, data, size);
+        mEx.mUniformHead = offset + size;
+        mUniformOffset = offset;
+        mUniformSize = size;
+    }
+
     void dispatch(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,
                   uint32_t depth) override {
         auto& pipelines = mEx.mPipelines[mPassIndex];
@@ -89,9 +110,23 @@ public:
             info.pSetLayouts = &p.setLayout;
             VK_CHECK(vkAllocateDescriptorSets(mEx.mCtx.device(), &info, &set));
             std::vector<VkDescriptorImageInfo> images(p.targets.size());
+            VkDescriptorBufferInfo uniforms{};
             std::vector<VkWriteDescriptorSet> writes;
             for (size_t i = 0; i < p.targets.size(); ++i) {
                 const auto& t = p.targets[i];
+                if (t.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
+                    if (!mUniformSize)
+                        throw InternalError("node " + pass().id + ": " + p.shader + " has a Uniforms block but setUniforms() was not called");
+                    uniforms = {mEx.mUniformRing.buffer(), mUniformOffset, mUniformSize};
+                    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+                    w.dstSet = set;
+                    w.dstBinding = t.binding;
+                    w.descriptorCount = 1;
+                    w.descriptorType = t.type;
+                    w.pBufferInfo = &uniforms;
+                    writes.push_back(w);
+                    continue;
+                }
                 const PassUse* u = findUse(t.port, t.output);
                 if (u) {
                     const Executor::Physical& ph = mEx.mPhysical[mEx.physicalOf(u->resource, u->previous)];
@@ -134,9 +169,12 @@ private:
     Executor& mEx;
     uint32_t mPassIndex;
     VkCommandBuffer mCmd;
+    VkDeviceSize mUniformOffset = 0;
+    uint32_t mUniformSize = 0;
 };
 
-Executor::Executor(Context& ctx, CompiledGraph& graph, ShaderCompiler& shaders) : mCtx(ctx), mGraph(graph) {
+Executor::Executor(Context& ctx, CompiledGraph& graph, ShaderCompiler& shaders)
+    : mCtx(ctx), mGraph(graph), mShaders(shaders) {
     try {
         create(shaders);
     } catch (...) {
@@ -187,6 +225,11 @@ void Executor::create(ShaderCompiler& shaders) {
         vkCmdPipelineBarrier2(cmd, &dep);
     });
 
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(ctx.physicalDevice(), &props);
+    mUniformAlign = std::max<VkDeviceSize>(props.limits.minUniformBufferOffsetAlignment, 16);
+    mUniformRing = GpuBuffer(ctx, kUniformRingSize, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, "graph.uniforms");
+
     createImages();
     createPipelines(shaders);
     mProfiler = std::make_unique<GpuProfiler>(ctx, static_cast<uint32_t>(graph.passes.size()));
@@ -198,6 +241,7 @@ void Executor::destroy() {
     mCtx.waitIdle();
     mPhysical.clear();
     mDummy = GpuImage();
+    mUniformRing = GpuBuffer();
     mProfiler.reset();
     VkDevice device = mCtx.device();
     std::vector<std::unique_ptr<Pipeline>> all;
@@ -261,7 +305,7 @@ void Executor::createImages() {
     }
     for (uint32_t i = 0; i < mGraph.resources.size(); ++i) {
         const GraphResource& r = mGraph.resources[i];
-        if (r.transient()) continue;
+        if (r.transient() || !r.isTexture()) continue;
         int copies = r.history ? 2 : 1;
         for (int c = 0; c < copies; ++c) {
             mPhysical.push_back({GpuImage(mCtx, r.desc, r.name + (r.history ? (c ? "[1]" : "[0]") : "")), {}});
@@ -290,6 +334,13 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
             for (const auto& b : shader.reflection.bindings) {
                 std::string where = "shader " + request.shader + " (node " + pass.id + ", " + pass.schema->type + ")";
                 if (b.set != 0) throw InternalError(where + ": binding '" + b.name + "' is in set " + std::to_string(b.set) + "; nodes use set 0");
+                if (b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
+                    if (b.name != "Uniforms")
+                        throw InternalError(where + ": uniform block '" + b.name + "' must be named Uniforms (filled by setUniforms())");
+                    bindings.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
+                    p->targets.push_back({b.binding, b.type, {}, false});
+                    continue;
+                }
                 bool output = b.name.rfind("out_", 0) == 0;
                 bool input = b.name.rfind("in_", 0) == 0;
                 std::string port = b.name.substr(output ? 4 : 3);
@@ -346,6 +397,7 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
 
 void Executor::recordFrame(VkCommandBuffer cmd) {
     mFrameStaging.clear();
+    mUniformHead = 0;
     mProfiler->begin(cmd);
     std::vector<VkImageMemoryBarrier2> barriers;
     auto flush = [&] {
@@ -364,7 +416,7 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
 
     for (uint32_t i = 0; i < mGraph.resources.size(); ++i) {
         const GraphResource& r = mGraph.resources[i];
-        if (!r.persistent && !r.history) mPhysical[mResourcePhysical[i][0]].state = ImageSyncState::discarded();
+        if (r.isTexture() && !r.persistent && !r.history) mPhysical[mResourcePhysical[i][0]].state = ImageSyncState::discarded();
     }
     if (mFrame == 0) {
         // History starts as zeros so a first-frame @prev read is defined (inputValid() says false).
@@ -385,7 +437,9 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
 
     for (uint32_t pi = 0; pi < mGraph.passes.size(); ++pi) {
         const CompiledPass& pass = mGraph.passes[pi];
-        for (const auto& u : pass.uses) require(physicalOf(u.resource, u.previous), accessOf(u.usage, pass.schema->pass));
+        for (const auto& u : pass.uses)
+            if (mGraph.resources[u.resource].isTexture())
+                require(physicalOf(u.resource, u.previous), accessOf(u.usage, pass.schema->pass));
         flush();
         mProfiler->beginScope(cmd, pi);
         PassContext ctx(*this, pi, cmd);

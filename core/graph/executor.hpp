@@ -83,6 +83,12 @@ private:
     double mPipelineMs = 0.0;
     uint32_t mFrame = 0;
     std::vector<GpuBuffer> mFrameStaging; // uploads recorded this frame
+    ShaderCompiler& mShaders;
+    // setUniforms() data: one host-visible buffer per executor, rewound every frame (one frame in
+    // flight, so the GPU is done with last frame's contents when recording starts).
+    GpuBuffer mUniformRing;
+    VkDeviceSize mUniformHead = 0;
+    VkDeviceSize mUniformAlign = 256;
 };
 
 } // namespace vitrine

@@ -5,6 +5,10 @@
 
 namespace vitrine {
 
+void detail::wrongObjectType(const std::string& port, const char* expected) {
+    throw InternalError("port '" + port + "' carries no object of the expected type (" + expected + ")");
+}
+
 const nlohmann::json& Params::at(const std::string& name) const {
     auto it = mValues.find(name);
     if (it == mValues.end()) throw InternalError("node " + mSchema.type + " reads undeclared param '" + name + "'");

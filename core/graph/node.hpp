@@ -9,7 +9,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
+#include <typeinfo>
 
 namespace vitrine {
 
@@ -38,6 +40,19 @@ private:
 
 using PipelineId = uint32_t;
 
+// What travels on a port that is not a texture: a scene (geometry, materials, their GPU copy), a
+// camera for the frame, or a CPU-side data block (e.g. shadow cascades). The producer creates it
+// in setup() (so consumers can read it in theirs) and may update it in execute(); consumers read
+// it in the same frame, after the producer ran (the graph order guarantees it).
+class PortObject {
+public:
+    virtual ~PortObject() = default;
+};
+
+namespace detail {
+[[noreturn]] void wrongObjectType(const std::string& port, const char* expected);
+}
+
 // Passed to Node::setup() once, when the graph is compiled (also by `vitrine validate`, with
 // no GPU). A node reads its params and input descriptions here, may adjust its output
 // descriptions, and declares the pipelines it will dispatch.
@@ -52,6 +67,14 @@ public:
     virtual PipelineId computePipeline(const std::string& shaderPath, const ShaderDefines& defines = {}) = 0;
     // A compute pipeline from GLSL the node generated itself; `name` appears in errors.
     virtual PipelineId computePipelineSource(const std::string& name, const std::string& source) = 0;
+    // Object ports (scene/camera/buffer kinds). setObject() is for outputs; object() for inputs.
+    virtual void setObject(const std::string& port, std::shared_ptr<PortObject> object) = 0;
+    virtual std::shared_ptr<PortObject> object(const std::string& port) const = 0;
+    template <typename T> std::shared_ptr<T> objectAs(const std::string& port) const {
+        auto o = std::dynamic_pointer_cast<T>(object(port));
+        if (!o) detail::wrongObjectType(port, typeid(T).name());
+        return o;
+    }
     // Resolves a path param relative to the graph file's directory.
     virtual std::filesystem::path resolvePath(const std::string& path) const = 0;
     // Throws UserError naming the graph file and /nodes/<id>/params/<param>.
@@ -80,6 +103,20 @@ public:
 
     // Records a copy of `pixels` into an output whose port usage is TransferDst.
     virtual void upload(const std::string& port, const Image& pixels) = 0;
+
+    // The object on an input or output port of a non-texture kind (see PortObject).
+    virtual PortObject& object(const std::string& port) = 0;
+    template <typename T> T& objectAs(const std::string& port) {
+        T* o = dynamic_cast<T*>(&object(port));
+        if (!o) detail::wrongObjectType(port, typeid(T).name());
+        return *o;
+    }
+    // For nodes that build their own pipelines (raster passes).
+    virtual ShaderCompiler& shaders() = 0;
+    // Uniform data for the next dispatch(): bound to the shader's uniform block `Uniforms` (any
+    // binding in set 0). Copied into a per-frame buffer, so `data` may be a temporary.
+    virtual void setUniforms(const void* data, uint32_t size) = 0;
+    template <typename T> void setUniforms(const T& data) { setUniforms(&data, static_cast<uint32_t>(sizeof(T))); }
 
     template <typename T> void dispatch(PipelineId pipeline, const T& push, uint32_t width, uint32_t height) {
         dispatch(pipeline, &push, static_cast<uint32_t>(sizeof(T)), width, height, 1);

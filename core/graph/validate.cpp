@@ -161,6 +161,9 @@ private:
                 if (out.kind != ip->kind)
                     fail(pptr, "input '" + port + "' takes a " + toString(ip->kind) + ", but " + r.text() + " is a " +
                                    toString(out.kind));
+                if (r.previous && out.kind != PortKind::Texture)
+                    fail(pptr, r.text() + ": only textures keep last frame's value; a " + toString(out.kind) +
+                                   " is always the current frame's");
                 n.inputs[port] = r;
             }
         }

@@ -13,6 +13,8 @@
 namespace vitrine::gpu_types {
 using vec2 = glm::vec2;
 using vec4 = glm::vec4;
+using mat4 = glm::mat4;
+using uvec4 = glm::uvec4;
 using ivec2 = glm::ivec2;
 using ivec4 = glm::ivec4;
 using uint = uint32_t;

@@ -249,6 +249,10 @@ int graphCommand(const Args& args) {
                     graph.passes[p].schema->type.c_str());
     for (size_t r = 0; r < graph.resources.size(); ++r) {
         const GraphResource& res = graph.resources[r];
+        if (!res.isTexture()) {
+            std::printf("  r%zu [shape=note, label=\"%s\\n%s\"];\n", r, res.name.c_str(), toString(res.kind));
+            continue;
+        }
         std::string kind = res.history ? "history" : res.persistent ? "persistent" : res.extracted ? "output" : "transient";
         std::printf("  r%zu [shape=ellipse, label=\"%s\\n%ux%u %s\\n%s, passes %u-%u\"];\n", r, res.name.c_str(),
                     res.desc.width, res.desc.height, formatName(res.desc.format).c_str(), kind.c_str(), res.firstPass,

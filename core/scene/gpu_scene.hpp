@@ -1,0 +1,132 @@
+#pragma once
+// The GPU copy of a scene and the objects that travel on scene/camera ports of the render graph.
+//
+// A scene node (scene.museum, scene.gltf) makes a SceneObject in setup() — CPU data only, so
+// `vitrine validate` needs no GPU — and a CameraObject; its execute() uploads the scene on the first
+// frame and then, every frame, poses the animated nodes and the camera and writes them to per-frame
+// buffers. Raster nodes bind GpuScene::set() (layout: shaders/scene/scene.glsl) and draw through it.
+
+#include "core/gpu/resources.hpp"
+#include "core/graph/node.hpp"
+#include "core/scene/scene.hpp"
+#include "shaders/scene/scene.h"
+
+#include <glm/glm.hpp>
+
+#include <memory>
+#include <vector>
+
+namespace vitrine {
+
+class Context;
+class ShaderCompiler;
+
+// One frame's camera, as every consumer sees it (CPU mirror of gpu_types::GpuCamera).
+struct CameraFrame {
+    scene::CameraState state;
+    glm::mat4 view{1.0f};
+    glm::mat4 proj{1.0f};         // jittered, reverse Z
+    glm::mat4 projNoJitter{1.0f}; // reverse Z
+    glm::mat4 viewProj{1.0f};
+    glm::mat4 viewProjNoJitter{1.0f};
+    glm::mat4 prevViewProjNoJitter{1.0f};
+    glm::mat4 invViewProj{1.0f};
+    glm::vec2 jitter{0.0f}; // pixels
+    glm::vec2 prevJitter{0.0f};
+    uint32_t width = 1, height = 1;
+    double time = 0.0;
+    uint32_t frame = 0;
+
+    gpu_types::GpuCamera gpu() const;
+};
+
+class CameraObject final : public PortObject {
+public:
+    CameraFrame current;
+};
+
+struct GpuDraw {
+    uint32_t instance = 0;  // index into Scene::instances and the instance buffer
+    uint32_t primitive = 0; // index into Scene::primitives
+    uint32_t material = 0;
+};
+
+struct GpuSceneStats {
+    uint64_t geometryBytes = 0;
+    uint64_t textureBytes = 0; // all mips
+    double uploadMs = 0.0;
+};
+
+// Vertex/index buffers, layered materials, textures with mips (normal maps: Toksvig mips built on the
+// GPU without renormalising), per-frame instance and camera buffers, and the descriptor set over all of
+// them. Everything but the per-frame buffers is uploaded once, in the constructor (waits for the GPU).
+class GpuScene {
+public:
+    // anisotropy: max anisotropic filtering of the textures; < 0 chooses per device.
+    GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& scene, float anisotropy = -1.0f);
+    ~GpuScene();
+    GpuScene(const GpuScene&) = delete;
+    GpuScene& operator=(const GpuScene&) = delete;
+
+    // Writes this frame's instance transforms (with last frame's for velocity) and camera. Safe while
+    // recording: the render graph runs one frame in flight, so the GPU is done with the last frame.
+    void update(const scene::ScenePose& pose, const scene::ScenePose& previous, const CameraFrame& camera);
+
+    VkDescriptorSetLayout setLayout() const { return mSetLayout; }
+    VkDescriptorSet set() const { return mSet; }
+    uint32_t textureCount() const { return static_cast<uint32_t>(mTextures.size()); }
+    const std::vector<GpuDraw>& draws() const { return mDraws; }
+    const GpuSceneStats& stats() const { return mStats; }
+    const GpuImage& texture(uint32_t index) const { return mTextures.at(index); }
+
+    // Binding 0: the scene's Vertex (72 bytes): position, normal, tangent, uv0, uv1, color at locations 0-5.
+    static std::vector<VkVertexInputBindingDescription> vertexBindings();
+    static std::vector<VkVertexInputAttributeDescription> vertexAttributes();
+    // Binds the vertex and index buffers. Then drawIndexed(cmd, draw) per draw.
+    void bindGeometry(VkCommandBuffer cmd) const;
+    void drawIndexed(VkCommandBuffer cmd, const GpuDraw& draw) const;
+
+private:
+    void uploadTextures(ShaderCompiler& shaders);
+    void buildToksvigMips(ShaderCompiler& shaders, VkCommandBuffer cmd, const std::vector<uint32_t>& normalMaps);
+    void createDescriptors();
+    void releaseHandles();
+
+    Context& mCtx;
+    const scene::Scene& mScene;
+    GpuBuffer mVertices, mIndices, mMaterials, mLayers, mInstances, mCamera;
+    std::vector<GpuImage> mTextures;       // one per scene texture
+    std::vector<VkSampler> mSamplers;      // one per scene texture
+    GpuImage mFallback;                    // bound when the scene has no textures
+    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
+    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    VkDescriptorSet mSet = VK_NULL_HANDLE;
+    std::vector<GpuDraw> mDraws;
+    GpuSceneStats mStats;
+    float mAnisotropy = -1.0f;
+};
+
+// What travels on a Scene port. CPU data from setup(); the GPU copy once a pass asks for it.
+class SceneObject final : public PortObject {
+public:
+    explicit SceneObject(std::shared_ptr<const scene::Scene> scene) : mScene(std::move(scene)) {}
+    const scene::Scene& scene() const { return *mScene; }
+    std::shared_ptr<const scene::Scene> shared() const { return mScene; }
+    bool uploaded() const { return mGpu != nullptr; }
+    GpuScene& gpu(Context& ctx, ShaderCompiler& shaders) {
+        if (!mGpu) mGpu = std::make_unique<GpuScene>(ctx, shaders, *mScene, anisotropy);
+        return *mGpu;
+    }
+    GpuScene& gpu() const; // InternalError before the producer uploaded it
+
+    // The pose of this frame and the last one (set by the scene node every frame).
+    scene::ScenePose pose, previousPose;
+    double time = 0.0;
+    float anisotropy = -1.0f; // texture filtering, set by the scene node before the upload
+
+private:
+    std::shared_ptr<const scene::Scene> mScene;
+    std::unique_ptr<GpuScene> mGpu;
+};
+
+} // namespace vitrine

@@ -1,0 +1,84 @@
+// lighting.deferred: sun (GGX + Lambert, cascaded shadows) and sky ambient over the G-buffer.
+#include "core/graph/registry.hpp"
+#include "core/scene/gpu_scene.hpp"
+#include "nodes/shadow/cascades.hpp"
+#include "shaders/lighting/deferred.h"
+
+namespace vitrine {
+namespace {
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "lighting.deferred";
+    s.doc = "Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance (GGX, Smith, Schlick) + Lambert for the sun "
+            "with PCF-filtered cascaded shadows and cavity; diffuse ambient from the sky's SH irradiance and indirect "
+            "specular from the sky (stand-ins until lightmaps and IBL), emissive added. Outputs HDR radiance (cd/m²).";
+    auto tex = [](const char* name, const char* doc, bool optional = false) {
+        return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
+    };
+    s.inputs = {
+        tex("normal", "G-buffer: octahedral normal, view depth, shininess"),
+        tex("base_color", "G-buffer: base colour, metallic"),
+        tex("material", "G-buffer: alpha, clothness, vertex AO, cavity"),
+        tex("emissive", "G-buffer: lightmap / emissive"),
+        tex("depth", "G-buffer hardware depth (reverse Z)"),
+        tex("shadow_map", "shadow.directional's atlas (without it the sun is unshadowed)", true),
+        {"cascades", PortKind::Buffer, {}, true, Usage::Sampled, "shadow.directional's cascades"},
+        tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
+        tex("sky", "A sky node's cubemap (background and mirror reflections)"),
+        {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
+    };
+    OutputPort color;
+    color.name = "color";
+    color.size = SizeRule::ofInput("normal");
+    color.doc = "HDR radiance: direct + ambient diffuse + indirect specular + emissive";
+    OutputPort spec = color;
+    spec.name = "specular_indirect";
+    spec.doc = "The indirect specular term alone (included in color; SSR replaces it where it hits)";
+    s.outputs = {color, spec};
+    s.params = {
+        {"sky_ambient", ParamType::Float, 0.15, 0.0, 1.0, {},
+         "Fraction of the open sky's ambient that reaches interior surfaces (a stand-in for occlusion until lightmaps "
+         "and probes exist)"},
+        {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows (off: the sun reaches everything)"},
+        {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
+        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of the emissive channel"},
+    };
+    return s;
+}
+
+class Deferred final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        mCamera = ctx.objectAs<CameraObject>("camera");
+        if (ctx.hasInput("cascades")) mCascades = ctx.objectAs<ShadowCascadesObject>("cascades");
+        if (ctx.hasInput("shadow_map") != ctx.hasInput("cascades"))
+            ctx.failParam("shadows", "connect both shadow_map and cascades of a shadow.directional node, or neither");
+        mPipeline = ctx.computePipeline("lighting/deferred.comp");
+    }
+
+    void execute(ExecuteContext& ctx) override {
+        const Params& p = ctx.params();
+        gpu_types::DeferredUniforms u{};
+        const CameraFrame& cam = mCamera->current;
+        u.invViewProj = cam.invViewProj;
+        u.cameraPos = glm::vec4(cam.state.position, 1.0f);
+        bool shadows = p.getBool("shadows") && mCascades;
+        u.params = {p.getFloat("sky_ambient"), shadows ? 1.0f : 0.0f, p.getFloat("sun_scale"), p.getFloat("emissive_scale")};
+        if (mCascades) u.shadow = mCascades->data;
+        else u.shadow.params = {1.0f, 1.0f, 0.0f, 0.0f};
+        ctx.setUniforms(u);
+        const ImageDesc& out = ctx.output("color").desc();
+        ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
+    }
+
+private:
+    std::shared_ptr<CameraObject> mCamera;
+    std::shared_ptr<ShadowCascadesObject> mCascades;
+    PipelineId mPipeline = 0;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Deferred>(); });
+
+} // namespace
+} // namespace vitrine

@@ -1,0 +1,35 @@
+// scene.gltf: a glTF 2.0 scene (.gltf or .glb) through core/scene's loader.
+#include "core/base/error.hpp"
+#include "core/graph/registry.hpp"
+#include "core/scene/gltf.hpp"
+#include "nodes/scene/scene_node.hpp"
+
+namespace vitrine {
+namespace {
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "scene.gltf";
+    s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
+            "KHR_texture_transform, KHR_materials_emissive_strength.";
+    s.pass = PassKind::Transfer;
+    s.params = {{"path", ParamType::Path, "", {}, {}, {}, "The .gltf or .glb file (relative to the graph file)"}};
+    addSceneNodeSchema(s);
+    return s;
+}
+
+class Gltf final : public SceneNode {
+public:
+    void setup(SetupContext& ctx) override {
+        std::string path = ctx.params().getString("path");
+        if (path.empty()) ctx.failParam("path", "expected the path of a .gltf or .glb file");
+        std::filesystem::path file = ctx.resolvePath(path);
+        if (!std::filesystem::exists(file)) ctx.failParam("path", "file not found: " + file.string());
+        publish(ctx, std::make_shared<const scene::Scene>(scene::loadGltf(file)));
+    }
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Gltf>(); });
+
+} // namespace
+} // namespace vitrine

@@ -1,0 +1,137 @@
+#include "nodes/scene/scene_node.hpp"
+
+#include "core/base/error.hpp"
+#include "core/gpu/context.hpp"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+
+namespace vitrine {
+
+void addSceneNodeSchema(NodeSchema& s) {
+    OutputPort scene;
+    scene.name = "scene";
+    scene.kind = PortKind::Scene;
+    scene.doc = "Geometry, layered materials, textures and this frame's pose (uploaded on the first frame)";
+    OutputPort camera;
+    camera.name = "camera";
+    camera.kind = PortKind::Camera;
+    camera.doc = "This frame's camera (matrices with and without jitter, last frame's)";
+    s.outputs.push_back(scene);
+    s.outputs.push_back(camera);
+    s.params.push_back({"camera", ParamType::String, "", {}, {}, {},
+                        "Camera path to follow (the museum: walkthrough, dolly, static). Empty: the first path, else the "
+                        "first glTF camera, else a view framing the scene"});
+    s.params.push_back({"fps", ParamType::Float, 24.0, 1.0, 1000.0, {}, "Frames per second of the frame clock"});
+    s.params.push_back({"start", ParamType::Float, 0.0, -1e6, 1e6, {}, "Time of frame 0 in seconds"});
+    s.params.push_back({"anisotropy", ParamType::Float, -1.0, -1.0, 16.0, {},
+                        "Anisotropic texture filtering (1 = off). -1: 8x on GPUs, off on CPU devices (lavapipe's "
+                        "software anisotropic filtering takes minutes per frame)"});
+    s.params.push_back({"jitter", ParamType::Bool, false, {}, {}, {},
+                        "Sub-pixel Halton(2,3) jitter of the projection, for temporal anti-aliasing"});
+}
+
+glm::vec2 haltonJitter(uint32_t frame) {
+    auto halton = [](uint32_t i, uint32_t base) {
+        float f = 1.0f, r = 0.0f;
+        for (; i > 0; i /= base) {
+            f /= static_cast<float>(base);
+            r += f * static_cast<float>(i % base);
+        }
+        return r;
+    };
+    uint32_t i = frame % 8 + 1;
+    return {halton(i, 2) - 0.5f, halton(i, 3) - 0.5f};
+}
+
+void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> scene) {
+    const Params& p = ctx.params();
+    mFps = p.getFloat("fps");
+    mStart = p.getFloat("start");
+    mJitter = p.getBool("jitter");
+    mCameraPath = p.getString("camera");
+    if (!mCameraPath.empty()) {
+        if (!scene->findCameraPath(mCameraPath)) {
+            std::string known;
+            for (const auto& path : scene->cameraPaths) known += (known.empty() ? "" : ", ") + path.name;
+            ctx.failParam("camera", "scene '" + scene->name + "' has no camera path '" + mCameraPath +
+                                        "'; expected one of: " + (known.empty() ? "(none)" : known));
+        }
+    } else if (!scene->cameraPaths.empty()) {
+        mCameraPath = scene->cameraPaths.front().name;
+    } else {
+        for (size_t n = 0; n < scene->nodes.size(); ++n)
+            if (scene->nodes[n].camera >= 0) {
+                mCameraNode = static_cast<int>(n);
+                break;
+            }
+    }
+    mScene = std::make_shared<SceneObject>(std::move(scene));
+    mScene->anisotropy = p.getFloat("anisotropy");
+    mCamera = std::make_shared<CameraObject>();
+    ctx.setObject("scene", mScene);
+    ctx.setObject("camera", mCamera);
+    mCamera->current.width = ctx.frame().width;
+    mCamera->current.height = ctx.frame().height;
+}
+
+scene::CameraState SceneNode::cameraAt(double t) const {
+    const scene::Scene& s = mScene->scene();
+    if (!mCameraPath.empty()) return s.cameraAt(mCameraPath, t);
+    scene::CameraState state;
+    if (mCameraNode >= 0) {
+        scene::ScenePose pose = s.evaluate(t);
+        const glm::mat4& world = pose.nodeWorld[mCameraNode];
+        state.lens = s.cameras[s.nodes[mCameraNode].camera];
+        state.position = glm::vec3(world[3]);
+        state.orientation = glm::quat_cast(glm::mat3(glm::normalize(glm::vec3(world[0])), glm::normalize(glm::vec3(world[1])),
+                                                     glm::normalize(glm::vec3(world[2]))));
+    } else {
+        // Framing: from the +Z side and a little above, far enough to see the whole bounding sphere.
+        glm::vec3 c = s.bounds.empty() ? glm::vec3(0.0f) : s.bounds.center();
+        float r = s.bounds.empty() ? 1.0f : 0.5f * glm::length(s.bounds.extent());
+        float dist = r / std::sin(0.5f * state.lens.yfov);
+        glm::vec3 dir = glm::normalize(glm::vec3(0.0f, 0.35f, 1.0f));
+        state.position = c + dir * dist;
+        glm::mat4 view = glm::lookAt(state.position, c, glm::vec3(0.0f, 1.0f, 0.0f));
+        state.orientation = glm::quat_cast(glm::mat3(glm::inverse(view)));
+        state.lens.znear = std::max(0.01f, dist - 2.0f * r) * 0.5f;
+    }
+    state.world = glm::translate(glm::mat4(1.0f), state.position) * glm::mat4_cast(state.orientation);
+    state.view = glm::inverse(state.world);
+    return state;
+}
+
+void SceneNode::execute(ExecuteContext& ctx) {
+    const scene::Scene& s = mScene->scene();
+    const uint32_t frame = ctx.frameIndex();
+    const double dt = 1.0 / mFps;
+    const double t = mStart + frame * dt;
+    GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
+
+    // Velocity is the motion over one frame interval, also on frame 0 (the clock is continuous).
+    mScene->time = t;
+    mScene->pose = s.evaluate(t);
+    mScene->previousPose = s.evaluate(t - dt);
+
+    CameraFrame& c = mCamera->current;
+    const float aspect = static_cast<float>(c.width) / static_cast<float>(c.height);
+    scene::CameraState now = cameraAt(t), before = cameraAt(t - dt);
+    c.state = now;
+    c.view = now.view;
+    c.projNoJitter = now.projection(aspect, true);
+    c.prevJitter = frame == 0 || !mJitter ? glm::vec2(0.0f) : haltonJitter(frame - 1);
+    c.jitter = mJitter ? haltonJitter(frame) : glm::vec2(0.0f);
+    glm::mat4 shift = glm::translate(glm::mat4(1.0f), glm::vec3(2.0f * c.jitter.x / c.width, 2.0f * c.jitter.y / c.height, 0.0f));
+    c.proj = shift * c.projNoJitter;
+    c.viewProj = c.proj * c.view;
+    c.viewProjNoJitter = c.projNoJitter * c.view;
+    c.prevViewProjNoJitter = before.projection(aspect, true) * before.view;
+    c.invViewProj = glm::inverse(c.viewProj);
+    c.time = t;
+    c.frame = frame;
+    gpu.update(mScene->pose, mScene->previousPose, c);
+}
+
+} // namespace vitrine

@@ -1,0 +1,39 @@
+#pragma once
+// What scene.museum and scene.gltf share: the scene/camera outputs, the camera choice, the frame clock,
+// sub-pixel jitter, and the per-frame pose + camera update of the GPU scene.
+
+#include "core/graph/node.hpp"
+#include "core/scene/gpu_scene.hpp"
+
+#include <memory>
+#include <string>
+
+namespace vitrine {
+
+// Ports and params common to every scene node (appended to the node's own).
+void addSceneNodeSchema(NodeSchema& s);
+
+class SceneNode : public Node {
+public:
+    void execute(ExecuteContext& ctx) override;
+
+protected:
+    // Subclasses load or build the scene, then call this.
+    void publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> scene);
+
+private:
+    scene::CameraState cameraAt(double t) const;
+
+    std::shared_ptr<SceneObject> mScene;
+    std::shared_ptr<CameraObject> mCamera;
+    std::string mCameraPath; // empty: a glTF camera node or a framing of the bounds
+    int mCameraNode = -1;
+    float mFps = 24.0f;
+    float mStart = 0.0f;
+    bool mJitter = false;
+};
+
+// Halton(2, 3) sub-pixel offsets in pixels, in (-0.5, 0.5), cycling over 8 frames.
+glm::vec2 haltonJitter(uint32_t frame);
+
+} // namespace vitrine

@@ -1,0 +1,61 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "scene/scene.glsl"
+#include "common/octahedral.glsl"
+
+// The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
+layout(location = 0) in vec3 vNormal;
+layout(location = 1) in vec4 vTangent;
+layout(location = 2) in vec2 vUv0;
+layout(location = 3) in vec2 vUv1;
+layout(location = 4) in vec4 vColor;
+layout(location = 5) in vec4 vClip;
+layout(location = 6) in vec4 vPrevClip;
+layout(location = 7) in float vViewDepth;
+
+layout(location = 0) out vec4 outNormal;   // octahedral normal xy, linear view depth, shininess
+layout(location = 1) out vec4 outBase;     // base colour rgb, metallic
+layout(location = 2) out vec4 outMaterial; // base colour alpha, clothness (reserved), vertex AO, cavity
+layout(location = 3) out vec2 outVelocity; // pixels, current minus previous position
+layout(location = 4) out vec3 outEmissive; // lightmap or emissive radiance
+
+#define FLAG_TOKSVIG 1u
+
+void main() {
+    GpuMaterial m = materials[draw.material];
+    LayeredSurface s = evaluateLayers(m, vUv0, vUv1);
+    float coverage = s.albedo.a;
+    if (m.info.z == 1u && coverage < m.emissive.a) discard;
+
+    vec3 n = normalize(vNormal);
+    vec3 t = vTangent.xyz - n * dot(n, vTangent.xyz);
+    t = dot(t, t) > 1e-12 ? normalize(t) : vec3(1.0, 0.0, 0.0);
+    vec3 b = cross(n, t) * (vTangent.w < 0.0 ? -1.0 : 1.0);
+    float len = length(s.normal);
+    vec3 nts = len > 1e-6 ? s.normal / len : vec3(0.0, 0.0, 1.0);
+    vec3 N = normalize(t * nts.x + b * nts.y + n * nts.z);
+    if (!gl_FrontFacing) N = -N;
+
+    float shininess = clamp(s.shininess, 0.0, 1.0);
+    if ((draw.flags & FLAG_TOKSVIG) != 0u) {
+        // Toksvig [Toksvig04] for GGX: the averaged normal's shortening is a variance added to alpha^2.
+        float roughness = 1.0 - shininess;
+        float a2 = roughness * roughness * roughness * roughness;
+        float l = clamp(len, 1e-3, 1.0);
+        a2 = min(a2 + (1.0 - l) / l, 1.0);
+        shininess = 1.0 - sqrt(sqrt(a2));
+    }
+
+    vec2 ndc = vClip.xy / vClip.w;
+    vec2 prevNdc = vPrevClip.xy / vPrevClip.w;
+    vec2 velocity = (ndc - prevNdc) * 0.5 * camera.params.zw;
+
+    vec3 emissive = m.emissive.rgb;
+    if (m.emissiveRef.info.x >= 0) emissive *= sampleRef(m.emissiveRef, vUv0, vUv1).rgb;
+
+    outNormal = vec4(octEncode(N), vViewDepth, shininess);
+    outBase = vec4(s.albedo.rgb * vColor.rgb, clamp(s.metallic, 0.0, 1.0));
+    outMaterial = vec4(coverage, 0.0, vColor.a, clamp(s.cavity, 0.0, 1.0));
+    outVelocity = velocity;
+    outEmissive = emissive;
+}

@@ -1,0 +1,22 @@
+#ifndef LIGHTING_DEFERRED_H
+#define LIGHTING_DEFERRED_H
+#include "../common/shared.h"
+#include "../shadow/cascades.h"
+
+#ifdef __cplusplus
+namespace vitrine::gpu_types {
+#endif
+
+// Uniforms of lighting.deferred (filled per frame from the camera and the shadow cascades).
+struct DeferredUniforms {
+    mat4 invViewProj;  // jittered, as the G-buffer was rasterised
+    vec4 cameraPos;    // world
+    vec4 params;       // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
+    ShadowCascades shadow;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(DeferredUniforms) == 64 + 32 + sizeof(ShadowCascades));
+}
+#endif
+#endif

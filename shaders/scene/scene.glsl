@@ -1,0 +1,95 @@
+// The scene's descriptor set (core/scene/gpu_scene.cpp, createDescriptors) and layered-material
+// evaluation (MUSEUM_SPEC §2). Include after #version; define VITRINE_SCENE_SET (default 0) and
+// VITRINE_SCENE_TEXTURES (the scene's texture count) before including.
+#ifndef SCENE_SCENE_GLSL
+#define SCENE_SCENE_GLSL
+#extension GL_GOOGLE_include_directive : require
+#include "scene/scene.h"
+
+#ifndef VITRINE_SCENE_SET
+#define VITRINE_SCENE_SET 0
+#endif
+#ifndef VITRINE_SCENE_TEXTURES
+#define VITRINE_SCENE_TEXTURES 1
+#endif
+
+layout(set = VITRINE_SCENE_SET, binding = 0, std140) uniform SceneCamera { GpuCamera camera; };
+layout(set = VITRINE_SCENE_SET, binding = 1, std430) readonly buffer SceneInstances { GpuInstance instances[]; };
+layout(set = VITRINE_SCENE_SET, binding = 2, std430) readonly buffer SceneMaterials { GpuMaterial materials[]; };
+layout(set = VITRINE_SCENE_SET, binding = 3, std430) readonly buffer SceneLayers { GpuLayer layers[]; };
+layout(set = VITRINE_SCENE_SET, binding = 4) uniform sampler2D sceneTextures[VITRINE_SCENE_TEXTURES];
+
+vec2 refUv(GpuTexRef r, vec2 uv0, vec2 uv1) {
+    vec3 uv = vec3(r.info.y == 0 ? uv0 : uv1, 1.0);
+    return vec2(dot(r.row0.xyz, uv), dot(r.row1.xyz, uv));
+}
+
+// The texel a reference points at; 1 without a texture (so "factor x texel" is the factor).
+// The texture index is the same for the whole draw (dynamically uniform).
+vec4 sampleRef(GpuTexRef r, vec2 uv0, vec2 uv1) {
+    if (r.info.x < 0) return vec4(1.0);
+    return texture(sceneTextures[r.info.x], refUv(r, uv0, uv1));
+}
+
+float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }
+
+// The five blended parameters of a surface point. `normal` is tangent space and NOT normalised: its
+// length is below 1 where a mip averaged disagreeing normals (Toksvig).
+struct LayeredSurface {
+    vec4 albedo; // linear rgb, a = coverage
+    vec3 normal;
+    float shininess;
+    float metallic;
+    float cavity;
+};
+
+// Layer 0 sets every parameter; each layer above blends the parameters it overrides over the result
+// below with its own mask weight: p = mix(below, layer, weight), each parameter independently.
+LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1) {
+    LayeredSurface s;
+    s.albedo = vec4(1.0);
+    s.normal = vec3(0.0, 0.0, 1.0);
+    s.shininess = 0.5;
+    s.metallic = 0.0;
+    s.cavity = 1.0;
+    uint first = m.info.x, count = m.info.y;
+    for (uint i = 0; i < count; ++i) {
+        GpuLayer l = layers[first + i];
+        float w = 1.0;
+        if (i > 0) {
+            GpuTexRef mr = l.refs[VITRINE_REF_MASK];
+            float t = mr.info.x < 0 ? 1.0 : channelOf(sampleRef(mr, uv0, uv1), mr.info.z);
+            w = clamp(l.scalars1.w * t, 0.0, 1.0);
+        }
+        uint bits = l.bits.x;
+        if ((bits & VITRINE_LAYER_ALBEDO) != 0u)
+            s.albedo = mix(s.albedo, l.albedo * sampleRef(l.refs[VITRINE_REF_ALBEDO], uv0, uv1), w);
+        if ((bits & VITRINE_LAYER_NORMAL) != 0u) {
+            vec3 n = vec3(0.0, 0.0, 1.0);
+            GpuTexRef nr = l.refs[VITRINE_REF_NORMAL];
+            if (nr.info.x >= 0) {
+                n = sampleRef(nr, uv0, uv1).xyz * 2.0 - 1.0;
+                n.xy *= l.scalars0.x;
+            }
+            s.normal = mix(s.normal, n, w);
+        }
+        if ((bits & VITRINE_LAYER_SHININESS) != 0u) {
+            GpuTexRef r = l.refs[VITRINE_REF_SHININESS];
+            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+            s.shininess = mix(s.shininess, mix(l.scalars0.z, l.scalars0.y, t), w);
+        }
+        if ((bits & VITRINE_LAYER_METALLIC) != 0u) {
+            GpuTexRef r = l.refs[VITRINE_REF_METALLIC];
+            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+            s.metallic = mix(s.metallic, mix(l.scalars1.x, l.scalars0.w, t), w);
+        }
+        if ((bits & VITRINE_LAYER_CAVITY) != 0u) {
+            GpuTexRef r = l.refs[VITRINE_REF_CAVITY];
+            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+            s.cavity = mix(s.cavity, mix(l.scalars1.z, l.scalars1.y, t), w);
+        }
+    }
+    return s;
+}
+
+#endif
