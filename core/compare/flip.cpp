@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <numbers>
 #include <string>
+#include <thread>
 
 // LDR-FLIP and HDR-FLIP as published (HPG 2020, EG 2021). Constant names follow the papers' symbols.
 namespace vitrine::compare {
@@ -171,8 +173,26 @@ Preprocessed preprocess(const Image& image, const FlipKernels& k) {
 }
 
 Plane ldrFlipPlane(const Image& reference, const Image& test, const FlipKernels& k) {
-    const Preprocessed r = preprocess(reference, k);
-    const Preprocessed t = preprocess(test, k);
+    // The two images are independent until the final per-pixel step, so the reference is prepared on a second thread
+    // (most of the time is these filters: about halves LDR-FLIP at 1080p on two cores).
+    Preprocessed r;
+    std::exception_ptr failure;
+    std::thread worker([&] {
+        try {
+            r = preprocess(reference, k);
+        } catch (...) {
+            failure = std::current_exception();
+        }
+    });
+    Preprocessed t;
+    try {
+        t = preprocess(test, k);
+    } catch (...) {
+        worker.join();
+        throw;
+    }
+    worker.join();
+    if (failure) std::rethrow_exception(failure);
     const double cmax = maxColorDifference();
     const double pccmax = kPc * cmax;
     Plane error(reference.width, reference.height);

@@ -27,5 +27,7 @@ int nodesCommand(const Args& args);
 int benchCommand(const Args& args);
 int graphCommand(const Args& args);
 int devicesCommand(const Args& args);
+int compareCommand(const Args& args);
+int goldenCommand(const Args& args);
 
 } // namespace vitrine::cli

@@ -9,6 +9,8 @@
 #include "core/image/io.hpp"
 #include "core/shader/compiler.hpp"
 #include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/output_dir.hpp"
+#include "tools/vitrine/render_output.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -39,44 +41,6 @@ CompiledGraph compileFromArgs(const Args& args) {
     return compileGraph(std::move(desc));
 }
 
-ContextOptions contextOptions(const Args& args) {
-    ContextOptions o;
-    o.device = args.get("device");
-    o.validation = args.has("validate");
-    return o;
-}
-
-// Files vitrine wrote into an output directory. A file that exists but is not listed was not
-// written by vitrine, and is not overwritten unless --overwrite says so.
-class OutputDir {
-public:
-    OutputDir(fs::path dir, bool overwrite) : mDir(std::move(dir)), mOverwrite(overwrite) {
-        std::error_code ec;
-        fs::create_directories(mDir, ec);
-        if (!fs::is_directory(mDir)) throw UserError(mDir.string() + ": cannot create the output directory");
-        std::ifstream in(mDir / kManifest);
-        for (std::string line; std::getline(in, line);)
-            if (!line.empty()) mWritten.insert(line);
-    }
-    fs::path claim(const std::string& name) {
-        fs::path p = mDir / name;
-        std::error_code ec;
-        fs::create_directories(p.parent_path(), ec);
-        if (fs::exists(p) && !mWritten.count(name) && !mOverwrite)
-            throw UserError(p.string() + ": exists and was not written by vitrine; pass --overwrite to replace it, "
-                                         "or choose another --out");
-        if (mWritten.insert(name).second) std::ofstream(mDir / kManifest, std::ios::app) << name << "\n";
-        return p;
-    }
-    const fs::path& dir() const { return mDir; }
-
-private:
-    static constexpr const char* kManifest = ".vitrine-outputs";
-    fs::path mDir;
-    bool mOverwrite;
-    std::set<std::string> mWritten;
-};
-
 double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
@@ -98,7 +62,7 @@ int runCommand(const Args& args) {
     if (exrMode != "half" && exrMode != "float" && exrMode != "none")
         throw UserError("--exr: expected half, float or none, got '" + exrMode + "'");
     fs::path outDir = args.get("out", (fs::path("out") / fs::path(graphArg(args)).stem()).string());
-    OutputDir out(outDir, args.has("overwrite"));
+    OutputDir out(outDir, args.has("overwrite") || args.has("force"));
 
     Context ctx(contextOptions(args));
     logInfo("device: " + ctx.deviceInfo().name + "; " + std::to_string(graph.passes.size()) + " passes, " +

@@ -20,6 +20,16 @@ commands:
   bench GRAPH [--frames N] [--warmup N] [--json FILE] [--set K=V]...
       Per-node GPU ms (median of timestamp queries), CPU record ms, compile ms, memory.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
+  compare A B [--reference R] [--frame N | --frames A:B] [--set K=V]... [--output NAME]
+          [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
+      A, B, R: graphs (variants too) or images (EXR/PNG), same size. Writes the images, |A-B|,
+      FLIP error maps, metrics.json (PSNR, SSIM, FLIP; flicker and error per frame with
+      --frames) and a self-contained report.html to DIR (default out/compare/A_vs_B).
+      Files vitrine did not write there are not replaced without --force.
+  golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]...
+      Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
+      `accept` (re)writes the golden EXRs, `check` compares with FLIP tolerances and writes
+      a heat map and report.html per failure into DIR (default golden-report). Exit 3: failed.
   devices                           List Vulkan devices.
 
 common options:
@@ -27,7 +37,8 @@ common options:
   --validate            Enable Vulkan validation layers
   --quiet / --verbose   Less / more output on stderr
 
-exit status: 0 done, 1 the input is wrong (message on stderr), 2 internal failure.
+exit status: 0 done, 1 the input is wrong (message on stderr), 2 internal failure (or Vulkan
+validation messages with --validate), 3 `golden check` found images beyond tolerance.
 )";
 
 } // namespace
@@ -35,7 +46,8 @@ exit status: 0 done, 1 the input is wrong (message on stderr), 2 internal failur
 int main(int argc, char** argv) {
     using namespace vitrine;
     try {
-        cli::Args args = cli::parse(argc, argv, {"set", "out", "frames", "device", "json", "warmup", "exr"});
+        cli::Args args = cli::parse(argc, argv, {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
+                                               "output", "ppd", "diff-scale", "manifest"});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
         if (args.command.empty() || args.command == "help" || args.has("help")) {
@@ -48,6 +60,8 @@ int main(int argc, char** argv) {
         if (args.command == "bench") return cli::benchCommand(args);
         if (args.command == "graph") return cli::graphCommand(args);
         if (args.command == "devices") return cli::devicesCommand(args);
+        if (args.command == "compare") return cli::compareCommand(args);
+        if (args.command == "golden") return cli::goldenCommand(args);
         throw UserError("unknown command '" + args.command + "'; run `vitrine help`");
     } catch (const UserError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

@@ -1,0 +1,218 @@
+// `vitrine compare` and `vitrine golden` as a user runs them: the real binary, real graphs, on the Vulkan device the
+// machine has (lavapipe in CI), at small sizes. Checks outcomes a user relies on (FXAA scores better against the
+// supersampled ground truth, the report exists and parses, bad input exits 1 naming the file, a perturbed render
+// fails the golden check), not numbers the code under test produced.
+#include "core/image/io.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace vitrine::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kSource = VITRINE_SOURCE_DIR;
+const std::string kSmall = "--set frame.width=160 --set frame.height=90";
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s)
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+struct CliResult {
+    int status = -1; // exit status, or -1 when the program did not exit normally
+    std::string output;
+};
+
+// Runs `vitrine ARGS` with stderr merged into stdout.
+CliResult vitrine(const std::string& args) {
+    const std::string command = quote(VITRINE_BINARY) + " " + args + " 2>&1";
+    CliResult r;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return r;
+    char buffer[4096];
+    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+        r.output.append(buffer, n);
+    const int status = pclose(pipe);
+    if (WIFEXITED(status)) r.status = WEXITSTATUS(status);
+    return r;
+}
+
+// A fresh, empty directory per test under the build tree.
+fs::path freshDir(const std::string& name) {
+    const fs::path dir = fs::path(VITRINE_TEST_OUT) / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string readText(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+const json* findPair(const json& metrics, const std::string& test, const std::string& reference) {
+    for (const json& p : metrics["pairs"])
+        if (p["test"] == test && p["reference"] == reference) return &p;
+    return nullptr;
+}
+
+Image flat(int w, int h, float v) {
+    Image image(w, h);
+    for (size_t i = 0; i < image.pixels.size(); ++i)
+        image.pixels[i] = i % 4 == 3 ? 1.0f : v;
+    return image;
+}
+
+TEST(CompareCli, FxaaBeatsNoAaAgainstTheSupersampledReference) {
+    const fs::path out = freshDir("compare_fxaa");
+    const CliResult r = vitrine("compare " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " " +
+                                quote(kSource + "/graphs/variants/no_fxaa.json") + " --reference " +
+                                quote(kSource + "/graphs/variants/supersampled.json") + " " + kSmall +
+                                " --validate --quiet --out " + quote(out.string()));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const json metrics = json::parse(readText(out / "metrics.json"));
+    const json* fxaa = findPair(metrics, "A", "reference");
+    const json* none = findPair(metrics, "B", "reference");
+    ASSERT_TRUE(fxaa && none) << metrics.dump(2);
+    std::printf("vs supersampled: FXAA PSNR %.3f FLIP %.4f; no AA PSNR %.3f FLIP %.4f\n", (*fxaa)["psnr"].get<double>(),
+                (*fxaa)["flip"]["mean"].get<double>(), (*none)["psnr"].get<double>(),
+                (*none)["flip"]["mean"].get<double>());
+    EXPECT_LT((*fxaa)["flip"]["mean"].get<double>(), (*none)["flip"]["mean"].get<double>());
+    EXPECT_GT((*fxaa)["psnr"].get<double>(), (*none)["psnr"].get<double>());
+    EXPECT_EQ(metrics["images"]["a"]["width"], 160);
+    EXPECT_EQ(metrics["images"]["reference"]["height"], 90);
+    // The variant differs from its base where it removes the fxaa node and rewires the tone mapper.
+    bool removedFxaa = false;
+    for (const json& c : metrics["graphChanges"])
+        removedFxaa |= c["op"] == "removed" && c["pointer"] == "/nodes/fxaa";
+    EXPECT_TRUE(removedFxaa) << metrics["graphChanges"].dump(2);
+
+    const std::string html = readText(out / "report.html");
+    EXPECT_NE(html.find("<html"), std::string::npos);
+    EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+    // Self-contained: nothing is fetched from the network.
+    EXPECT_EQ(html.find("src=\"http"), std::string::npos);
+    EXPECT_EQ(html.find("href=\"http"), std::string::npos);
+    for (const char* file : {"a.png", "b.png", "reference.png", "diff_a_b.exr", "flip_a_b.png", "flip_a_reference.exr"})
+        EXPECT_TRUE(fs::is_regular_file(out / file)) << file;
+    // The written images are the renders: A's EXR is 160x90.
+    EXPECT_EQ(loadExrLayer(out / "a.exr", "").width, 160);
+}
+
+TEST(CompareCli, FramesRangeAddsTemporalMetrics) {
+    const fs::path out = freshDir("compare_frames");
+    const CliResult r =
+        vitrine("compare " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " " +
+                quote(kSource + "/graphs/variants/no_fxaa.json") + " --reference " +
+                quote(kSource + "/graphs/variants/no_fxaa.json") +
+                " --set frame.width=48 --set frame.height=32 --frames 1:3 --quiet --out " + quote(out.string()));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const json metrics = json::parse(readText(out / "metrics.json"));
+    ASSERT_EQ(metrics["temporal"].size(), 3u);
+    for (const json& t : metrics["temporal"]) {
+        EXPECT_EQ(t["frames"], 3);
+        // The zone plate does not move: a still image has no flicker.
+        EXPECT_EQ(t["flicker"], 0.0) << t["label"];
+    }
+    const json& b = metrics["temporal"][1];
+    ASSERT_EQ(b["label"], "B");
+    ASSERT_EQ(b["errorPerFrame"]["values"].size(), 3u);
+    // B and the reference are the same graph: zero FLIP error in every frame.
+    for (const json& v : b["errorPerFrame"]["values"])
+        EXPECT_EQ(v, 0.0);
+    EXPECT_GT(metrics["temporal"][0]["errorPerFrame"]["values"][0].get<double>(), 0.0);
+}
+
+TEST(CompareCli, ImagesOfDifferentSizesAreAUserError) {
+    const fs::path dir = freshDir("compare_sizes");
+    writeExr(dir / "small.exr", flat(16, 9, 0.5f), ExrPixelType::Float);
+    writeExr(dir / "large.exr", flat(32, 18, 0.5f), ExrPixelType::Float);
+    const CliResult r = vitrine("compare " + quote((dir / "small.exr").string()) + " " +
+                                quote((dir / "large.exr").string()) + " --out " + quote((dir / "out").string()));
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("small.exr"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("large.exr"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("16x9"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("same size"), std::string::npos) << r.output;
+
+    // A graph rendered at 160x90 against a 16x9 image.
+    const CliResult g =
+        vitrine("compare " + quote(kSource + "/graphs/variants/no_fxaa.json") + " " +
+                quote((dir / "small.exr").string()) + " " + kSmall + " --quiet --out " + quote((dir / "out").string()));
+    EXPECT_EQ(g.status, 1) << g.output;
+    EXPECT_NE(g.output.find("160x90"), std::string::npos) << g.output;
+    EXPECT_NE(g.output.find("small.exr"), std::string::npos) << g.output;
+}
+
+TEST(CompareCli, MissingAndNonImageFilesAreUserErrorsNamingTheFile) {
+    const fs::path dir = freshDir("compare_bad_files");
+    writeExr(dir / "ok.exr", flat(8, 8, 0.25f), ExrPixelType::Float);
+    std::ofstream(dir / "notes.txt") << "not an image\n";
+    std::ofstream(dir / "fake.png") << "not a PNG either\n";
+    const std::string ok = quote((dir / "ok.exr").string()), outDir = " --out " + quote((dir / "out").string());
+    struct Case {
+        std::string args;
+        std::string file;
+    };
+    for (const Case& c : {Case{ok + " " + quote((dir / "missing.exr").string()), "missing.exr"},
+                          Case{quote((dir / "notes.txt").string()) + " " + ok, "notes.txt"},
+                          Case{ok + " " + ok + " --reference " + quote((dir / "fake.png").string()), "fake.png"},
+                          Case{ok + " " + quote((dir / "nope.json").string()), "nope.json"}}) {
+        const CliResult r = vitrine("compare " + c.args + outDir);
+        EXPECT_EQ(r.status, 1) << c.file << ": " << r.output;
+        EXPECT_NE(r.output.find(c.file), std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+    }
+}
+
+TEST(CompareCli, DoesNotOverwriteFilesItDidNotWriteUnlessForced) {
+    const fs::path dir = freshDir("compare_overwrite");
+    writeExr(dir / "x.exr", flat(8, 8, 0.25f), ExrPixelType::Float);
+    writeExr(dir / "y.exr", flat(8, 8, 0.75f), ExrPixelType::Float);
+    fs::create_directories(dir / "out");
+    std::ofstream(dir / "out" / "report.html") << "mine";
+    const std::string args = "compare " + quote((dir / "x.exr").string()) + " " + quote((dir / "y.exr").string()) +
+                             " --out " + quote((dir / "out").string());
+    const CliResult refused = vitrine(args);
+    EXPECT_EQ(refused.status, 1) << refused.output;
+    EXPECT_NE(refused.output.find("--force"), std::string::npos) << refused.output;
+    EXPECT_EQ(readText(dir / "out" / "report.html"), "mine");
+    EXPECT_FALSE(fs::exists(dir / "out" / "a.png"));
+
+    const CliResult forced = vitrine(args + " --force");
+    ASSERT_EQ(forced.status, 0) << forced.output;
+    EXPECT_NE(readText(dir / "out" / "report.html"), "mine");
+    // What vitrine wrote itself it may replace on the next run without being told.
+    EXPECT_EQ(vitrine(args).status, 0);
+}
+
+TEST(GoldenCli, PerturbedRenderFailsTheCheckAndWritesAReport) {
+    const fs::path out = freshDir("golden_perturbed");
+    // A slightly higher zone-plate frequency moves every ring.
+    const CliResult r = vitrine("golden check fxaa_zoneplate --set pattern.params.max_frequency=0.32 --quiet --out " +
+                                quote(out.string()));
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_NE(r.output.find("FAIL fxaa_zoneplate"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::is_regular_file(out / "fxaa_zoneplate" / "report.html"));
+    EXPECT_TRUE(fs::is_regular_file(out / "fxaa_zoneplate" / "flip.png"));
+    const json metrics = json::parse(readText(out / "fxaa_zoneplate" / "metrics.json"));
+    EXPECT_GT(metrics["pairs"][0]["flip"]["mean"].get<double>(), 0.002);
+}
+
+} // namespace
+} // namespace vitrine::test

@@ -1,0 +1,295 @@
+// `vitrine compare A B [--reference R]`: renders graphs or loads images, computes PSNR, SSIM and FLIP (and, over
+// --frames a:b, flicker and error per frame), writes the images, heat maps, metrics.json and one self-contained
+// report.html. The metrics and the report come from core/compare; this file only gathers the inputs.
+#include "core/base/error.hpp"
+#include "core/base/log.hpp"
+#include "core/compare/report.hpp"
+#include "core/graph/loader.hpp"
+#include "core/image/io.hpp"
+#include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/output_dir.hpp"
+#include "tools/vitrine/render_output.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+
+namespace vitrine::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Input {
+    std::string role; // "A", "B" or "reference": labels in the report and in messages
+    std::string key;  // "a", "b" or "reference": file names
+    fs::path path;
+    std::optional<GraphDesc> graph; // empty: an image file
+    std::string output;             // the graph output compared
+    std::vector<Image> frames;      // frames first..last (an image repeats itself)
+    Image still;                    // the frame compared as a still
+};
+
+std::string lower(std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+    return s;
+}
+
+bool isImageFile(const fs::path& path) {
+    const std::string ext = lower(path.extension().string());
+    return ext == ".exr" || ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr";
+}
+
+Input openInput(const std::string& role, const std::string& key, const fs::path& path, const Args& args) {
+    const std::string expected = "expected a graph (.json) or an image (.exr, .png, .jpg, .hdr)";
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw UserError(path.string() + ": not found (compare " + role + ": " + expected + ")");
+    if (!fs::is_regular_file(path, ec))
+        throw UserError(path.string() + ": not a regular file (compare " + role + ": " + expected + ")");
+    Input in{role, key, path, {}, {}, {}, {}};
+    const std::string ext = lower(path.extension().string());
+    if (ext == ".json") {
+        in.graph = loadGraph(path, args.all("set"));
+        in.output = pickOutput(*in.graph, args.get("output"));
+    } else if (!isImageFile(path)) {
+        throw UserError(path.string() + ": compare " + role + ": " + expected + ", got a '" + ext + "' file");
+    }
+    return in;
+}
+
+struct FrameRange {
+    uint32_t first = 0;
+    uint32_t last = 0;
+    uint32_t still = 0; // the frame compared as a still image
+    bool temporal = false;
+};
+
+uint32_t parseIndex(const std::string& text, const std::string& option, const std::string& expected) {
+    if (text.empty() || text.size() > 6 || !std::all_of(text.begin(), text.end(), ::isdigit))
+        throw UserError(option + ": expected " + expected + ", got '" + text + "'");
+    return static_cast<uint32_t>(std::stoul(text));
+}
+
+// --frame N picks the still; --frames a:b renders a..b for temporal metrics (the still defaults to b). Without either
+// the still is the last frame of the longest graph.
+FrameRange frameRange(const Args& args, const std::vector<Input*>& inputs) {
+    FrameRange r;
+    uint32_t graphFrames = 1;
+    for (const Input* in : inputs)
+        if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
+    if (args.has("frames")) {
+        const std::string text = args.get("frames");
+        const auto colon = text.find(':');
+        const std::string expected = "FIRST:LAST frame indices with FIRST < LAST (e.g. 0:15)";
+        if (colon == std::string::npos) throw UserError("--frames: expected " + expected + ", got '" + text + "'");
+        r.first = parseIndex(text.substr(0, colon), "--frames", expected);
+        r.last = parseIndex(text.substr(colon + 1), "--frames", expected);
+        if (r.first >= r.last) throw UserError("--frames: expected " + expected + ", got '" + text + "'");
+        r.temporal = true;
+        r.still = r.last;
+    } else {
+        r.still = graphFrames - 1;
+    }
+    if (args.has("frame")) {
+        r.still = parseIndex(args.get("frame"), "--frame", "a frame index");
+        if (r.temporal && (r.still < r.first || r.still > r.last))
+            throw UserError("--frame " + std::to_string(r.still) + ": expected a frame inside --frames " +
+                            args.get("frames"));
+    }
+    if (!r.temporal) r.first = r.last = r.still;
+    return r;
+}
+
+void requireSameSize(const Input& a, const Input& b) {
+    if (a.still.width == b.still.width && a.still.height == b.still.height) return;
+    auto describe = [](const Input& in) {
+        return in.role + " " + in.path.string() + (in.graph ? " (output " + in.output + ")" : "") + " is " +
+               std::to_string(in.still.width) + "x" + std::to_string(in.still.height);
+    };
+    throw UserError("compare: " + describe(a) + " but " + describe(b) +
+                    "; expected the same size (for graphs, e.g. --set frame.width=W --set frame.height=H)");
+}
+
+void writeBytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
+    std::ofstream file(path, std::ios::binary | std::ios::trunc);
+    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    file.close();
+    if (!file) throw UserError(path.string() + ": cannot write the file");
+}
+
+// Writes NAME.png (and NAME.exr with the float values when `exr`) and returns the PNG for the report.
+compare::ReportImage writeImage(OutputDir& out, const std::string& name, const std::string& label, const Image& image,
+                                bool exr) {
+    compare::ReportImage r{label, encodePng(image), image.width, image.height};
+    writeBytes(out.claim(name + ".png"), r.png);
+    if (exr) writeExr(out.claim(name + ".exr"), image, ExrPixelType::Float);
+    return r;
+}
+
+std::string formatPsnr(double psnr) {
+    char buffer[32];
+    if (std::isfinite(psnr))
+        std::snprintf(buffer, sizeof buffer, "%7.2f dB", psnr);
+    else
+        std::snprintf(buffer, sizeof buffer, "%10s", "identical");
+    return buffer;
+}
+
+} // namespace
+
+int compareCommand(const Args& args) {
+    if (args.positional.size() != 2) throw UserError("compare: expected two inputs, A and B (graphs or images)");
+    Input a = openInput("A", "a", args.positional[0], args);
+    Input b = openInput("B", "b", args.positional[1], args);
+    std::optional<Input> reference;
+    if (args.has("reference")) reference = openInput("reference", "reference", args.get("reference"), args);
+    std::vector<Input*> inputs = {&a, &b};
+    if (reference) inputs.push_back(&*reference);
+
+    const FrameRange range = frameRange(args, inputs);
+    const bool hdr = args.has("hdr");
+    double ppd = compare::kDefaultPixelsPerDegree;
+    if (args.has("ppd")) {
+        const std::string text = args.get("ppd");
+        char* end = nullptr;
+        ppd = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(ppd > 0.0) || !std::isfinite(ppd))
+            throw UserError("--ppd: expected pixels per degree > 0, got '" + text + "'");
+    }
+    double diffScale = 1.0;
+    if (args.has("diff-scale")) {
+        const std::string text = args.get("diff-scale");
+        char* end = nullptr;
+        diffScale = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !(diffScale > 0.0) || !std::isfinite(diffScale))
+            throw UserError("--diff-scale: expected a number > 0, got '" + text + "'");
+    }
+
+    // Every file this run writes is checked before any rendering, so a refusal comes at once.
+    std::vector<std::string> names = {"a.png",        "a.exr",        "b.png",        "b.exr",        "diff_a_b.png",
+                                      "diff_a_b.exr", "flip_a_b.png", "flip_a_b.exr", "metrics.json", "report.html"};
+    if (reference)
+        names.insert(names.end(),
+                     {"reference.png", "reference.exr", "diff_a_reference.png", "diff_b_reference.png",
+                      "flip_a_reference.png", "flip_a_reference.exr", "flip_b_reference.png", "flip_b_reference.exr"});
+    const std::string defaultOut =
+        (fs::path("out") / "compare" / (a.path.stem().string() + "_vs_" + b.path.stem().string())).string();
+    OutputDir out(args.get("out", defaultOut), args.has("force") || args.has("overwrite"));
+    for (const std::string& name : names) {
+        std::error_code ec;
+        if (fs::exists(out.dir() / name, ec)) out.claim(name);
+    }
+
+    std::unique_ptr<Context> ctx;
+    std::unique_ptr<ShaderCompiler> shaders;
+    uint32_t frameCount = range.last + 1;
+    for (const Input* in : inputs)
+        if (in->graph) frameCount = std::max(frameCount, in->graph->frame.frames);
+    std::vector<uint32_t> wanted;
+    for (uint32_t f = range.first; f <= range.last; ++f)
+        wanted.push_back(f);
+    for (Input* in : inputs) {
+        if (in->graph) {
+            if (!ctx) {
+                ctx = std::make_unique<Context>(contextOptions(args));
+                shaders = std::make_unique<ShaderCompiler>();
+                logInfo("device: " + ctx->deviceInfo().name);
+            }
+            logInfo("rendering " + in->role + ": " + in->path.string() + " (output " + in->output + ", " +
+                    std::to_string(frameCount) + " frame(s))");
+            std::map<uint32_t, Image> frames =
+                renderOutput(*ctx, *shaders, *in->graph, in->output, frameCount, wanted, !args.has("quiet"));
+            for (uint32_t f : wanted)
+                in->frames.push_back(std::move(frames.at(f)));
+        } else {
+            Image image = loadImage(in->path);
+            in->frames.assign(wanted.size(), image);
+        }
+        in->still = in->frames[range.still - range.first];
+    }
+    requireSameSize(a, b);
+    if (reference) requireSameSize(a, *reference);
+
+    logInfo("computing metrics");
+    compare::PairOptions pairOptions;
+    pairOptions.hdr = hdr;
+    pairOptions.pixelsPerDegree = ppd;
+    compare::ReportInput report;
+    report.title = a.path.stem().string() + " vs " + b.path.stem().string() +
+                   (reference ? " (reference: " + reference->path.stem().string() + ")" : "");
+    const std::string frameText = " [frame " + std::to_string(range.still) + "]";
+    auto label = [&](const Input& in) {
+        return in.role + ": " + in.path.string() + (in.graph ? " → " + in.output + frameText : "");
+    };
+    report.a = writeImage(out, "a", label(a), a.still, true);
+    report.b = writeImage(out, "b", label(b), b.still, true);
+    if (reference) report.reference = writeImage(out, "reference", label(*reference), reference->still, true);
+
+    const Image diff = compare::absoluteDifference(a.still, b.still);
+    writeExr(out.claim("diff_a_b.exr"), diff, ExrPixelType::Float);
+    char scaleText[32];
+    std::snprintf(scaleText, sizeof scaleText, "%g", diffScale);
+    report.differenceMaps.push_back(writeImage(out, "diff_a_b", std::string("|A − B| × ") + scaleText,
+                                               compare::falseColor(diff, diffScale), false));
+
+    struct PairJob {
+        const Input* test;
+        const Input* ref;
+        std::string name;
+    };
+    std::vector<PairJob> jobs = {{&a, &b, "a_b"}};
+    if (reference) {
+        jobs.push_back({&a, &*reference, "a_reference"});
+        jobs.push_back({&b, &*reference, "b_reference"});
+        for (const Input* in : {&a, &b})
+            report.differenceMaps.push_back(writeImage(
+                out, "diff_" + in->key + "_reference", "|" + in->role + " − reference| × " + scaleText,
+                compare::falseColor(compare::absoluteDifference(in->still, reference->still), diffScale), false));
+    }
+    for (const PairJob& job : jobs) {
+        compare::PairComparison pair =
+            compare::comparePair(job.test->role, job.test->still, job.ref->role, job.ref->still, pairOptions);
+        writeExr(out.claim("flip_" + job.name + ".exr"), pair.flipErrorMap, ExrPixelType::Float);
+        report.flipMaps.push_back(
+            writeImage(out, "flip_" + job.name,
+                       std::string(hdr ? "HDR" : "LDR") + "-FLIP " + job.test->role + " vs " + job.ref->role,
+                       compare::flipColorMap(pair.flipErrorMap), false));
+        report.metrics.push_back(pair.metrics);
+    }
+
+    if (range.temporal) {
+        for (const Input* in : inputs) {
+            compare::TemporalMetrics t;
+            t.label = in->role;
+            t.frameCount = static_cast<int>(in->frames.size());
+            t.flicker = compare::flicker(in->frames);
+            t.errorMetric = compare::FrameMetric::FlipMean;
+            if (reference && in != &*reference)
+                t.errorPerFrame = compare::errorPerFrame(in->frames, reference->frames, t.errorMetric);
+            report.temporal.push_back(std::move(t));
+        }
+    }
+    if (a.graph) report.graphA = a.graph->document;
+    if (b.graph) report.graphB = b.graph->document;
+
+    std::ofstream(out.claim("metrics.json")) << compare::metricsJson(report).dump(2) << "\n";
+    compare::writeReport(out.claim("report.html"), report);
+
+    for (const compare::PairMetrics& m : report.metrics)
+        std::printf("%-3s vs %-10s PSNR %s   SSIM %.4f   FLIP mean %.4f (weighted median %.4f)\n", m.test.c_str(),
+                    m.reference.c_str(), formatPsnr(m.psnr).c_str(), m.ssim, m.flip.mean, m.flip.weightedMedian);
+    for (const compare::TemporalMetrics& t : report.temporal)
+        std::printf("%-9s flicker %.5f over %d frames\n", t.label.c_str(), t.flicker, t.frameCount);
+    std::printf("wrote %s\n", (out.dir() / "report.html").string().c_str());
+    if (ctx && ctx->validationMessageCount() > 0) {
+        logWarning(std::to_string(ctx->validationMessageCount()) + " Vulkan validation message(s)");
+        return 2;
+    }
+    return 0;
+}
+
+} // namespace vitrine::cli

@@ -1,0 +1,54 @@
+#include "tools/vitrine/render_output.hpp"
+
+#include "core/base/error.hpp"
+#include "core/graph/compiler.hpp"
+#include "core/graph/executor.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+namespace vitrine::cli {
+
+ContextOptions contextOptions(const Args& args) {
+    ContextOptions o;
+    o.device = args.get("device");
+    o.validation = args.has("validate");
+    return o;
+}
+
+std::string deviceClass(const Context& ctx) {
+    std::string name = ctx.deviceInfo().name;
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+    return name.find("llvmpipe") != std::string::npos || name.find("lavapipe") != std::string::npos ? "lavapipe"
+                                                                                                    : "gpu";
+}
+
+std::string pickOutput(const GraphDesc& desc, const std::string& requested) {
+    if (desc.outputs.empty()) throw UserError(desc.where("/outputs") + ": expected at least one output");
+    if (requested.empty()) return desc.outputs.front().name;
+    std::string names;
+    for (const OutputDecl& o : desc.outputs) {
+        if (o.name == requested) return requested;
+        names += (names.empty() ? "" : ", ") + o.name;
+    }
+    throw UserError(desc.where("/outputs") + ": --output " + requested + ": no such output; the graph has " + names);
+}
+
+std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, GraphDesc desc, const std::string& output,
+                                       uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress) {
+    std::erase_if(desc.outputs, [&](const OutputDecl& o) { return o.name != output; });
+    desc.frame.frames = frameCount;
+    desc.frame.write = frames;
+    CompiledGraph graph = compileGraph(std::move(desc));
+    Executor executor(ctx, graph, shaders);
+    std::map<uint32_t, Image> images;
+    RunOptions options;
+    options.frames = frameCount;
+    options.write = frames;
+    options.progress = progress;
+    options.onOutput = [&](uint32_t frame, const std::string&, const Image& image) { images[frame] = image; };
+    executor.run(options);
+    return images;
+}
+
+} // namespace vitrine::cli

@@ -1,0 +1,33 @@
+#pragma once
+
+#include "core/gpu/context.hpp"
+#include "core/graph/graph_desc.hpp"
+#include "core/image/image.hpp"
+#include "core/shader/compiler.hpp"
+#include "tools/vitrine/cli.hpp"
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+// Rendering one output of a graph at chosen frames: shared by `compare` and `golden`.
+namespace vitrine::cli {
+
+// --device and --validate.
+ContextOptions contextOptions(const Args& args);
+
+// "lavapipe" for Mesa's CPU device (lavapipe / llvmpipe), else "gpu": golden images and their tolerances are kept
+// per device class, because a CPU rasteriser and a GPU round differently.
+std::string deviceClass(const Context& ctx);
+
+// The output `requested` of `desc` (empty: the first of its outputs). UserError naming the graph file and the outputs
+// it has when there is no such output.
+std::string pickOutput(const GraphDesc& desc, const std::string& requested);
+
+// Compiles `desc` with only `output` kept (so nodes no other output needs are culled), runs `frameCount` frames and
+// returns the output at each of `frames` (all < frameCount).
+std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, GraphDesc desc, const std::string& output,
+                                       uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress);
+
+} // namespace vitrine::cli
