@@ -66,11 +66,11 @@ public:
     const GpuImage& input(const std::string& port) override { return imageOf(port, false); }
     const GpuImage& output(const std::string& port) override { return imageOf(port, true); }
 
-    void upload(const std::string& port, const Image& pixels) override {
+    void upload(const std::string& port, const Image& pixels, uint32_t layer) override {
         const PassUse* u = findUse(port, true);
         if (!u || u->usage != Usage::TransferDst)
             throw InternalError("node " + pass().id + ": upload to '" + port + "', which is not a TransferDst output");
-        mEx.mFrameStaging.push_back(recordUpload(mEx.mCtx, mCmd, imageOf(port, true), pixels));
+        mEx.mFrameStaging.push_back(recordUpload(mEx.mCtx, mCmd, imageOf(port, true), pixels, layer));
     }
 
     void dispatch(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,

@@ -78,8 +78,8 @@ public:
     virtual void dispatch(PipelineId pipeline, const void* push, uint32_t pushSize, uint32_t width,
                           uint32_t height, uint32_t depth = 1) = 0;
 
-    // Records a copy of `pixels` into an output whose port usage is TransferDst.
-    virtual void upload(const std::string& port, const Image& pixels) = 0;
+    // Records a copy of `pixels` into mip 0 / `layer` of an output whose port usage is TransferDst.
+    virtual void upload(const std::string& port, const Image& pixels, uint32_t layer = 0) = 0;
 
     template <typename T> void dispatch(PipelineId pipeline, const T& push, uint32_t width, uint32_t height) {
         dispatch(pipeline, &push, static_cast<uint32_t>(sizeof(T)), width, height, 1);
