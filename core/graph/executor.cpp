@@ -69,11 +69,11 @@ public:
     const GpuImage& input(const std::string& port) override { return imageOf(port, false); }
     const GpuImage& output(const std::string& port) override { return imageOf(port, true); }
 
-    void upload(const std::string& port, const Image& pixels) override {
+    void upload(const std::string& port, const Image& pixels, uint32_t layer) override {
         const PassUse* u = findUse(port, true);
         if (!u || u->usage != Usage::TransferDst)
             throw InternalError("node " + pass().id + ": upload to '" + port + "', which is not a TransferDst output");
-        mEx.mFrameStaging.push_back(recordUpload(mEx.mCtx, mCmd, imageOf(port, true), pixels));
+        mEx.mFrameStaging.push_back(recordUpload(mEx.mCtx, mCmd, imageOf(port, true), pixels, layer));
     }
 
     PortObject& object(const std::string& port) override {

@@ -101,8 +101,8 @@ public:
     virtual void dispatch(PipelineId pipeline, const void* push, uint32_t pushSize, uint32_t width,
                           uint32_t height, uint32_t depth = 1) = 0;
 
-    // Records a copy of `pixels` into an output whose port usage is TransferDst.
-    virtual void upload(const std::string& port, const Image& pixels) = 0;
+    // Records a copy of `pixels` into mip 0 / `layer` of an output whose port usage is TransferDst.
+    virtual void upload(const std::string& port, const Image& pixels, uint32_t layer = 0) = 0;
 
     // The object on an input or output port of a non-texture kind (see PortObject).
     virtual PortObject& object(const std::string& port) = 0;

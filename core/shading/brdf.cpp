@@ -1,0 +1,69 @@
+#include "core/shading/brdf.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vitrine::shading {
+
+float roughnessFromShininess(float shininess) {
+    return std::clamp(1.0f - shininess, 0.0f, 1.0f);
+}
+
+float ggxAlpha(float roughness) {
+    return std::max(roughness * roughness, kMinGgxAlpha);
+}
+
+float ggxD(float NoH, float alpha) {
+    float a2 = alpha * alpha;
+    float d = NoH * NoH * (a2 - 1.0f) + 1.0f;
+    return a2 / (kPi * d * d);
+}
+
+float smithGgxVisibility(float NoV, float NoL, float alpha) {
+    float a2 = alpha * alpha;
+    float lambdaV = NoL * std::sqrt(NoV * NoV * (1.0f - a2) + a2);
+    float lambdaL = NoV * std::sqrt(NoL * NoL * (1.0f - a2) + a2);
+    return 0.5f / std::max(lambdaV + lambdaL, 1e-12f);
+}
+
+glm::vec3 schlickFresnel(glm::vec3 f0, float VoH) {
+    float m = 1.0f - std::clamp(VoH, 0.0f, 1.0f);
+    float m5 = m * m * m * m * m;
+    return f0 + (glm::vec3(1.0f) - f0) * m5;
+}
+
+glm::vec3 specularF0(glm::vec3 baseColor, float metallic) {
+    return glm::mix(glm::vec3(0.04f), baseColor, metallic);
+}
+
+glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic) {
+    return baseColor * (1.0f - metallic);
+}
+
+glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {
+    float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
+    glm::vec3 h = glm::normalize(v + l);
+    float NoH = std::clamp(glm::dot(n, h), 0.0f, 1.0f);
+    float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+    float alpha = ggxAlpha(roughness);
+    glm::vec3 spec =
+        ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(specularF0(baseColor, metallic), VoH);
+    return (diffuseAlbedo(baseColor, metallic) * lambertDiffuse() + spec) * NoL;
+}
+
+glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,
+                           glm::vec3 intensity) {
+    return brdfCosine(n, v, l, baseColor, metallic, roughness) * (kPi * intensity);
+}
+
+float toksvigRoughness(float roughness, float normalLength) {
+    float na = std::clamp(normalLength, 1e-4f, 1.0f);
+    float alpha = ggxAlpha(roughness);
+    float s = 2.0f / (alpha * alpha) - 2.0f;
+    float ft = na / (na + s * (1.0f - na));
+    float alpha2 = 2.0f / (ft * s + 2.0f);
+    return std::sqrt(std::sqrt(alpha2));
+}
+
+} // namespace vitrine::shading

@@ -1,0 +1,28 @@
+#pragma once
+
+#include <glm/glm.hpp>
+
+// CPU mirror of shaders/common/brdf.glsl (same names, same maths, same units and pi
+// convention: see the top of that file). Used by tests and CPU references.
+namespace vitrine::shading {
+
+inline constexpr float kPi = 3.14159265358979323846f;
+inline constexpr float kMinGgxAlpha = 0.002f;
+
+float roughnessFromShininess(float shininess);
+float ggxAlpha(float roughness);
+float ggxD(float NoH, float alpha);
+float smithGgxVisibility(float NoV, float NoL, float alpha);
+glm::vec3 schlickFresnel(glm::vec3 f0, float VoH);
+inline float lambertDiffuse() {
+    return 1.0f / kPi;
+}
+glm::vec3 specularF0(glm::vec3 baseColor, float metallic);
+glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic);
+glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness);
+// intensity = E / pi, E the light's illuminance (lux) on a surface facing it.
+glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,
+                           glm::vec3 intensity);
+float toksvigRoughness(float roughness, float normalLength);
+
+} // namespace vitrine::shading

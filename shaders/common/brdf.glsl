@@ -1,0 +1,95 @@
+#ifndef VITRINE_BRDF_GLSL
+#define VITRINE_BRDF_GLSL
+
+// The shading model of MUSEUM_SPEC §1, used by every lighting node; CPU mirror:
+// core/shading/brdf.hpp. Cook-Torrance specular (GGX NDF, height-correlated Smith GGX
+// visibility, Schlick Fresnel) plus Lambert diffuse, metallic workflow [Karis13].
+//
+// Units and the pi convention. Radiance is in cd/m^2 (the RGB's Rec.709 luminance), illuminance
+// in lux. A directional light is given by its "intensity" I = E / pi, where E is the
+// illuminance it produces on a surface facing it (lux); the shading multiplies I by pi again:
+//     L_out = f(l, v) * (pi * I) * NoL = f(l, v) * E * NoL.
+// So a white Lambertian surface facing a light of intensity I has radiance I, and a light whose
+// intensity was derived by hand from sky luminance is entered divided by pi. The sky nodes
+// output E (lux, texel 9 of their `sh` texture): pass E / pi as the intensity.
+
+#ifndef VITRINE_PI
+#define VITRINE_PI
+const float kPi = 3.14159265358979323846;
+#endif
+
+// Smallest GGX alpha (roughness ~0.045): keeps D finite in fp32 and highlights at least a
+// fraction of a pixel wide.
+const float kMinGgxAlpha = 0.002;
+
+// The G-buffer stores shininess = 1 - roughness (perceptual roughness, UE4's parameter).
+float roughnessFromShininess(float shininess) { return clamp(1.0 - shininess, 0.0, 1.0); }
+float ggxAlpha(float roughness) { return max(roughness * roughness, kMinGgxAlpha); }
+
+// GGX / Trowbridge-Reitz NDF, normalised so that the integral of D(h) NoH over the hemisphere is 1.
+float ggxD(float NoH, float alpha) {
+    float a2 = alpha * alpha;
+    float d = NoH * NoH * (a2 - 1.0) + 1.0;
+    return a2 / (kPi * d * d);
+}
+
+// Height-correlated Smith GGX visibility V = G2 / (4 NoL NoV) [Heitz14].
+float smithGgxVisibility(float NoV, float NoL, float alpha) {
+    float a2 = alpha * alpha;
+    float lambdaV = NoL * sqrt(NoV * NoV * (1.0 - a2) + a2);
+    float lambdaL = NoV * sqrt(NoL * NoL * (1.0 - a2) + a2);
+    return 0.5 / max(lambdaV + lambdaL, 1e-12);
+}
+
+vec3 schlickFresnel(vec3 f0, float VoH) {
+    float m = 1.0 - clamp(VoH, 0.0, 1.0);
+    float m2 = m * m;
+    return f0 + (1.0 - f0) * (m2 * m2 * m);
+}
+
+float lambertDiffuse() { return 1.0 / kPi; }
+
+// Metallic workflow: dielectrics reflect 4 % at normal incidence, metals their base colour.
+vec3 specularF0(vec3 baseColor, float metallic) { return mix(vec3(0.04), baseColor, metallic); }
+vec3 diffuseAlbedo(vec3 baseColor, float metallic) { return baseColor * (1.0 - metallic); }
+
+// Specular lobe f_s(l, v) = D V F, without the cosine.
+vec3 ggxSpecular(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0) {
+    return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+}
+
+// The full BRDF times the cosine, f(l, v) NoL, for unit vectors n (surface), v (to the eye),
+// l (to the light). Zero when l or v is below the surface.
+vec3 brdfCosine(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+    float NoL = dot(n, l);
+    float NoV = dot(n, v);
+    if (NoL <= 0.0 || NoV <= 0.0) return vec3(0.0);
+    vec3 h = normalize(v + l);
+    float NoH = clamp(dot(n, h), 0.0, 1.0);
+    float VoH = clamp(dot(v, h), 0.0, 1.0);
+    vec3 spec = ggxSpecular(NoV, NoL, NoH, VoH, ggxAlpha(roughness), specularF0(baseColor, metallic));
+    return (diffuseAlbedo(baseColor, metallic) * lambertDiffuse() + spec) * NoL;
+}
+
+// Outgoing radiance (cd/m^2) from one directional light of intensity I = E / pi (see the top
+// of this file): brdfCosine * pi * I.
+vec3 shadeDirectional(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness, vec3 intensity) {
+    return brdfCosine(n, v, l, baseColor, metallic, roughness) * (kPi * intensity);
+}
+
+// Toksvig [Toksvig04]: a normal averaged over a footprint (mip-mapped without renormalising)
+// has length |Na| < 1; treat the spread as a Gaussian of angular variance (1 - |Na|) / |Na| and
+// widen the lobe. Mapping: GGX alpha to the Blinn-Phong exponent s = 2 / alpha^2 - 2,
+// Toksvig's factor ft = |Na| / (|Na| + s (1 - |Na|)), s' = ft s, back with
+// alpha'^2 = 2 / (s' + 2). For small alpha this is alpha'^2 ~= alpha^2 + 2 (1 - |Na|) / |Na|.
+// Returns the widened perceptual roughness (never below sqrt(kMinGgxAlpha)).
+float toksvigRoughness(float roughness, float normalLength) {
+    float na = clamp(normalLength, 1e-4, 1.0);
+    float alpha = ggxAlpha(roughness);
+    float s = 2.0 / (alpha * alpha) - 2.0;
+    float ft = na / (na + s * (1.0 - na));
+    float alpha2 = 2.0 / (ft * s + 2.0);
+    return sqrt(sqrt(alpha2));
+}
+
+#endif

@@ -1,0 +1,160 @@
+#include "tests/gpu/test_nodes.hpp"
+
+#include "core/graph/node.hpp"
+#include "core/graph/registry.hpp"
+
+#include <string>
+
+namespace vitrine::test {
+namespace {
+
+const char* kOctahedralSource = R"(#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common/octahedral.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_result;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    const int n = 128, h = 64;
+    if (p.x >= 2 * n || p.y >= h) return;
+    if (p.x < n) {
+        float theta = (float(p.y) + 0.5) / float(h) * 3.14159265358979;
+        float phi = (float(p.x) + 0.5) / float(n) * 6.28318530717959;
+        vec3 d = vec3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
+        imageStore(out_result, p, vec4(octEncode(d), 0.0, 1.0));
+    } else {
+        vec2 e = vec2((float(p.x - n) + 0.5) / float(n), (float(p.y) + 0.5) / float(h)) * 2.0 - 1.0;
+        imageStore(out_result, p, vec4(octDecode(e), 1.0));
+    }
+}
+)";
+
+const char* kFurnaceSource = R"(#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common/brdf.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_albedo;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= 16 || p.y >= 16) return;
+    float NoV = (float(p.x) + 0.5) / 16.0;
+    float alpha = ggxAlpha((float(p.y) + 0.5) / 16.0);
+    vec3 v = vec3(sqrt(1.0 - NoV * NoV), 0.0, NoV);
+    const int m = 64;
+    float spec = 0.0, lambert = 0.0;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+            // Stratified: one sample at the centre of each of m x m cells.
+            float u1 = (float(i) + 0.5) / float(m), u2 = (float(j) + 0.5) / float(m);
+            // Visible-normal sampling of h [Heitz18] (pdf_l = G1(v) D / (4 NoV)); with F = 1
+            // the estimator f NoL / pdf_l is G2 / G1(v) = 4 V NoL NoV / G1(v).
+            vec3 vh = normalize(vec3(alpha * v.x, alpha * v.y, v.z));
+            vec3 t1 = vec3(0.0, 1.0, 0.0); // vh lies in the XZ plane
+            vec3 t2 = cross(vh, t1);
+            float r = sqrt(u1), phi = 2.0 * kPi * u2;
+            float p1 = r * cos(phi), p2 = r * sin(phi);
+            float s = 0.5 * (1.0 + vh.z);
+            p2 = (1.0 - s) * sqrt(1.0 - p1 * p1) + s * p2;
+            vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+            vec3 h = normalize(vec3(alpha * nh.x, alpha * nh.y, max(0.0, nh.z)));
+            float VoH = dot(v, h);
+            vec3 l = 2.0 * VoH * h - v;
+            float g1 = 2.0 * NoV / (NoV + sqrt(alpha * alpha + (1.0 - alpha * alpha) * NoV * NoV));
+            if (l.z > 0.0) spec += 4.0 * smithGgxVisibility(NoV, l.z, alpha) * l.z * NoV / g1;
+            // Cosine-weighted sampling of l for Lambert: f cos / pdf = (1/pi) cos / (cos / pi).
+            float cosL = sqrt(1.0 - u1);
+            lambert += lambertDiffuse() * cosL / (cosL / kPi);
+        }
+    imageStore(out_albedo, p, vec4(spec, lambert, 0.0, 0.0) / float(m * m));
+}
+)";
+
+const char* kUnfoldSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0, rgba32f) readonly uniform imageCube in_cube;
+layout(binding = 1) writeonly uniform image2D out_faces;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 s = imageSize(out_faces);
+    if (p.x >= s.x || p.y >= s.y) return;
+    int n = s.y;
+    imageStore(out_faces, p, imageLoad(in_cube, ivec3(p.x % n, p.y, p.x / n)));
+}
+)";
+
+const char* kSampleSource = R"(#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common/cubemap.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) uniform samplerCube in_cube;
+layout(binding = 1) writeonly uniform image2D out_faces;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 s = imageSize(out_faces);
+    if (p.x >= s.x || p.y >= s.y) return;
+    int n = s.y;
+    vec3 d = cubeTexelDirection(uint(p.x / n), ivec2(p.x % n, p.y), n);
+    imageStore(out_faces, p, textureLod(in_cube, d, 0.0));
+}
+)";
+
+OutputPort floatOutput(const std::string& name, uint32_t w, uint32_t h) {
+    OutputPort out;
+    out.name = name;
+    out.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    out.size = SizeRule::absolute(w, h);
+    out.doc = "test output";
+    return out;
+}
+
+class SourceNode final : public Node {
+public:
+    SourceNode(std::string name, const char* source, std::string output, bool fromCube)
+        : mName(std::move(name)), mSource(source), mOutput(std::move(output)), mFromCube(fromCube) {}
+    void setup(SetupContext& ctx) override {
+        if (mFromCube) {
+            ImageDesc& out = ctx.output(mOutput);
+            out.width = 6 * ctx.input("cube").width;
+            out.height = ctx.input("cube").height;
+        }
+        mPipeline = ctx.computePipelineSource(mName, mSource);
+    }
+    void execute(ExecuteContext& ctx) override {
+        const ImageDesc& out = ctx.output(mOutput).desc();
+        ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
+    }
+
+private:
+    std::string mName;
+    const char* mSource;
+    std::string mOutput;
+    bool mFromCube;
+    PipelineId mPipeline = 0;
+};
+
+NodeSchema testSchema(const std::string& type, std::vector<InputPort> inputs, OutputPort out) {
+    NodeSchema s;
+    s.type = type;
+    s.doc = "test-only node of test_gpu";
+    s.inputs = std::move(inputs);
+    s.outputs = {std::move(out)};
+    return s;
+}
+
+const NodeRegistration kOctahedral(testSchema("test.octahedral", {}, floatOutput("result", 2 * kOctGrid, 64)), [] {
+    return std::make_unique<SourceNode>("test/octahedral", kOctahedralSource, "result", false);
+});
+const NodeRegistration kFurnace(testSchema("test.furnace", {}, floatOutput("albedo", 16, 16)), [] {
+    return std::make_unique<SourceNode>("test/furnace", kFurnaceSource, "albedo", false);
+});
+const NodeRegistration
+    kUnfold(testSchema("test.cube_unfold", {{"cube", PortKind::Texture, {}, false, Usage::StorageRead, "cube map"}},
+                       floatOutput("faces", 6, 1)),
+            [] { return std::make_unique<SourceNode>("test/cube_unfold", kUnfoldSource, "faces", true); });
+const NodeRegistration
+    kSample(testSchema("test.cube_sample", {{"cube", PortKind::Texture, {}, false, Usage::Sampled, "cube map"}},
+                       floatOutput("faces", 6, 1)),
+            [] { return std::make_unique<SourceNode>("test/cube_sample", kSampleSource, "faces", true); });
+
+} // namespace
+} // namespace vitrine::test
