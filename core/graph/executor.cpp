@@ -130,7 +130,7 @@ public:
                 const PassUse* u = findUse(t.port, t.output);
                 if (u) {
                     const Executor::Physical& ph = mEx.mPhysical[mEx.physicalOf(u->resource, u->previous)];
-                    images[i] = {mEx.mSampler, ph.image.view(), ph.state.layout};
+                    images[i] = {mEx.samplerFor(ph.image.desc().format), ph.image.view(), ph.state.layout};
                 } else {
                     images[i] = {mEx.mSampler, mEx.mDummy.view(), VK_IMAGE_LAYOUT_GENERAL};
                 }
@@ -192,6 +192,10 @@ void Executor::create(ShaderCompiler& shaders) {
     si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     si.maxLod = VK_LOD_CLAMP_NONE;
     VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &mSampler));
+    // Formats without linear filtering (depth on most devices) are bound with a nearest sampler.
+    si.magFilter = si.minFilter = VK_FILTER_NEAREST;
+    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &mNearestSampler));
 
     std::vector<VkDescriptorPoolSize> sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4096},
                                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1024},
@@ -239,6 +243,9 @@ Executor::~Executor() { destroy(); }
 
 void Executor::destroy() {
     mCtx.waitIdle();
+    for (auto& pass : mGraph.passes) pass.node->releaseGpu();
+    for (auto& r : mGraph.resources)
+        if (r.object) r.object->releaseGpu();
     mPhysical.clear();
     mDummy = GpuImage();
     mUniformRing = GpuBuffer();
@@ -247,25 +254,37 @@ void Executor::destroy() {
     std::vector<std::unique_ptr<Pipeline>> all;
     for (auto& list : mPipelines)
         for (auto& p : list) all.push_back(std::move(p));
-    VkSampler sampler = mSampler;
+    VkSampler sampler = mSampler, nearest = mNearestSampler;
     VkDescriptorPool pool = mDescriptorPool;
     VkDeviceMemory heap = mTransientHeap;
     auto shared = std::make_shared<std::vector<std::unique_ptr<Pipeline>>>(std::move(all));
-    mCtx.destroyLater([device, shared, sampler, pool, heap] {
+    mCtx.destroyLater([device, shared, sampler, nearest, pool, heap] {
         for (auto& p : *shared) {
             if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
             if (p->layout) vkDestroyPipelineLayout(device, p->layout, nullptr);
             if (p->setLayout) vkDestroyDescriptorSetLayout(device, p->setLayout, nullptr);
         }
         if (sampler) vkDestroySampler(device, sampler, nullptr);
+        if (nearest) vkDestroySampler(device, nearest, nullptr);
         if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
         if (heap) vkFreeMemory(device, heap, nullptr);
     });
     mSampler = VK_NULL_HANDLE;
+    mNearestSampler = VK_NULL_HANDLE;
     mDescriptorPool = VK_NULL_HANDLE;
     mTransientHeap = VK_NULL_HANDLE;
     mPipelines.clear();
     mCtx.collectGarbage();
+}
+
+VkSampler Executor::samplerFor(VkFormat format) {
+    auto it = mLinearFilterable.find(format);
+    if (it == mLinearFilterable.end()) {
+        VkFormatProperties props;
+        vkGetPhysicalDeviceFormatProperties(mCtx.physicalDevice(), format, &props);
+        it = mLinearFilterable.emplace(format, (props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT) != 0).first;
+    }
+    return it->second ? mSampler : mNearestSampler;
 }
 
 uint32_t Executor::physicalOf(uint32_t resource, bool previous) const {

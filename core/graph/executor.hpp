@@ -5,6 +5,7 @@
 #include "core/image/image.hpp"
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -74,7 +75,10 @@ private:
     std::vector<std::array<uint32_t, 2>> mResourcePhysical; // history resources use both
     VkDeviceMemory mTransientHeap = VK_NULL_HANDLE;
     std::vector<std::vector<std::unique_ptr<Pipeline>>> mPipelines; // per pass
+    VkSampler samplerFor(VkFormat format);
     VkSampler mSampler = VK_NULL_HANDLE;
+    VkSampler mNearestSampler = VK_NULL_HANDLE;
+    std::map<VkFormat, bool> mLinearFilterable;
     VkDescriptorPool mDescriptorPool = VK_NULL_HANDLE;
     GpuImage mDummy; // bound to unconnected optional inputs
     std::unique_ptr<GpuProfiler> mProfiler;

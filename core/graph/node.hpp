@@ -47,6 +47,9 @@ using PipelineId = uint32_t;
 class PortObject {
 public:
     virtual ~PortObject() = default;
+    // Called when the executor that ran the graph goes away (before its Vulkan device may): drop every
+    // GPU object. The CPU side stays, so another executor can run the same compiled graph.
+    virtual void releaseGpu() {}
 };
 
 namespace detail {
@@ -128,6 +131,8 @@ public:
     virtual ~Node() = default;
     virtual void setup(SetupContext& ctx) {}
     virtual void execute(ExecuteContext& ctx) = 0;
+    // Nodes that own Vulkan objects (raster pipelines) drop them here; see PortObject::releaseGpu().
+    virtual void releaseGpu() {}
 };
 
 } // namespace vitrine

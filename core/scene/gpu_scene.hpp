@@ -118,6 +118,7 @@ public:
         return *mGpu;
     }
     GpuScene& gpu() const; // InternalError before the producer uploaded it
+    void releaseGpu() override { mGpu.reset(); }
 
     // The pose of this frame and the last one (set by the scene node every frame).
     scene::ScenePose pose, previousPose;

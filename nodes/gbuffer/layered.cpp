@@ -82,6 +82,11 @@ public:
         endRendering(cmd);
     }
 
+    void releaseGpu() override {
+        mCullBack = RasterPipeline();
+        mCullNone = RasterPipeline();
+    }
+
 private:
     void createPipelines(ExecuteContext& ctx, GpuScene& gpu) {
         ShaderDefines defines = {{"VITRINE_SCENE_TEXTURES", std::to_string(std::max(1u, gpu.textureCount()))}};

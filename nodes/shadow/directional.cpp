@@ -100,6 +100,8 @@ public:
         endRendering(cmd);
     }
 
+    void releaseGpu() override { mPipeline = RasterPipeline(); }
+
 private:
     void createPipeline(ExecuteContext& ctx, GpuScene& gpu) {
         RasterPipelineDesc d;

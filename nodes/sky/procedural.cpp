@@ -2,6 +2,9 @@
 // its SH9 irradiance and the sun (derived from the same turbidity) for the directional light.
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
+#include "core/scene/gpu_scene.hpp"
+
+#include <optional>
 #include "shaders/sky/sky.h"
 
 #include <cmath>
@@ -33,6 +36,8 @@ NodeSchema schema() {
     sh.doc = "16x1: texels 0-8 SH9 radiance of the sky without the sun, 9 sun illuminance (lux), 10 direction to "
              "the sun, 11 (sun luminance, angular radius, turbidity, 0)";
     s.outputs = {cube, sh};
+    s.inputs = {{"scene", PortKind::Scene, {}, true, Usage::Sampled,
+                 "When connected, the sun direction is the scene's sun (sun_elevation/sun_azimuth are ignored)"}};
     s.params = {
         {"turbidity",
          ParamType::Float,
@@ -73,6 +78,10 @@ public:
         cube.cube = true;
         mCubePipeline = ctx.computePipeline("sky/procedural.comp");
         mShPipeline = ctx.computePipeline("sky/procedural_sh.comp");
+        if (ctx.hasInput("scene")) {
+            auto scene = ctx.objectAs<SceneObject>("scene");
+            if (scene->scene().hasSun) mSceneSun = glm::normalize(scene->scene().sun.toSun);
+        }
     }
     void execute(ExecuteContext& ctx) override {
         // Both outputs are persistent and depend on params only: one evaluation serves every frame.
@@ -83,6 +92,7 @@ public:
         gpu_types::SkyProceduralPush push{};
         push.toSun =
             glm::vec4(std::cos(e) * std::sin(a), std::sin(e), -std::cos(e) * std::cos(a), p.getFloat("turbidity"));
+        if (mSceneSun) push.toSun = glm::vec4(*mSceneSun, p.getFloat("turbidity"));
         push.groundAlbedo = p.getFloat("ground_albedo");
         push.sunAngularRadius = static_cast<float>(kSunAngularRadiusDeg * deg);
         push.size = static_cast<uint32_t>(p.getInt("size"));
@@ -94,6 +104,7 @@ public:
 private:
     PipelineId mCubePipeline = 0;
     PipelineId mShPipeline = 0;
+    std::optional<glm::vec3> mSceneSun;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Procedural>(); });

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "scene/scene.glsl"
+#include "common/brdf.glsl"
 #include "common/octahedral.glsl"
 
 // The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
@@ -38,12 +39,8 @@ void main() {
 
     float shininess = clamp(s.shininess, 0.0, 1.0);
     if ((draw.flags & FLAG_TOKSVIG) != 0u) {
-        // Toksvig [Toksvig04] for GGX: the averaged normal's shortening is a variance added to alpha^2.
-        float roughness = 1.0 - shininess;
-        float a2 = roughness * roughness * roughness * roughness;
-        float l = clamp(len, 1e-3, 1.0);
-        a2 = min(a2 + (1.0 - l) / l, 1.0);
-        shininess = 1.0 - sqrt(sqrt(a2));
+        // Toksvig [Toksvig04]: the averaged normal's shortening widens the lobe (common/brdf.glsl).
+        shininess = 1.0 - toksvigRoughness(roughnessFromShininess(shininess), min(len, 1.0));
     }
 
     vec2 ndc = vClip.xy / vClip.w;

@@ -29,5 +29,6 @@ int graphCommand(const Args& args);
 int devicesCommand(const Args& args);
 int compareCommand(const Args& args);
 int goldenCommand(const Args& args);
+int exportSceneCommand(const Args& args);
 
 } // namespace vitrine::cli

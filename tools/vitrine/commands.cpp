@@ -7,6 +7,7 @@
 #include "core/graph/loader.hpp"
 #include "core/graph/registry.hpp"
 #include "core/image/io.hpp"
+#include "core/scene/gpu_scene.hpp"
 #include "core/shader/compiler.hpp"
 #include "tools/vitrine/cli.hpp"
 #include "tools/vitrine/output_dir.hpp"
@@ -179,6 +180,15 @@ int benchCommand(const Args& args) {
     j["gpu_ms_total_median"] = median(total);
     j["cpu_record_ms_median"] = median(record);
     if (ctx.validationMessageCount() > 0) j["validation_messages"] = ctx.validationMessageCount();
+    j["scenes"] = nlohmann::json::array();
+    for (const auto& r : graph.resources) {
+        auto* so = dynamic_cast<SceneObject*>(r.object.get());
+        if (!so || !so->uploaded()) continue;
+        const GpuSceneStats& st = so->gpu().stats();
+        j["scenes"].push_back({{"resource", r.name}, {"triangles", so->scene().triangleCount()},
+                               {"draws", so->gpu().draws().size()}, {"geometry_bytes", st.geometryBytes},
+                               {"texture_bytes", st.textureBytes}, {"upload_ms", st.uploadMs}});
+    }
 
     if (args.has("json")) {
         std::string path = args.get("json");
@@ -200,6 +210,11 @@ int benchCommand(const Args& args) {
                     mib(m.transientAliased).c_str(), mib(m.transientUnaliased).c_str(),
                     m.transientUnaliased ? 100.0 * m.transientAliased / m.transientUnaliased : 100.0,
                     mib(m.persistent).c_str());
+        for (const auto& sc : j["scenes"])
+            std::printf("  scene %s: %zu triangles in %zu draws; geometry %s, textures %s (with mips); upload %.0f ms\n",
+                        sc["resource"].get<std::string>().c_str(), sc["triangles"].get<size_t>(), sc["draws"].get<size_t>(),
+                        mib(sc["geometry_bytes"].get<uint64_t>()).c_str(), mib(sc["texture_bytes"].get<uint64_t>()).c_str(),
+                        sc["upload_ms"].get<double>());
     }
     return ctx.validationMessageCount() > 0 ? 2 : 0;
 }

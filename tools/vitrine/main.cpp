@@ -30,6 +30,8 @@ commands:
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
       `accept` (re)writes the golden EXRs, `check` compares with FLIP tolerances and writes
       a heat map and report.html per failure into DIR (default golden-report). Exit 3: failed.
+  export-scene museum|FILE OUT.glb [--seed N] [--texture-size N] [--force]
+      Write the procedural museum (or re-write a glTF file) as glTF binary for other tools.
   devices                           List Vulkan devices.
 
 common options:
@@ -47,7 +49,8 @@ int main(int argc, char** argv) {
     using namespace vitrine;
     try {
         cli::Args args = cli::parse(argc, argv, {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                               "output", "ppd", "diff-scale", "manifest"});
+                                               "output", "ppd", "diff-scale", "manifest", "seed",
+                                               "texture-size"});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
         if (args.command.empty() || args.command == "help" || args.has("help")) {
@@ -62,6 +65,7 @@ int main(int argc, char** argv) {
         if (args.command == "devices") return cli::devicesCommand(args);
         if (args.command == "compare") return cli::compareCommand(args);
         if (args.command == "golden") return cli::goldenCommand(args);
+        if (args.command == "export-scene") return cli::exportSceneCommand(args);
         throw UserError("unknown command '" + args.command + "'; run `vitrine help`");
     } catch (const UserError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

@@ -25,7 +25,15 @@ std::string deviceClass(const Context& ctx) {
 
 std::string pickOutput(const GraphDesc& desc, const std::string& requested) {
     if (desc.outputs.empty()) throw UserError(desc.where("/outputs") + ": expected at least one output");
-    if (requested.empty()) return desc.outputs.front().name;
+    if (requested.empty()) {
+        // Outputs are kept sorted by name (JSON objects), so "first" would favour "debug/..." over the
+        // image the graph is about: an output called "final" wins, then the first one without a '/'.
+        for (const OutputDecl& o : desc.outputs)
+            if (o.name == "final") return o.name;
+        for (const OutputDecl& o : desc.outputs)
+            if (o.name.find('/') == std::string::npos) return o.name;
+        return desc.outputs.front().name;
+    }
     std::string names;
     for (const OutputDecl& o : desc.outputs) {
         if (o.name == requested) return requested;

@@ -83,7 +83,8 @@ void slab(MeshBuilder& b, const Frame& f, float w, float h, float t, std::span<c
         float ow = o.x1 - o.x0, oh = o.y1 - o.y0;
         rect(b, Frame{f.at(o.x0, o.y0), -n, f.v}, t, oh, uvScale);                      // left jamb, facing +u
         rect(b, Frame{f.at(o.x1, o.y0) - n * t, n, f.v}, t, oh, uvScale);               // right jamb, facing -u
-        if (o.y0 > 0.0f) rect(b, Frame{f.at(o.x0, o.y0), f.u, -n}, ow, t, uvScale);     // sill, facing +v
+        // Sill facing +v; at y0 = 0 it is a doorway's threshold, closing the floor across the wall.
+        rect(b, Frame{f.at(o.x0, o.y0), f.u, -n}, ow, t, uvScale);
         if (o.y1 < h) rect(b, Frame{f.at(o.x0, o.y1) - n * t, f.u, n}, ow, t, uvScale); // head, facing -v
     }
 }
