@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#define VITRINE_SCENE_FRAGMENT
 #include "scene/scene.glsl"
 #include "common/brdf.glsl"
 #include "common/octahedral.glsl"
@@ -23,8 +24,9 @@ layout(location = 4) out vec3 outEmissive; // lightmap or emissive radiance
 #define FLAG_TOKSVIG 1u
 
 void main() {
+    UvGradients grads = uvGradients(vUv0, vUv1);
     GpuMaterial m = materials[draw.material];
-    LayeredSurface s = evaluateLayers(m, vUv0, vUv1);
+    LayeredSurface s = evaluateLayers(m, vUv0, vUv1, grads);
     float coverage = s.albedo.a;
     if (m.info.z == 1u && coverage < m.emissive.a) discard;
 
@@ -48,7 +50,7 @@ void main() {
     vec2 velocity = (ndc - prevNdc) * 0.5 * camera.params.zw;
 
     vec3 emissive = m.emissive.rgb;
-    if (m.emissiveRef.info.x >= 0) emissive *= sampleRef(m.emissiveRef, vUv0, vUv1).rgb;
+    if (m.emissiveRef.info.x >= 0) emissive *= sampleRef(m.emissiveRef, vUv0, vUv1, grads).rgb;
 
     outNormal = vec4(octEncode(N), vViewDepth, shininess);
     outBase = vec4(s.albedo.rgb * vColor.rgb, clamp(s.metallic, 0.0, 1.0));

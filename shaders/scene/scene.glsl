@@ -1,6 +1,7 @@
 // The scene's descriptor set (core/scene/gpu_scene.cpp, createDescriptors) and layered-material
 // evaluation (MUSEUM_SPEC §2). Include after #version; define VITRINE_SCENE_SET (default 0) and
-// VITRINE_SCENE_TEXTURES (the scene's texture count) before including.
+// VITRINE_SCENE_TEXTURES (the scene's texture count) before including, and VITRINE_SCENE_FRAGMENT in
+// fragment shaders (for uvGradients()).
 #ifndef SCENE_SCENE_GLSL
 #define SCENE_SCENE_GLSL
 #extension GL_GOOGLE_include_directive : require
@@ -24,11 +25,31 @@ vec2 refUv(GpuTexRef r, vec2 uv0, vec2 uv1) {
     return vec2(dot(r.row0.xyz, uv), dot(r.row1.xyz, uv));
 }
 
+// Screen-space derivatives of both UV sets, taken once at the top of the fragment shader in uniform
+// control flow. Sampling then uses explicit gradients: implicit ones inside the material loop depend on
+// helper invocations executing the buffer loads that drive it, which lavapipe does not guarantee (it
+// showed as wrong mip levels along triangle edges).
+struct UvGradients {
+    vec4 uv0; // xy: d/dx, zw: d/dy
+    vec4 uv1;
+};
+
+#ifdef VITRINE_SCENE_FRAGMENT
+UvGradients uvGradients(vec2 uv0, vec2 uv1) {
+    UvGradients g;
+    g.uv0 = vec4(dFdx(uv0), dFdy(uv0));
+    g.uv1 = vec4(dFdx(uv1), dFdy(uv1));
+    return g;
+}
+#endif
+
 // The texel a reference points at; 1 without a texture (so "factor x texel" is the factor).
 // The texture index is the same for the whole draw (dynamically uniform).
-vec4 sampleRef(GpuTexRef r, vec2 uv0, vec2 uv1) {
+vec4 sampleRef(GpuTexRef r, vec2 uv0, vec2 uv1, UvGradients g) {
     if (r.info.x < 0) return vec4(1.0);
-    return texture(sceneTextures[r.info.x], refUv(r, uv0, uv1));
+    vec4 d = r.info.y == 0 ? g.uv0 : g.uv1;
+    mat2 m = mat2(r.row0.x, r.row1.x, r.row0.y, r.row1.y); // the transform's linear part (columns)
+    return textureGrad(sceneTextures[r.info.x], refUv(r, uv0, uv1), m * d.xy, m * d.zw);
 }
 
 float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }
@@ -45,7 +66,7 @@ struct LayeredSurface {
 
 // Layer 0 sets every parameter; each layer above blends the parameters it overrides over the result
 // below with its own mask weight: p = mix(below, layer, weight), each parameter independently.
-LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1) {
+LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
     LayeredSurface s;
     s.albedo = vec4(1.0);
     s.normal = vec3(0.0, 0.0, 1.0);
@@ -58,34 +79,34 @@ LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1) {
         float w = 1.0;
         if (i > 0) {
             GpuTexRef mr = l.refs[VITRINE_REF_MASK];
-            float t = mr.info.x < 0 ? 1.0 : channelOf(sampleRef(mr, uv0, uv1), mr.info.z);
+            float t = mr.info.x < 0 ? 1.0 : channelOf(sampleRef(mr, uv0, uv1, g), mr.info.z);
             w = clamp(l.scalars1.w * t, 0.0, 1.0);
         }
         uint bits = l.bits.x;
         if ((bits & VITRINE_LAYER_ALBEDO) != 0u)
-            s.albedo = mix(s.albedo, l.albedo * sampleRef(l.refs[VITRINE_REF_ALBEDO], uv0, uv1), w);
+            s.albedo = mix(s.albedo, l.albedo * sampleRef(l.refs[VITRINE_REF_ALBEDO], uv0, uv1, g), w);
         if ((bits & VITRINE_LAYER_NORMAL) != 0u) {
             vec3 n = vec3(0.0, 0.0, 1.0);
             GpuTexRef nr = l.refs[VITRINE_REF_NORMAL];
             if (nr.info.x >= 0) {
-                n = sampleRef(nr, uv0, uv1).xyz * 2.0 - 1.0;
+                n = sampleRef(nr, uv0, uv1, g).xyz * 2.0 - 1.0;
                 n.xy *= l.scalars0.x;
             }
             s.normal = mix(s.normal, n, w);
         }
         if ((bits & VITRINE_LAYER_SHININESS) != 0u) {
             GpuTexRef r = l.refs[VITRINE_REF_SHININESS];
-            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1, g), r.info.z);
             s.shininess = mix(s.shininess, mix(l.scalars0.z, l.scalars0.y, t), w);
         }
         if ((bits & VITRINE_LAYER_METALLIC) != 0u) {
             GpuTexRef r = l.refs[VITRINE_REF_METALLIC];
-            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1, g), r.info.z);
             s.metallic = mix(s.metallic, mix(l.scalars1.x, l.scalars0.w, t), w);
         }
         if ((bits & VITRINE_LAYER_CAVITY) != 0u) {
             GpuTexRef r = l.refs[VITRINE_REF_CAVITY];
-            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+            float t = r.info.x < 0 ? 1.0 : channelOf(sampleRef(r, uv0, uv1, g), r.info.z);
             s.cavity = mix(s.cavity, mix(l.scalars1.z, l.scalars1.y, t), w);
         }
     }
