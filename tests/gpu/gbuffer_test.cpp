@@ -783,5 +783,64 @@ TEST_F(Gbuffer, ToksvigLowersShininessOfHighMipsByTheFormula) {
     EXPECT_LT(worstN, 2e-3);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Texture level of detail must not depend on how a surface is triangulated: a plane drawn as 2 and as
+// 512 triangles gives the same base colour. (lavapipe once sampled the smallest mips along triangle
+// edges, because implicit derivatives inside the material loop depended on helper invocations.)
+TEST_F(Gbuffer, TextureDetailDoesNotDependOnTessellation) {
+    auto build = [](int cells) {
+        SceneBuilder b;
+        const uint32_t n = 64;
+        const uint32_t img = b.image("checker", n, n, [](uint32_t x, uint32_t y) {
+            uint8_t v = ((x / 4 + y / 4) % 2) ? 230 : 25;
+            return glm::u8vec4(v, v, v, 255);
+        });
+        sc::Material m = singleLayer(0.5f);
+        m.layers[0].albedo.factor = glm::vec4(1.0f);
+        m.layers[0].albedo.texture.texture = b.texture(img, sc::TextureUsage::Color, sc::Sampler{});
+        m.layers[0].albedo.texture.transform.scale = glm::vec2(4.0f);
+        b.s.materials.push_back(m);
+        // A 6 x 6 m floor in the XZ plane, cells x cells quads sharing their vertices.
+        std::vector<sc::Vertex> v;
+        std::vector<uint32_t> idx;
+        for (int j = 0; j <= cells; ++j)
+            for (int i = 0; i <= cells; ++i) {
+                sc::Vertex vert;
+                float u = static_cast<float>(i) / cells, w = static_cast<float>(j) / cells;
+                vert.position = {-3.0f + 6.0f * u, 0.0f, -3.0f + 6.0f * w};
+                vert.normal = {0, 1, 0};
+                vert.tangent = {1, 0, 0, 1};
+                vert.uv0 = {u, w};
+                v.push_back(vert);
+            }
+        for (int j = 0; j < cells; ++j)
+            for (int i = 0; i < cells; ++i) {
+                uint32_t a = static_cast<uint32_t>(j * (cells + 1) + i), c = a + static_cast<uint32_t>(cells) + 1;
+                idx.insert(idx.end(), {a, c, a + 1, a + 1, c, c + 1}); // counter-clockwise seen from +Y
+            }
+        b.node("floor", b.mesh("floor", v, idx, 0));
+        glm::vec3 eye(0.0f, 1.2f, 3.5f);
+        b.cameraPath("view", 1.2f, {{0.0f, eye, lookRotation(eye, glm::vec3(0.0f, 0.0f, -1.0f)), 1.2f}});
+        return b.write("floor" + std::to_string(cells));
+    };
+    const int w = 96, h = 64;
+    auto coarse = runGraph(gbufferGraph(build(1), w, h, json::object(), json::object()));
+    auto fine = runGraph(gbufferGraph(build(16), w, h, json::object(), json::object()));
+    double worst = 0.0, sum = 0.0;
+    int covered = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (coarse["depth"].at(x, y)[0] <= 0.0f) continue; // no floor here (above the horizon)
+            ++covered;
+            double d = std::fabs(static_cast<double>(coarse["base"].at(x, y)[0]) - fine["base"].at(x, y)[0]);
+            worst = std::max(worst, d);
+            sum += d;
+        }
+    std::printf("tessellation: %d floor pixels, max |diff| %.4f, mean %.5f\n", covered, worst, sum / std::max(covered, 1));
+    EXPECT_GT(covered, w * h / 3);
+    // Equal up to interpolation rounding across different triangles (a wrong mip shows as ~0.4).
+    EXPECT_LT(worst, 4.0 / 255.0);
+}
+
 } // namespace
 } // namespace vitrine::test
