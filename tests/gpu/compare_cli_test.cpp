@@ -204,8 +204,9 @@ TEST(CompareCli, DoesNotOverwriteFilesItDidNotWriteUnlessForced) {
 TEST(GoldenCli, PerturbedRenderFailsTheCheckAndWritesAReport) {
     const fs::path out = freshDir("golden_perturbed");
     // A slightly higher zone-plate frequency moves every ring.
-    const CliResult r = vitrine("golden check fxaa_zoneplate --set pattern.params.max_frequency=0.32 --quiet --out " +
-                                quote(out.string()));
+    const CliResult r = vitrine("golden check fxaa_zoneplate --set pattern.params.max_frequency=0.32 --quiet --skip-missing "
+                                "--out " + quote(out.string()));
+    if (r.status == 77) GTEST_SKIP() << r.output; // no goldens for this device class (a GPU) in the tree yet
     EXPECT_EQ(r.status, 3) << r.output;
     EXPECT_NE(r.output.find("FAIL fxaa_zoneplate"), std::string::npos) << r.output;
     EXPECT_TRUE(fs::is_regular_file(out / "fxaa_zoneplate" / "report.html"));

@@ -30,6 +30,7 @@ commands:
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
       `accept` (re)writes the golden EXRs, `check` compares with FLIP tolerances and writes
       a heat map and report.html per failure into DIR (default golden-report). Exit 3: failed.
+      --skip-missing: exit 77 (skipped) when this device class has no goldens yet.
   export-scene museum|FILE OUT.glb [--seed N] [--texture-size N] [--force]
       Write the procedural museum (or re-write a glTF file) as glTF binary for other tools.
   devices                           List Vulkan devices.
