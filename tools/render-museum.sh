@@ -1,11 +1,8 @@
 #!/usr/bin/env bash
-# The README's first command: install, build, render the default graph headless to out/.
-# Until graphs/museum.json exists (the scene and lighting work), the default graph is the
-# FXAA zone plate.
+# The README's first command: install, build, render the Museum graph (graphs/museum.json) headless
+# to out/default/. Extra arguments go to `vitrine run` (e.g. --set frame.width=1280).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
-graph=graphs/museum.json
-[ -f "$graph" ] || graph=graphs/fxaa_zoneplate.json
-./build/vitrine run "$graph" --out out/default "${@}"
+./build/vitrine run graphs/museum.json --out out/default "${@}"
 echo "images in out/default/"
