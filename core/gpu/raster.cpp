@@ -1,24 +1,12 @@
 #include "core/gpu/raster.hpp"
 
 #include "core/gpu/context.hpp"
+#include "core/gpu/pipeline.hpp"
 #include "core/gpu/vk_check.hpp"
 
 #include <utility>
 
 namespace vitrine {
-
-namespace {
-
-VkShaderModule createModule(VkDevice device, const CompiledShader& shader) {
-    VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    mi.codeSize = shader.spirv.size() * 4;
-    mi.pCode = shader.spirv.data();
-    VkShaderModule module;
-    VK_CHECK(vkCreateShaderModule(device, &mi, nullptr, &module));
-    return module;
-}
-
-} // namespace
 
 RasterPipeline::RasterPipeline(Context& ctx, const RasterPipelineDesc& desc) : mCtx(&ctx) {
     VkDevice device = ctx.device();
@@ -32,11 +20,11 @@ RasterPipeline::RasterPipeline(Context& ctx, const RasterPipelineDesc& desc) : m
 
     std::vector<VkPipelineShaderStageCreateInfo> stages;
     std::vector<VkShaderModule> modules;
-    modules.push_back(createModule(device, desc.vertex));
+    modules.push_back(createShaderModule(device, desc.vertex));
     stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
                       modules.back(), "main", nullptr});
     if (desc.fragment) {
-        modules.push_back(createModule(device, *desc.fragment));
+        modules.push_back(createShaderModule(device, *desc.fragment));
         stages.push_back({VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
                           modules.back(), "main", nullptr});
     }

@@ -4,6 +4,7 @@
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/formats.hpp"
+#include "core/gpu/pipeline.hpp"
 #include "core/gpu/profiler.hpp"
 #include "core/gpu/transfer.hpp"
 #include "core/graph/lifetimes.hpp"
@@ -394,20 +395,7 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
             pl.pPushConstantRanges = &range;
             VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &p->layout));
 
-            VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-            mi.codeSize = shader.spirv.size() * 4;
-            mi.pCode = shader.spirv.data();
-            VkShaderModule module;
-            VK_CHECK(vkCreateShaderModule(device, &mi, nullptr, &module));
-            VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-            ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-            ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-            ci.stage.module = module;
-            ci.stage.pName = "main";
-            ci.layout = p->layout;
-            VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &p->pipeline);
-            vkDestroyShaderModule(device, module, nullptr);
-            VK_CHECK(result);
+            p->pipeline = createComputePipeline(device, shader, p->layout);
             mCtx.setName(reinterpret_cast<uint64_t>(p->pipeline), VK_OBJECT_TYPE_PIPELINE, pass.id + ":" + request.shader);
         }
     }

@@ -3,6 +3,7 @@
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
+#include "core/gpu/pipeline.hpp"
 #include "core/gpu/vk_check.hpp"
 #include "core/shader/compiler.hpp"
 
@@ -17,7 +18,7 @@ using namespace gpu_types;
 
 gpu_types::GpuCamera CameraFrame::gpu() const {
     GpuCamera c{};
-    c.view = view;
+    c.view = state.view;
     c.proj = proj;
     c.viewProj = viewProj;
     c.invViewProj = invViewProj;
@@ -304,17 +305,7 @@ void GpuScene::buildToksvigMips(ShaderCompiler& shaders, VkCommandBuffer cmd, co
     pl.pSetLayouts = &setLayout;
     VkPipelineLayout layout;
     VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &layout));
-    VkShaderModuleCreateInfo mi{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    mi.codeSize = shader.spirv.size() * 4;
-    mi.pCode = shader.spirv.data();
-    VkShaderModule module;
-    VK_CHECK(vkCreateShaderModule(device, &mi, nullptr, &module));
-    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", nullptr};
-    ci.layout = layout;
-    VkPipeline pipeline;
-    VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline));
-    vkDestroyShaderModule(device, module, nullptr);
+    VkPipeline pipeline = createComputePipeline(device, shader, layout);
 
     uint32_t sets = 0;
     for (uint32_t t : normalMaps) sets += mTextures[t].desc().mipLevels;

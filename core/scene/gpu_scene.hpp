@@ -23,8 +23,7 @@ class ShaderCompiler;
 
 // One frame's camera, as every consumer sees it (CPU mirror of gpu_types::GpuCamera).
 struct CameraFrame {
-    scene::CameraState state;
-    glm::mat4 view{1.0f};
+    scene::CameraState state; // pose and lens; state.view / state.world are the view matrix and its inverse
     glm::mat4 proj{1.0f};         // jittered, reverse Z
     glm::mat4 projNoJitter{1.0f}; // reverse Z
     glm::mat4 viewProj{1.0f};

@@ -109,24 +109,27 @@ void SceneNode::execute(ExecuteContext& ctx) {
     const double dt = 1.0 / mFps;
     const double t = mStart + frame * dt;
     GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
-
-    // Velocity is the motion over one frame interval, also on frame 0 (the clock is continuous).
-    mScene->time = t;
-    mScene->pose = s.evaluate(t);
-    mScene->previousPose = s.evaluate(t - dt);
-
     CameraFrame& c = mCamera->current;
     const float aspect = static_cast<float>(c.width) / static_cast<float>(c.height);
-    scene::CameraState now = cameraAt(t), before = cameraAt(t - dt);
-    c.state = now;
-    c.view = now.view;
-    c.projNoJitter = now.projection(aspect, true);
+
+    // Velocity is the motion over one frame interval, also on frame 0 (the clock is continuous).
+    // Consecutive frames hand their pose and camera on instead of evaluating them again.
+    const bool consecutive = mEvaluated && frame == mLastFrame + 1;
+    mScene->previousPose = consecutive ? std::move(mScene->pose) : s.evaluate(t - dt);
+    const scene::CameraState before = consecutive ? c.state : cameraAt(t - dt);
+    mScene->time = t;
+    mScene->pose = s.evaluate(t);
+    c.state = cameraAt(t);
+    mEvaluated = true;
+    mLastFrame = frame;
+
+    c.projNoJitter = c.state.projection(aspect, true);
     c.prevJitter = frame == 0 || !mJitter ? glm::vec2(0.0f) : haltonJitter(frame - 1);
     c.jitter = mJitter ? haltonJitter(frame) : glm::vec2(0.0f);
     glm::mat4 shift = glm::translate(glm::mat4(1.0f), glm::vec3(2.0f * c.jitter.x / c.width, 2.0f * c.jitter.y / c.height, 0.0f));
     c.proj = shift * c.projNoJitter;
-    c.viewProj = c.proj * c.view;
-    c.viewProjNoJitter = c.projNoJitter * c.view;
+    c.viewProj = c.proj * c.state.view;
+    c.viewProjNoJitter = c.projNoJitter * c.state.view;
     c.prevViewProjNoJitter = before.projection(aspect, true) * before.view;
     c.invViewProj = glm::inverse(c.viewProj);
     c.time = t;

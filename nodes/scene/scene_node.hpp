@@ -31,6 +31,8 @@ private:
     float mFps = 24.0f;
     float mStart = 0.0f;
     bool mJitter = false;
+    bool mEvaluated = false; // pose and camera of mLastFrame are in mScene / mCamera
+    uint32_t mLastFrame = 0;
 };
 
 // Halton(2, 3) sub-pixel offsets in pixels, in (-0.5, 0.5), cycling over 8 frames.

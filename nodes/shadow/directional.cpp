@@ -130,7 +130,7 @@ private:
         const float zfar = std::max(mDistance, znear * 2.0f);
         const float aspect = static_cast<float>(cam.width) / static_cast<float>(cam.height);
         const float ty = std::tan(0.5f * cam.state.lens.yfov), tx = ty * aspect;
-        const glm::mat4 world = glm::inverse(cam.view);
+        const glm::mat4& world = cam.state.world;
         const glm::vec3 eye(world[3]), right(world[0]), up(world[1]), fwd(-world[2]);
         glm::vec3 lightUp = std::abs(toSun.y) > 0.99f ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
         const float sceneRadius = s.bounds.empty() ? 100.0f : 0.5f * glm::length(s.bounds.extent());

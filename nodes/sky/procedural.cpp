@@ -3,12 +3,11 @@
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
-
-#include <optional>
 #include "shaders/sky/sky.h"
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 namespace vitrine {
 namespace {

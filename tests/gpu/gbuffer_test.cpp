@@ -4,7 +4,6 @@
 // camera clock, raster) is what is measured.
 #include "tests/gpu/gpu_test.hpp"
 
-#include "core/scene/gltf.hpp"
 #include "core/scene/scene.hpp"
 #include "nodes/scene/scene_node.hpp"
 
@@ -15,7 +14,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <unistd.h>
 
 namespace vitrine::test {
 namespace {
@@ -98,27 +96,8 @@ struct SceneBuilder {
         s.cameraPaths.push_back(path);
     }
 
-    // Finalizes, validates and writes the scene as a .glb for scene.gltf.
-    std::filesystem::path write(const std::string& name) {
-        s.finalize();
-        s.validate();
-        auto dir = std::filesystem::temp_directory_path() / ("vitrine_gbuffer_test_" + std::to_string(::getpid()));
-        std::filesystem::create_directories(dir);
-        auto file = dir / (name + ".glb");
-        sc::exportGlb(s, file);
-        return file;
-    }
+    std::filesystem::path write(const std::string& name) { return writeSceneGlb(s, "gbuffer_" + name); }
 };
-
-// Removes the .glb files when the test program ends.
-class ScratchCleanup : public ::testing::Environment {
-public:
-    void TearDown() override {
-        std::filesystem::remove_all(std::filesystem::temp_directory_path() /
-                                    ("vitrine_gbuffer_test_" + std::to_string(::getpid())));
-    }
-};
-const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 sc::Material singleLayer(float shininess) {
     sc::Material m;
@@ -151,14 +130,6 @@ sc::Transform at(glm::vec3 t, glm::quat r = glm::quat(1, 0, 0, 0)) {
     tr.translation = t;
     tr.rotation = r;
     return tr;
-}
-
-// A camera orientation looking from eye at target, +Y up (camera looks down its local -Z).
-glm::quat lookRotation(glm::vec3 eye, glm::vec3 target) {
-    glm::vec3 back = glm::normalize(eye - target);
-    glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
-    glm::vec3 up = glm::cross(back, right);
-    return glm::normalize(glm::quat_cast(glm::mat3(right, up, back)));
 }
 
 json gbufferGraph(const std::filesystem::path& glb, int w, int h, json sceneParams, json gbufferParams, int frames = 1) {
@@ -688,7 +659,7 @@ TEST_F(Gbuffer, SphereNormalsDecodeToAnalyticNormals) {
             glm::dvec3 decoded = octDecode(g[0], g[1]);
             worst = std::max(worst, glm::length(decoded - n));
             worstDepth = std::max(worstDepth, std::fabs(g[2] + cam.toView(hit).z));
-            glm::dvec3 exact;
+            glm::dvec3 exact(0.0);
             if (!meshNormal(eye, d, hit, exact)) {
                 ++missedFacet;
                 continue;

@@ -4,10 +4,13 @@
 #include "core/graph/executor.hpp"
 #include "core/graph/loader.hpp"
 #include "core/graph/registry.hpp"
+#include "core/scene/gltf.hpp"
+#include "core/scene/scene.hpp"
 #include "core/shader/compiler.hpp"
 
 #include <cmath>
 #include <memory>
+#include <unistd.h>
 
 namespace vitrine::test {
 
@@ -72,6 +75,36 @@ double maxAbsDiff(const Image& a, const Image& b) {
     for (size_t i = 0; i < a.pixels.size() && i < b.pixels.size(); ++i)
         m = std::max(m, static_cast<double>(std::fabs(a.pixels[i] - b.pixels[i])));
     return m;
+}
+
+namespace {
+
+std::filesystem::path scratchDir() {
+    return std::filesystem::temp_directory_path() / ("vitrine_gpu_test_" + std::to_string(::getpid()));
+}
+
+class ScratchCleanup : public ::testing::Environment {
+public:
+    void TearDown() override { std::filesystem::remove_all(scratchDir()); }
+};
+const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+
+} // namespace
+
+std::filesystem::path writeSceneGlb(scene::Scene& s, const std::string& name) {
+    s.finalize();
+    s.validate();
+    std::filesystem::create_directories(scratchDir());
+    auto file = scratchDir() / (name + ".glb");
+    scene::exportGlb(s, file);
+    return file;
+}
+
+glm::quat lookRotation(glm::vec3 eye, glm::vec3 target) {
+    glm::vec3 back = glm::normalize(eye - target);
+    glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
+    glm::vec3 up = glm::cross(back, right);
+    return glm::normalize(glm::quat_cast(glm::mat3(right, up, back)));
 }
 
 } // namespace vitrine::test

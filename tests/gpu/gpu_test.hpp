@@ -3,11 +3,18 @@
 #include "core/gpu/context.hpp"
 #include "core/image/image.hpp"
 
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <map>
 #include <string>
+
+namespace vitrine::scene {
+struct Scene;
+}
 
 namespace vitrine::test {
 
@@ -27,6 +34,13 @@ private:
 // Validates, compiles and runs a graph given as JSON; returns every graph output of the last frame.
 std::map<std::string, Image> runGraph(const nlohmann::json& graph);
 std::map<std::string, Image> runGraphFile(const std::string& path, const std::vector<std::string>& sets = {});
+
+// Finalizes and validates a scene built in a test and writes it as <name>.glb into a scratch folder of
+// this test process (removed when the program ends), for scene.gltf.
+std::filesystem::path writeSceneGlb(scene::Scene& s, const std::string& name);
+
+// A camera orientation looking from eye at target, +Y up (cameras look down their local -Z).
+glm::quat lookRotation(glm::vec3 eye, glm::vec3 target);
 
 double rmse(const Image& a, const Image& b); // over RGB
 double maxAbsDiff(const Image& a, const Image& b);

@@ -5,7 +5,6 @@
 // (the sun travels in the file), so the whole path from glTF to radiance is what is measured.
 #include "tests/gpu/gpu_test.hpp"
 
-#include "core/scene/gltf.hpp"
 #include "core/scene/scene.hpp"
 #include "core/shading/brdf.hpp"
 #include "core/shading/octahedral.hpp"
@@ -20,7 +19,6 @@
 #include <filesystem>
 #include <limits>
 #include <numbers>
-#include <unistd.h>
 
 namespace vitrine::test {
 namespace {
@@ -105,14 +103,11 @@ struct SceneBuilder {
         lens.yfov = yfov;
         lens.znear = 0.05f;
         s.cameras.push_back(lens);
-        glm::vec3 back = glm::normalize(eye - target);
-        glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0, 1, 0), back));
-        glm::vec3 up = glm::cross(back, right);
         sc::Node n;
         n.name = "view";
         n.camera = static_cast<int32_t>(s.cameras.size() - 1);
         n.local.translation = eye;
-        n.local.rotation = glm::normalize(glm::quat_cast(glm::mat3(right, up, back)));
+        n.local.rotation = lookRotation(eye, target);
         s.nodes.push_back(n);
         s.roots.push_back(static_cast<uint32_t>(s.nodes.size() - 1));
     }
@@ -122,26 +117,8 @@ struct SceneBuilder {
         s.sun.toSun = glm::normalize(toSun);
     }
 
-    // Finalizes, validates and writes the scene as a .glb for scene.gltf.
-    std::filesystem::path write() {
-        s.finalize();
-        s.validate();
-        auto dir = std::filesystem::temp_directory_path() / ("vitrine_lighting_test_" + std::to_string(::getpid()));
-        std::filesystem::create_directories(dir);
-        auto file = dir / (s.name + ".glb");
-        sc::exportGlb(s, file);
-        return file;
-    }
+    std::filesystem::path write() { return writeSceneGlb(s, "lighting_" + s.name); }
 };
-
-class ScratchCleanup : public ::testing::Environment {
-public:
-    void TearDown() override {
-        std::filesystem::remove_all(std::filesystem::temp_directory_path() /
-                                    ("vitrine_lighting_test_" + std::to_string(::getpid())));
-    }
-};
-const auto* const kCleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 void addQuad(std::vector<Tri>& tris, glm::vec3 c, glm::vec3 u, glm::vec3 v, glm::vec3 n) {
     sc::Vertex p[4] = {vertex(c - u - v, n), vertex(c + u - v, n), vertex(c + u + v, n), vertex(c - u + v, n)};
