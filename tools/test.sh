@@ -5,4 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/build.sh
 vulkaninfo --summary 2>/dev/null | grep -E "deviceName|driverName" || true
-ctest --test-dir build --output-on-failure -j "$(nproc)" --timeout 600
+ctest --test-dir build --output-on-failure --no-tests=error -j "$(nproc)" --timeout 600

@@ -38,10 +38,7 @@ VkBool32 debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugU
                        const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     auto* ctx = static_cast<Context*>(user);
     std::string message = data && data->pMessage ? data->pMessage : "(no message)";
-    {
-        std::lock_guard<std::mutex> lock(ctx->mMessageMutex);
-        ctx->mMessages.push_back(message);
-    }
+    ctx->mLog->add(message);
     if (ctx->mPrintValidation) {
         const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
         std::fprintf(stderr, "vulkan validation %s: %s\n", level, message.c_str());
@@ -82,7 +79,18 @@ std::string lower(std::string s) {
     return s;
 }
 
-VkInstance createInstance(bool validation, bool debugUtils) {
+VkDebugUtilsMessengerCreateInfoEXT messengerInfo(void* user) {
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT;
+    info.pfnUserCallback = debugCallback;
+    info.pUserData = user;
+    return info;
+}
+
+// validation: the Khronos layer with the debug-utils messenger chained into instance creation (so messages of
+// vkCreateInstance/vkDestroyInstance are caught too) and, when asked, synchronization validation.
+VkInstance createInstance(bool validation, bool debugUtils, bool syncValidation = false, void* user = nullptr) {
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = "vitrine";
     app.pEngineName = "vitrine";
@@ -94,6 +102,17 @@ VkInstance createInstance(bool validation, bool debugUtils) {
     if (debugUtils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
 
     VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    VkDebugUtilsMessengerCreateInfoEXT messenger = messengerInfo(user);
+    const VkValidationFeatureEnableEXT syncFeature = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+    if (validation) {
+        info.pNext = &messenger;
+        if (syncValidation) {
+            features.enabledValidationFeatureCount = 1;
+            features.pEnabledValidationFeatures = &syncFeature;
+            messenger.pNext = &features;
+        }
+    }
     info.pApplicationInfo = &app;
     info.enabledLayerCount = static_cast<uint32_t>(layers.size());
     info.ppEnabledLayerNames = layers.data();
@@ -133,25 +152,26 @@ std::vector<DeviceInfo> Context::listDevices() {
     return result;
 }
 
-Context::Context(const ContextOptions& options) : mPrintValidation(options.printValidation) {
+Context::Context(const ContextOptions& options)
+    : mPrintValidation(options.printValidation),
+      mLog(options.log ? options.log : std::make_shared<ValidationLog>()) {
     mValidation = options.validation;
     if (mValidation && !hasLayer("VK_LAYER_KHRONOS_validation"))
         throw UserError("validation requested but VK_LAYER_KHRONOS_validation is not installed "
                         "(Debian package vulkan-validationlayers; tools/install-deps.sh installs it)");
     bool debugUtils = hasInstanceExtension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    mInstance = createInstance(mValidation, debugUtils);
+    // Without the messenger the layer's messages could not be counted: a validated run would pass unheard.
+    if (mValidation && !debugUtils)
+        throw UserError("validation requested but the Vulkan loader offers no " VK_EXT_DEBUG_UTILS_EXTENSION_NAME
+                        ", so validation messages could not be counted");
+    mInstance = createInstance(mValidation, debugUtils, mValidation && options.synchronizationValidation, this);
 
     if (debugUtils) {
         mSetName = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
             vkGetInstanceProcAddr(mInstance, "vkSetDebugUtilsObjectNameEXT"));
     }
     if (mValidation && debugUtils) {
-        VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-        info.messageSeverity =
-            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-        info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT;
-        info.pfnUserCallback = debugCallback;
-        info.pUserData = this;
+        VkDebugUtilsMessengerCreateInfoEXT info = messengerInfo(this);
         auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
             vkGetInstanceProcAddr(mInstance, "vkCreateDebugUtilsMessengerEXT"));
         VK_CHECK(create(mInstance, &info, nullptr, &mMessenger));
@@ -265,15 +285,24 @@ Context::~Context() {
     if (mInstance) vkDestroyInstance(mInstance, nullptr);
 }
 
-size_t Context::validationMessageCount() const {
-    std::lock_guard<std::mutex> lock(mMessageMutex);
+void ValidationLog::add(std::string message) {
+    std::lock_guard<std::mutex> lock(mMutex);
+    mMessages.push_back(std::move(message));
+}
+
+size_t ValidationLog::count() const {
+    std::lock_guard<std::mutex> lock(mMutex);
     return mMessages.size();
 }
 
-std::vector<std::string> Context::validationMessages() const {
-    std::lock_guard<std::mutex> lock(mMessageMutex);
+std::vector<std::string> ValidationLog::messages() const {
+    std::lock_guard<std::mutex> lock(mMutex);
     return mMessages;
 }
+
+size_t Context::validationMessageCount() const { return mLog->count(); }
+
+std::vector<std::string> Context::validationMessages() const { return mLog->messages(); }
 
 void Context::setName(uint64_t handle, VkObjectType type, const std::string& name) const {
     if (!mSetName || name.empty()) return;

@@ -14,10 +14,26 @@ namespace vitrine {
 
 class Allocator;
 
+// The validation messages of a context. Shared so that a test harness can still read what the layer said while
+// the context was being destroyed (leaked objects are reported then).
+class ValidationLog {
+public:
+    void add(std::string message);
+    size_t count() const;
+    std::vector<std::string> messages() const;
+
+private:
+    mutable std::mutex mMutex;
+    std::vector<std::string> mMessages;
+};
+
 struct ContextOptions {
     bool validation = false;  // enable VK_LAYER_KHRONOS_validation and count its messages
+    // With validation: also the layer's synchronization validation (SYNC-HAZARD-* messages count like any other).
+    bool synchronizationValidation = true;
     std::string device;       // index ("0") or a case-insensitive substring of the device name; empty: best
     bool printValidation = true;
+    std::shared_ptr<ValidationLog> log; // where messages go; made by the context when empty
 };
 
 struct DeviceInfo {
@@ -52,6 +68,7 @@ public:
     // Validation messages (warnings and errors) seen since the context was made. Tests fail on any.
     size_t validationMessageCount() const;
     std::vector<std::string> validationMessages() const;
+    const std::shared_ptr<ValidationLog>& validationLog() const { return mLog; }
 
     void setName(uint64_t handle, VkObjectType type, const std::string& name) const;
 
@@ -104,8 +121,7 @@ private:
     std::vector<VkFence> mFreeFences;
     std::deque<Deferred> mDeferred;
 
-    mutable std::mutex mMessageMutex;
-    std::vector<std::string> mMessages;
+    std::shared_ptr<ValidationLog> mLog;
     friend VkBool32 debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
                                   const VkDebugUtilsMessengerCallbackDataEXT*, void*);
 };

@@ -9,17 +9,51 @@
 #include "core/shader/compiler.hpp"
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <unistd.h>
 
 namespace vitrine::test {
 
+namespace {
+
+// The shared context lives until the test environment tears down; its log outlives it, so messages the layer
+// raises while the device and instance are destroyed (leaked objects, say) still fail the run.
+std::shared_ptr<ValidationLog>& sharedLog() {
+    static std::shared_ptr<ValidationLog> log = std::make_shared<ValidationLog>();
+    return log;
+}
+
+std::unique_ptr<Context>& sharedContext() {
+    static std::unique_ptr<Context> ctx;
+    return ctx;
+}
+
+class ContextTeardown : public ::testing::Environment {
+public:
+    void TearDown() override {
+        if (!sharedContext()) return;
+        const size_t before = sharedLog()->count();
+        sharedContext().reset();
+        const auto messages = sharedLog()->messages();
+        if (messages.size() > before)
+            ADD_FAILURE() << "Vulkan validation reported " << messages.size() - before
+                          << " message(s) while the shared test context was destroyed; the last: " << messages.back();
+    }
+};
+const auto* const kContextTeardown = ::testing::AddGlobalTestEnvironment(new ContextTeardown);
+
+} // namespace
+
 Context& gpu() {
-    static std::unique_ptr<Context> ctx = [] {
+    auto& ctx = sharedContext();
+    if (!ctx) {
         ContextOptions o;
         o.validation = true;
-        return std::make_unique<Context>(o);
-    }();
+        o.synchronizationValidation = true;
+        o.log = sharedLog();
+        ctx = std::make_unique<Context>(o);
+    }
     return *ctx;
 }
 
@@ -57,9 +91,27 @@ std::map<std::string, Image> runGraphFile(const std::string& path, const std::ve
     return runCompiled(compileGraph(loadGraph(path, sets)));
 }
 
+namespace {
+
+// Image comparisons refuse what they cannot measure: an empty image or two sizes make the test fail, and the
+// result is infinite so that no "error below bound" assertion can pass by accident.
+bool comparable(const Image& a, const Image& b) {
+    if (a.width <= 0 || a.height <= 0 || a.pixels.empty()) {
+        ADD_FAILURE() << "image comparison of an empty image (" << a.width << "x" << a.height << ")";
+        return false;
+    }
+    if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size()) {
+        ADD_FAILURE() << "image comparison of different sizes: " << a.width << "x" << a.height << " vs " << b.width
+                      << "x" << b.height;
+        return false;
+    }
+    return true;
+}
+
+} // namespace
+
 double rmse(const Image& a, const Image& b) {
-    EXPECT_EQ(a.width, b.width);
-    EXPECT_EQ(a.height, b.height);
+    if (!comparable(a, b)) return std::numeric_limits<double>::infinity();
     double sum = 0.0;
     size_t n = static_cast<size_t>(a.width) * a.height;
     for (size_t i = 0; i < n; ++i)
@@ -71,8 +123,9 @@ double rmse(const Image& a, const Image& b) {
 }
 
 double maxAbsDiff(const Image& a, const Image& b) {
+    if (!comparable(a, b)) return std::numeric_limits<double>::infinity();
     double m = 0.0;
-    for (size_t i = 0; i < a.pixels.size() && i < b.pixels.size(); ++i)
+    for (size_t i = 0; i < a.pixels.size(); ++i)
         m = std::max(m, static_cast<double>(std::fabs(a.pixels[i] - b.pixels[i])));
     return m;
 }
