@@ -66,4 +66,12 @@ float toksvigRoughness(float roughness, float normalLength) {
     return std::sqrt(std::sqrt(alpha2));
 }
 
+glm::vec2 envBrdfApprox(float NoV, float roughness) {
+    const glm::vec4 c0(-1.0f, -0.0275f, -0.572f, 0.022f);
+    const glm::vec4 c1(1.0f, 0.0425f, 1.04f, -0.04f);
+    glm::vec4 r = roughness * c0 + c1;
+    float a004 = std::min(r.x * r.x, std::exp2(-9.28f * NoV)) * r.x + r.y;
+    return glm::vec2(-1.04f, 1.04f) * a004 + glm::vec2(r.z, r.w);
+}
+
 } // namespace vitrine::shading

@@ -25,4 +25,9 @@ glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 base
                            glm::vec3 intensity);
 float toksvigRoughness(float roughness, float normalLength);
 
+// Split-sum environment BRDF by Karis' analytic fit ("mobile" approximation), as inlined in
+// shaders/lighting/deferred.comp: returns (a, b) with directional albedo ~= F0 a + b for the GGX
+// lobe of perceptual roughness `roughness` seen at NoV. Used by the GPU lighting tests' references.
+glm::vec2 envBrdfApprox(float NoV, float roughness);
+
 } // namespace vitrine::shading

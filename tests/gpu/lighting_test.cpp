@@ -3,188 +3,23 @@
 // an analytic sphere, and the sky's diffuse ambient against the CPU SH irradiance of the read-back
 // coefficients. Scenes are built in code, written with exportGlb() and loaded through scene.gltf
 // (the sun travels in the file), so the whole path from glTF to radiance is what is measured.
-#include "tests/gpu/gpu_test.hpp"
+#include "tests/gpu/lighting_scene.hpp"
 
-#include "core/scene/scene.hpp"
 #include "core/shading/brdf.hpp"
 #include "core/shading/octahedral.hpp"
 #include "core/shading/sh.hpp"
 #include "shaders/sky/sky.h"
 
-#include <glm/gtc/quaternion.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <limits>
-#include <numbers>
 
 namespace vitrine::test {
 namespace {
 
 using nlohmann::json;
-namespace sc = vitrine::scene;
-constexpr double kPi = std::numbers::pi;
-
-// ---------------------------------------------------------------------------------------------
-// Scene building
-
-struct Tri {
-    sc::Vertex a, b, c;
-};
-
-sc::Vertex vertex(glm::vec3 p, glm::vec3 n) {
-    sc::Vertex v;
-    v.position = p;
-    v.normal = glm::normalize(n);
-    glm::vec3 ref = std::abs(v.normal.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
-    v.tangent = glm::vec4(glm::normalize(glm::cross(ref, v.normal)), 1.0f);
-    return v;
-}
-
-struct SceneBuilder {
-    sc::Scene s;
-
-    explicit SceneBuilder(const std::string& name) { s.name = name; }
-
-    // Triangles are wound counter-clockwise seen from the side their vertex normals point to (glTF's
-    // front face), whatever order they were given in; degenerate ones (UV sphere poles) are dropped.
-    uint32_t mesh(const std::string& name, const std::vector<Tri>& tris, uint32_t material) {
-        sc::Primitive p;
-        p.firstIndex = static_cast<uint32_t>(s.indices.size());
-        p.vertexOffset = static_cast<uint32_t>(s.vertices.size());
-        uint32_t count = 0;
-        for (Tri t : tris) {
-            glm::vec3 area = glm::cross(t.b.position - t.a.position, t.c.position - t.a.position);
-            if (glm::length(area) < 1e-9f) continue;
-            if (glm::dot(area, t.a.normal + t.b.normal + t.c.normal) < 0.0f) std::swap(t.b, t.c);
-            for (const sc::Vertex& v : {t.a, t.b, t.c}) {
-                s.vertices.push_back(v);
-                s.indices.push_back(count++);
-            }
-        }
-        p.indexCount = p.vertexCount = count;
-        p.material = material;
-        s.primitives.push_back(p);
-        sc::Mesh m;
-        m.name = name;
-        m.firstPrimitive = static_cast<uint32_t>(s.primitives.size() - 1);
-        m.primitiveCount = 1;
-        s.meshes.push_back(m);
-        return static_cast<uint32_t>(s.meshes.size() - 1);
-    }
-
-    uint32_t material(const std::string& name, glm::vec3 base, float metallic, float shininess) {
-        sc::Material m;
-        m.name = name;
-        sc::MaterialLayer l;
-        l.albedo.factor = glm::vec4(base, 1.0f);
-        l.metallic = {metallic, 0.0f};
-        l.shininess = {shininess, 0.0f};
-        m.layers = {l};
-        s.materials.push_back(m);
-        return static_cast<uint32_t>(s.materials.size() - 1);
-    }
-
-    void node(const std::string& name, int32_t mesh, glm::vec3 translation = glm::vec3(0.0f)) {
-        sc::Node n;
-        n.name = name;
-        n.mesh = mesh;
-        n.local.translation = translation;
-        s.nodes.push_back(n);
-        s.roots.push_back(static_cast<uint32_t>(s.nodes.size() - 1));
-    }
-
-    // A still glTF camera node at eye looking at target (+Y up); the scene node follows it.
-    void camera(glm::vec3 eye, glm::vec3 target, float yfov) {
-        sc::Camera lens;
-        lens.name = "view";
-        lens.yfov = yfov;
-        lens.znear = 0.05f;
-        s.cameras.push_back(lens);
-        sc::Node n;
-        n.name = "view";
-        n.camera = static_cast<int32_t>(s.cameras.size() - 1);
-        n.local.translation = eye;
-        n.local.rotation = lookRotation(eye, target);
-        s.nodes.push_back(n);
-        s.roots.push_back(static_cast<uint32_t>(s.nodes.size() - 1));
-    }
-
-    void sun(glm::vec3 toSun) {
-        s.hasSun = true;
-        s.sun.toSun = glm::normalize(toSun);
-    }
-
-    std::filesystem::path write() { return writeSceneGlb(s, "lighting_" + s.name); }
-};
-
-void addQuad(std::vector<Tri>& tris, glm::vec3 c, glm::vec3 u, glm::vec3 v, glm::vec3 n) {
-    sc::Vertex p[4] = {vertex(c - u - v, n), vertex(c + u - v, n), vertex(c + u + v, n), vertex(c - u + v, n)};
-    tris.push_back({p[0], p[1], p[2]});
-    tris.push_back({p[0], p[2], p[3]});
-}
-
-std::vector<Tri> boxTris(glm::vec3 half) {
-    std::vector<Tri> tris;
-    for (int axis = 0; axis < 3; ++axis)
-        for (float sign : {-1.0f, 1.0f}) {
-            glm::vec3 n(0.0f), u(0.0f), v(0.0f);
-            n[axis] = sign;
-            u[(axis + 1) % 3] = half[(axis + 1) % 3];
-            v[(axis + 2) % 3] = half[(axis + 2) % 3];
-            addQuad(tris, n * half[axis], u, v, n);
-        }
-    return tris;
-}
-
-// UV sphere: vertices on the sphere, smooth normals (position / radius).
-std::vector<Tri> sphereTris(float radius, int segments, int rings) {
-    auto at = [&](int i, int j) {
-        double theta = kPi * i / rings, phi = 2.0 * kPi * j / segments;
-        glm::vec3 n(static_cast<float>(std::sin(theta) * std::cos(phi)), static_cast<float>(std::cos(theta)),
-                    static_cast<float>(std::sin(theta) * std::sin(phi)));
-        sc::Vertex v = vertex(n * radius, n);
-        v.tangent = glm::vec4(static_cast<float>(-std::sin(phi)), 0.0f, static_cast<float>(std::cos(phi)), 1.0f);
-        v.uv0 = glm::vec2(static_cast<float>(j) / segments, static_cast<float>(i) / rings);
-        return v;
-    };
-    std::vector<Tri> tris;
-    for (int i = 0; i < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            tris.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-            tris.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-        }
-    return tris;
-}
-
-// ---------------------------------------------------------------------------------------------
-// CPU references
-
-// Pinhole camera with Vulkan clip conventions (y down), written out from the camera's pose.
-struct Pinhole {
-    glm::dvec3 position{0.0};
-    glm::dquat orientation{1, 0, 0, 0};
-    double yfov = 0.8;
-    double width = 1, height = 1;
-
-    explicit Pinhole(const sc::Scene& s, int w, int h) : width(w), height(h) {
-        for (const sc::Node& n : s.nodes)
-            if (n.camera >= 0) {
-                position = glm::dvec3(n.local.translation);
-                orientation = glm::dquat(n.local.rotation);
-                yfov = s.cameras[n.camera].yfov;
-                return;
-            }
-    }
-    // Unit world direction of the ray through the centre of pixel (x, y).
-    glm::dvec3 ray(int x, int y) const {
-        double g = 1.0 / std::tan(0.5 * yfov);
-        glm::dvec2 ndc = (glm::dvec2(x, y) + 0.5) / glm::dvec2(width, height) * 2.0 - 1.0;
-        return glm::normalize(orientation * glm::dvec3(ndc.x * (width / height) / g, -ndc.y / g, -1.0));
-    }
-};
+using namespace lighting;
 
 // Ray / axis-aligned box (slabs): the entry distance, or infinity when missed.
 double hitBox(glm::dvec3 o, glm::dvec3 d, glm::dvec3 lo, glm::dvec3 hi) {
@@ -199,59 +34,6 @@ double hitBox(glm::dvec3 o, glm::dvec3 d, glm::dvec3 lo, glm::dvec3 hi) {
         t1 = std::min(t1, std::max(ta, tb));
     }
     return t0 <= t1 ? t0 : std::numeric_limits<double>::infinity();
-}
-
-glm::dvec3 rgb(const Image& img, int x, int y) {
-    const float* p = img.at(x, y);
-    return {p[0], p[1], p[2]};
-}
-
-shading::Sh9 readSh(const Image& sh) {
-    shading::Sh9 s;
-    for (int i = 0; i < 9; ++i) s.c[i] = rgb(sh, i, 0);
-    return s;
-}
-
-// The G-buffer stores base colour and metallic as UNORM8: the CPU reference uses the stored values.
-glm::vec3 unorm8(glm::vec3 c) {
-    return glm::round(glm::clamp(c, 0.0f, 1.0f) * 255.0f) / 255.0f;
-}
-
-// Direct sun radiance by core/shading's BRDF (the π convention of brdf.glsl: intensity = E / π).
-glm::dvec3 cpuSun(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::vec3 base, float metallic, float shininess,
-                  glm::dvec3 sunE) {
-    return glm::dvec3(shading::shadeDirectional(glm::vec3(n), glm::vec3(v), glm::vec3(l), unorm8(base), metallic,
-                                                shading::roughnessFromShininess(shininess), glm::vec3(sunE / kPi)));
-}
-
-double relErr(glm::dvec3 a, glm::dvec3 b) {
-    double e = 0.0;
-    for (int c = 0; c < 3; ++c) e = std::max(e, std::abs(a[c] - b[c]) / std::max(std::abs(b[c]), 1e-30));
-    return e;
-}
-
-json lightingNode(json params, bool shadowMap) {
-    json in = {{"normal", "gbuffer.normal"}, {"base_color", "gbuffer.base_color"}, {"material", "gbuffer.material"},
-               {"emissive", "gbuffer.emissive"}, {"depth", "gbuffer.depth"}, {"sky_sh", "sky.sh"},
-               {"sky", "sky.cubemap"}, {"camera", "scene.camera"}};
-    if (shadowMap) {
-        in["shadow_map"] = "shadow.shadow_map";
-        in["cascades"] = "shadow.cascades";
-    }
-    return {{"type", "lighting.deferred"}, {"in", in}, {"params", params}};
-}
-
-// The sun is lit as a directional light, so the sky's cube map (the indirect specular) leaves its
-// disk out, as sky.procedural's sun_in_cubemap asks; with it the sun would count twice on glossy
-// surfaces.
-json baseNodes(const std::filesystem::path& glb) {
-    return {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}}}}},
-            {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}},
-            {"sky", {{"type", "sky.procedural"}, {"in", {{"scene", "scene.scene"}}}, {"params", {{"size", 16}, {"sun_in_cubemap", false}}}}}};
-}
-
-json graph(json nodes, json outputs, int w, int h) {
-    return {{"format", "vitrine-graph/1"}, {"frame", {{"width", w}, {"height", h}}}, {"nodes", nodes}, {"outputs", outputs}};
 }
 
 class Lighting : public GpuTest {};
@@ -270,8 +52,10 @@ TEST_F(Lighting, SunShadowFallsWhereTheOccluderBlocksTheSun) {
     std::vector<Tri> quad;
     addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
     b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, b.material("ground", ground, 0.0f, groundShininess))));
-    b.node("occluder", static_cast<int32_t>(b.mesh("occluder", boxTris(glm::vec3(boxHalf)), b.material("box", boxColor, 0.0f, 0.5f))),
-           glm::vec3(boxCentre));
+    b.node(
+        "occluder",
+        static_cast<int32_t>(b.mesh("occluder", boxTris(glm::vec3(boxHalf)), b.material("box", boxColor, 0.0f, 0.5f))),
+        glm::vec3(boxCentre));
     b.camera({-4.0f, 7.0f, 3.0f}, {-0.8f, 0.0f, -0.4f}, 0.9f);
     b.sun({0.7f, 1.0f, 0.25f});
     auto glb = b.write();
@@ -282,7 +66,8 @@ TEST_F(Lighting, SunShadowFallsWhereTheOccluderBlocksTheSun) {
                        {"params", {{"resolution", 512}, {"cascades", 2}, {"distance", 20.0}}}};
     nodes["lit"] = lightingNode({{"sky_ambient", 0.0}}, true);
     nodes["unshadowed"] = lightingNode({{"sky_ambient", 0.0}, {"shadows", false}}, true);
-    auto out = runGraph(graph(nodes, {{"lit", "lit.color"}, {"unshadowed", "unshadowed.color"}, {"sh", "sky.sh"}}, W, H));
+    auto out =
+        runGraph(graph(nodes, {{"lit", "lit.color"}, {"unshadowed", "unshadowed.color"}, {"sh", "sky.sh"}}, W, H));
     const Image& lit = out.at("lit");
     const Image& unshadowed = out.at("unshadowed");
     ASSERT_EQ(lit.width, W);
@@ -294,8 +79,8 @@ TEST_F(Lighting, SunShadowFallsWhereTheOccluderBlocksTheSun) {
 
     // Ground points more than `margin` from the shadow's edge (the far cascade, which holds the whole
     // ground in view, has texels of ~5.5 cm: 2 x its ~14 m bounding sphere / 512; PCF reaches 3 texels
-    // and the normal offset 1.5, so the penumbra is under ~0.2 m wide): occluded when the sun ray hits the box shrunk by the margin, lit when it misses
-    // the box grown by it.
+    // and the normal offset 1.5, so the penumbra is under ~0.2 m wide): occluded when the sun ray hits the box shrunk
+    // by the margin, lit when it misses the box grown by it.
     const double margin = 0.3;
     const glm::dvec3 grow(margin, margin, margin), shrink(margin, 0.0, margin);
     Pinhole cam(b.s, W, H);
@@ -311,7 +96,8 @@ TEST_F(Lighting, SunShadowFallsWhereTheOccluderBlocksTheSun) {
             // The camera sees the ground here, not the box (nor its edge).
             if (hitBox(cam.position, d, boxCentre - boxHalf - 0.05, boxCentre + boxHalf + 0.05) < t) continue;
             bool blocked = hitBox(p, l, boxCentre - boxHalf + shrink, boxCentre + boxHalf - shrink) < 1e30;
-            bool clear = hitBox(p, l, boxCentre - boxHalf - grow, boxCentre + boxHalf + grow) == std::numeric_limits<double>::infinity();
+            bool clear = hitBox(p, l, boxCentre - boxHalf - grow, boxCentre + boxHalf + grow) ==
+                         std::numeric_limits<double>::infinity();
             if (!blocked && !clear) continue;
             glm::dvec3 expected = cpuSun({0, 1, 0}, -d, l, ground, 0.0f, groundShininess, sunE);
             glm::dvec3 got = rgb(lit, x, y), gotOff = rgb(unshadowed, x, y);
@@ -360,7 +146,7 @@ TEST_F(Lighting, SphereMatchesCpuBrdfAndShAmbient) {
         SCOPED_TRACE(mat.name);
         SceneBuilder b(std::string("sphere_") + mat.name);
         b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(static_cast<float>(radius), 128, 64),
-                                                      b.material(mat.name, mat.base, mat.metallic, mat.shininess))));
+                                                     b.material(mat.name, mat.base, mat.metallic, mat.shininess))));
         b.camera({0.0f, 0.4f, 3.2f}, {0.0f, 0.0f, 0.0f}, 0.8f);
         b.sun({0.55f, 0.75f, 0.6f});
         auto glb = b.write();
@@ -369,8 +155,12 @@ TEST_F(Lighting, SphereMatchesCpuBrdfAndShAmbient) {
         nodes["direct"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", sunScale}}, false);
         nodes["full"] = lightingNode({{"sky_ambient", 1.0}, {"sun_scale", sunScale}}, false);
         auto out = runGraph(graph(nodes,
-                                  {{"direct", "direct.color"}, {"full", "full.color"}, {"spec", "full.specular_indirect"},
-                                   {"direct_spec", "direct.specular_indirect"}, {"sh", "sky.sh"}, {"normal", "gbuffer.normal"}},
+                                  {{"direct", "direct.color"},
+                                   {"full", "full.color"},
+                                   {"spec", "full.specular_indirect"},
+                                   {"direct_spec", "direct.specular_indirect"},
+                                   {"sh", "sky.sh"},
+                                   {"normal", "gbuffer.normal"}},
                                   W, H));
         const Image& sh = out.at("sh");
         const glm::dvec3 l = glm::normalize(rgb(sh, SKY_TEXEL_SUN_DIRECTION, 0));
@@ -394,7 +184,8 @@ TEST_F(Lighting, SphereMatchesCpuBrdfAndShAmbient) {
                 // relative error of a small value grows).
                 if (glm::dot(n, v) < 0.3 || glm::dot(n, l) < 0.2) continue;
                 ++samples;
-                glm::dvec3 gbufferN(shading::octDecode(glm::vec2(out.at("normal").at(x, y)[0], out.at("normal").at(x, y)[1])));
+                glm::dvec3 gbufferN(
+                    shading::octDecode(glm::vec2(out.at("normal").at(x, y)[0], out.at("normal").at(x, y)[1])));
                 worstNormal = std::max(worstNormal, std::acos(std::min(1.0, glm::dot(gbufferN, n))));
 
                 glm::dvec3 expected = cpuSun(n, v, l, mat.base, mat.metallic, mat.shininess, sunE);
@@ -422,12 +213,13 @@ TEST_F(Lighting, SphereMatchesCpuBrdfAndShAmbient) {
                 }
                 brightest = std::max(brightest, std::max(rgb(out.at("full"), x, y).r, rgb(out.at("full"), x, y).g));
             }
-        std::printf("%s: %d sphere pixels (brightest %.0f cd/m2), direct max relative error %.2g, ambient diffuse "
-                    "max error %.2g of the pixel (%.2g of itself), G-buffer normal max %.2g rad from the analytic one\n",
-                    mat.name, samples, brightest, worstDirect, worstAmbient, worstAmbientRel, worstNormal);
+        std::printf(
+            "%s: %d sphere pixels (brightest %.0f cd/m2), direct max relative error %.2g, ambient diffuse "
+            "max error %.2g of the pixel (%.2g of itself), G-buffer normal max %.2g rad from the analytic one\n",
+            mat.name, samples, brightest, worstDirect, worstAmbient, worstAmbientRel, worstNormal);
         EXPECT_GE(samples, 500);
         EXPECT_LT(brightest, 40000.0); // well below the shader's clamp (60000), so nothing measured is clipped
-        EXPECT_EQ(worstLeak, 0.0); // sky_ambient = 0: no indirect specular
+        EXPECT_EQ(worstLeak, 0.0);     // sky_ambient = 0: no indirect specular
     }
 }
 

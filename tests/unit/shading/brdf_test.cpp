@@ -1,12 +1,16 @@
 // BRDF checks with independent maths: the NDF's normalisation, the directional albedo of the
 // GGX-Smith lobe (F = 1) by a deterministic quadrature written here from Heitz's Lambda form of
-// the height-correlated masking, the pi convention, and the Toksvig mapping.
+// the height-correlated masking, the pi convention, Schlick's Fresnel against values worked out by
+// hand and against the exact Fresnel equations, the split-sum fit of deferred.comp against values
+// worked out by hand and the mirror limit, and the Toksvig mapping.
 #include "core/shading/brdf.hpp"
 #include "tests/unit/shading/furnace.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace vitrine::shading {
 namespace {
@@ -60,6 +64,86 @@ TEST(Brdf, DirectionalLightFollowsThePiConvention) {
     glm::vec3 M = shadeDirectional(n, n, n, glm::vec3(0.5f), 1.0f, 1.0f, glm::vec3(1.0f));
     EXPECT_NEAR(M.x, 0.5f * 0.25f, 1e-6f);
     EXPECT_EQ(roughnessFromShininess(0.8f), 1.0f - 0.8f);
+}
+
+// Exact unpolarised reflectance of a smooth dielectric of refractive index `ior` seen from air, at
+// cos(theta) = c: the mean of the s- and p-polarised Fresnel equations.
+double exactDielectricFresnel(double c, double ior) {
+    double sinT = std::sqrt(std::max(0.0, 1.0 - c * c)) / ior, cosT = std::sqrt(1.0 - sinT * sinT);
+    double rs = (c - ior * cosT) / (c + ior * cosT), rp = (cosT - ior * c) / (cosT + ior * c);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+TEST(Brdf, SchlickFresnelMatchesHandComputedValues) {
+    // 0.04 + 0.96 (1 - c)^5: (1 - c)^5 is 1e-5, 0.03125, 0.16807, 0.32768, 0.59049 at c = 0.9 .. 0.1.
+    struct Case {
+        float cosTheta;
+        float expected;
+    };
+    for (Case k : {Case{1.0f, 0.04f}, Case{0.9f, 0.0400096f}, Case{0.5f, 0.07f}, Case{0.3f, 0.2013472f},
+                   Case{0.2f, 0.3545728f}, Case{0.1f, 0.6068704f}, Case{0.0f, 1.0f}})
+        EXPECT_NEAR(schlickFresnel(glm::vec3(0.04f), k.cosTheta).y, k.expected, 1e-6f) << "cos " << k.cosTheta;
+    // Metal (copper-like F0) at c = 0.5: F0 + (1 - F0) 0.03125 per channel.
+    glm::vec3 metal = schlickFresnel(glm::vec3(0.95f, 0.64f, 0.54f), 0.5f);
+    EXPECT_NEAR(metal.x, 0.9515625f, 1e-6f);
+    EXPECT_NEAR(metal.y, 0.65125f, 1e-6f);
+    EXPECT_NEAR(metal.z, 0.554375f, 1e-6f);
+}
+
+TEST(Brdf, SchlickFresnelIsWithinItsApproximationErrorOfExactFresnelForIor15) {
+    // IOR 1.5 has F0 = (0.5 / 2.5)^2 = 0.04. Schlick's error (exponent 5) is at most 0.036 over the
+    // whole range and 6.5 % of the exact value for cos in [0.1, 0.3]; exponent 4 is off by 0.10 and by
+    // 17-30 % there, so the bounds (0.05 and 10 %) tell the two apart.
+    double worstAbs = 0.0, worstGrazing = 0.0;
+    for (int i = 0; i <= 100; ++i) {
+        double c = i / 100.0, exact = exactDielectricFresnel(c, 1.5);
+        double schlick = schlickFresnel(glm::vec3(0.04f), static_cast<float>(c)).x;
+        worstAbs = std::max(worstAbs, std::abs(schlick - exact));
+        EXPECT_NEAR(schlick, exact, 0.05) << "cos " << c;
+        if (c >= 0.1 && c <= 0.3) {
+            worstGrazing = std::max(worstGrazing, std::abs(schlick - exact) / exact);
+            EXPECT_NEAR(schlick, exact, 0.10 * exact) << "cos " << c;
+        }
+    }
+    std::printf("Schlick vs exact Fresnel (IOR 1.5): max error %.4f, %.3f of the exact value for cos in [0.1, 0.3]\n",
+                worstAbs, worstGrazing);
+}
+
+TEST(Brdf, GrazingDirectionalLightUsesSchlickAtTheHalfVector) {
+    // Black rough dielectric (alpha = 1), light and view mirrored about the normal at cos = 0.2, so
+    // h = n and VoH = NoV = NoL = 0.2: D = 1/pi, V = 0.5 / (NoL + NoV) = 1.25, F = 0.3545728 (above).
+    // Radiance for I = 1: D V F NoL pi = 1.25 x 0.3545728 x 0.2 = 0.0886432.
+    const float c = 0.2f, s = std::sqrt(1.0f - c * c);
+    glm::vec3 n(0, 0, 1), v(s, 0, c), l(-s, 0, c);
+    glm::vec3 L = shadeDirectional(n, v, l, glm::vec3(0.0f), 0.0f, 1.0f, glm::vec3(1.0f));
+    EXPECT_NEAR(L.y, 0.0886432f, 1e-5f);
+}
+
+TEST(Brdf, EnvBrdfApproxMatchesHandComputedValuesAndTheMirrorLimit) {
+    // Karis' fit worked out by hand: rr = r (-1, -0.0275, -0.572, 0.022) + (1, 0.0425, 1.04, -0.04),
+    // a004 = min(rr.x^2, 2^(-9.28 NoV)) rr.x + rr.y, (a, b) = (rr.z - 1.04 a004, rr.w + 1.04 a004).
+    struct Case {
+        float noV, roughness, a, b;
+    };
+    for (Case k : {// r = 0, NoV = 1: a004 = 2^-9.28 + 0.0425 = 0.0441086
+                   Case{1.0f, 0.0f, 0.9941271f, 0.0058729f},
+                   // r = 0.5, NoV = 0.5: rr = (0.5, 0.02875, 0.754, -0.029), 2^-4.64 = 0.0401071 < 0.25,
+                   // a004 = 0.0401071 x 0.5 + 0.02875 = 0.0488035
+                   Case{0.5f, 0.5f, 0.7032443f, 0.0217557f},
+                   // r = 1: rr.x = 0, so a004 = rr.y = 0.015 at any NoV
+                   Case{0.3f, 1.0f, 0.4524f, -0.0024f}}) {
+        glm::vec2 ab = envBrdfApprox(k.noV, k.roughness);
+        EXPECT_NEAR(ab.x, k.a, 1e-6f) << "NoV " << k.noV << " r " << k.roughness;
+        EXPECT_NEAR(ab.y, k.b, 1e-6f) << "NoV " << k.noV << " r " << k.roughness;
+    }
+    // A perfect mirror reflects F(NoV) of the incoming light, so with Schlick's F the split sum is
+    // a = 1 - (1 - NoV)^5, b = (1 - NoV)^5 exactly; the fit keeps a + b = 1 and follows b within 0.045.
+    for (int i = 0; i <= 20; ++i) {
+        float noV = i / 20.0f;
+        glm::vec2 ab = envBrdfApprox(noV, 0.0f);
+        EXPECT_NEAR(ab.x + ab.y, 1.0f, 1e-6f) << "NoV " << noV;
+        EXPECT_NEAR(ab.y, std::pow(1.0f - noV, 5.0f), 0.05f) << "NoV " << noV;
+    }
 }
 
 TEST(Brdf, ToksvigWidensTheLobeByTheNormalVariance) {

@@ -1,0 +1,230 @@
+// lighting.deferred term by term against core/shading's CPU maths: the sun's specular at grazing
+// half-vector angles (where Schlick's Fresnel is far from F0), and, under a uniform coloured sky, the
+// indirect specular (split-sum fit), the diffuse ambient with vertex AO and cavity, and the emissive
+// channel, each compared with its own CPU value. Tolerances are absolute or relative to the CPU value,
+// never to what the GPU produced.
+#include "tests/gpu/lighting_scene.hpp"
+
+#include "core/image/io.hpp"
+#include "core/shading/brdf.hpp"
+#include "core/shading/sh.hpp"
+#include "shaders/sky/sky.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+using namespace lighting;
+
+class LightingTerms : public GpuTest {};
+
+// A flat black dielectric ground lit by a sun 12° above the horizon in front of the camera: the glare
+// between camera and sun is the sun's mirror reflection, where VoH = sin((view elevation + 12°) / 2),
+// about 0.2 at its centre. Black base colour leaves the specular lobe alone, so each pixel is
+// D V F E NoL with F = Schlick's at VoH; Schlick's exponent 4 instead of 5 makes F 22-34 % larger at
+// VoH 0.2-0.3, no Fresnel (F = F0) 80 % smaller. The plane's normal is exact in the G-buffer and the
+// output is RGBA16F, so the measured error is ~3e-3: the bound is 2 % of the CPU value. The ground's
+// cavity (0.6) darkens the sun as well as the ambient (MUSEUM_SPEC §1), so the sun term carries it.
+TEST_F(LightingTerms, GrazingSunSpecularFollowsCpuSchlickFresnel) {
+    const int W = 64, H = 64;
+    const float shininess = 0.55f, cavity = 0.6f; // 153 / 255: exact in the UNORM8 G-buffer
+    const double sunElevation = 12.0 * kPi / 180.0;
+    // sun_scale keeps the glare (~14000 cd/m² after scaling and cavity) inside RGBA16F and the shader's clamp.
+    const double sunScale = 0.1;
+    const float groundHalf = 40.0f;
+
+    SceneBuilder b("grazing");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
+    uint32_t black = b.material("black", glm::vec3(0.0f), 0.0f, shininess);
+    b.s.materials[black].layers[0].cavity = {cavity, 0.0f};
+    b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, black)));
+    b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
+    b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
+    auto glb = b.write();
+
+    json nodes = baseNodes(glb);
+    nodes["direct"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", sunScale}}, false);
+    auto out = runGraph(graph(nodes, {{"direct", "direct.color"}, {"sh", "sky.sh"}}, W, H));
+    const Image& direct = out.at("direct");
+    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    ASSERT_GT(sunE.g, 100.0);
+
+    Pinhole cam(b.s, W, H);
+    int checked = 0, grazing = 0;
+    double worst = 0.0, worstGrazing = 0.0, minVoH = 1.0, brightest = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= 0.0) continue;
+            glm::dvec3 p = cam.position - cam.position.y / d.y * d;
+            if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue; // sky beyond
+            glm::dvec3 v = -d;
+            glm::dvec3 expected = cpuSun({0, 1, 0}, v, l, glm::vec3(0.0f), 0.0f, shininess, sunE) * double(cavity);
+            // Only where the lobe is bright enough for half precision to be far below the bound.
+            if (expected.g < 1.0) continue;
+            ++checked;
+            glm::dvec3 got = rgb(direct, x, y);
+            double e = relErr(got, expected);
+            worst = std::max(worst, e);
+            brightest = std::max(brightest, got.r);
+            double voH = glm::dot(v, glm::normalize(v + l));
+            if (voH <= 0.3) {
+                ++grazing;
+                minVoH = std::min(minVoH, voH);
+                worstGrazing = std::max(worstGrazing, e);
+            }
+            EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << " VoH " << voH << ": " << got.g << " vs " << expected.g;
+        }
+    std::printf("grazing sun: %d of %d ground pixels with VoH <= 0.3 (min %.3f, max relative error %.2g), all of "
+                "them max relative error %.2g, brightest %.0f cd/m2\n",
+                grazing, checked, minVoH, worstGrazing, worst, brightest);
+    EXPECT_GE(grazing, 300);
+    EXPECT_LT(minVoH, 0.22);
+    EXPECT_LT(brightest, 40000.0); // nothing measured is near the shader's clamp
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct SphereMaterial {
+    const char* name;
+    glm::vec3 base;
+    float metallic, shininess;
+    float vertexAo, cavity; // multiples of 1/255, so the UNORM8 G-buffer stores them exactly
+    glm::vec3 emissive;     // factor x strength, values R11G11B10 stores exactly
+    glm::dvec3 centre;
+};
+
+// A uniform sky whose red is 4x its blue (an equirect .exr, no sun in it), around three spheres: a
+// mirror metal (indirect specular is the cube map alone, so its colour shows directly), a rough
+// dielectric with vertex AO 0.6 and cavity 0.4, and a black emitter. Under a uniform sky the cube map
+// is C in every direction and the SH is C's constant term, so the CPU values are closed-form:
+// indirect specular (F0 a + b) C occlusion with (a, b) from the split-sum fit, diffuse albedo C
+// occlusion, emissive its G-buffer value x emissive_scale. Each is compared by itself:
+// `specular_indirect` against the CPU specular, a node with sky_ambient 0 against the CPU emissive,
+// and `color` against the CPU sum. Bounds, relative to the CPU value per channel: 2 % for terms that
+// depend on the interpolated normal of a 96 x 48 UV sphere (measured: at most 1 %) and RGBA16F output;
+// 0.5 % for the emissive, which passes through exactly representable values (measured: exact). The
+// sky's red/blue ratio of 4 makes a channel swap 4x off on the mirror; AO and cavity off multiply the
+// dielectric's ambient by 1.7 and 2.5.
+TEST_F(LightingTerms, IndirectSpecularOcclusionAndEmissiveMatchCpuUnderColouredSky) {
+    const int W = 128, H = 48;
+    const double radius = 0.5, emissiveScale = 2.5, skyIntensity = 200.0;
+    const glm::dvec3 skyColor = glm::dvec3(1.0, 0.5, 0.25) * skyIntensity;
+    const SphereMaterial materials[] = {
+        {"mirror_metal", glm::vec3(0.9f), 1.0f, 1.0f, 1.0f, 1.0f, glm::vec3(0.0f), {-1.1, 0.0, 0.0}},
+        {"occluded_dielectric", glm::vec3(0.6f), 0.0f, 0.6f, 0.6f, 0.4f, glm::vec3(0.0f), {0.0, 0.0, 0.0}},
+        {"emitter", glm::vec3(0.0f), 0.0f, 0.5f, 1.0f, 1.0f, glm::vec3(1.0f, 2.0f, 4.0f), {1.1, 0.0, 0.0}},
+    };
+
+    SceneBuilder b("coloured_sky");
+    for (const SphereMaterial& m : materials) {
+        uint32_t material = b.material(m.name, m.base, m.metallic, m.shininess);
+        b.s.materials[material].layers[0].cavity = {m.cavity, 0.0f};
+        // glTF's emissiveFactor is at most 1: the rest is KHR_materials_emissive_strength.
+        float strength = std::max({m.emissive.x, m.emissive.y, m.emissive.z, 1.0f});
+        b.s.materials[material].emissiveFactor = m.emissive / strength;
+        b.s.materials[material].emissiveStrength = strength;
+        std::vector<Tri> tris = sphereTris(static_cast<float>(radius), 96, 48);
+        for (Tri& t : tris)
+            t.a.color.a = t.b.color.a = t.c.color.a = m.vertexAo;
+        b.node(m.name, static_cast<int32_t>(b.mesh(m.name, tris, material)), glm::vec3(m.centre));
+    }
+    b.camera({0.0f, 0.0f, 4.0f}, {0.0f, 0.0f, 0.0f}, 0.35f);
+    auto glb = b.write();
+
+    Image sky(64, 32);
+    for (int y = 0; y < sky.height; ++y)
+        for (int x = 0; x < sky.width; ++x) {
+            float* p = sky.at(x, y);
+            p[0] = 1.0f, p[1] = 0.5f, p[2] = 0.25f, p[3] = 1.0f;
+        }
+    const auto skyFile = glb.parent_path() / "uniform_orange_sky.exr";
+    writeExr(skyFile, sky, ExrPixelType::Float);
+
+    json nodes = baseNodes(glb);
+    nodes["sky"] = {{"type", "sky.hdri"},
+                    {"params", {{"path", skyFile.string()}, {"intensity", skyIntensity}, {"size", 16}}}};
+    nodes["full"] = lightingNode({{"sky_ambient", 1.0}, {"emissive_scale", emissiveScale}}, false);
+    nodes["emit"] = lightingNode({{"sky_ambient", 0.0}, {"emissive_scale", emissiveScale}}, false);
+    auto out = runGraph(graph(
+        nodes, {{"full", "full.color"}, {"spec", "full.specular_indirect"}, {"emit", "emit.color"}, {"sh", "sky.sh"}},
+        W, H));
+    const Image& sh = out.at("sh");
+    const shading::Sh9 skySh = readSh(sh);
+    // The set-up itself: no sun found in a uniform sky, and its SH is the constant C.
+    ASSERT_EQ(glm::length(rgb(sh, SKY_TEXEL_SUN_ILLUMINANCE, 0)), 0.0);
+    for (glm::dvec3 dir : {glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0), glm::dvec3(0, -0.6, 0.8)})
+        ASSERT_LT(relErr(shading::shRadiance(skySh, dir), skyColor), 5e-3);
+
+    Pinhole cam(b.s, W, H);
+    int samples[3] = {0, 0, 0};
+    double worstSpec[3] = {0, 0, 0}, worstFull[3] = {0, 0, 0}, worstEmit[3] = {0, 0, 0}, worstBackground = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            int k = -1;
+            double t = 1e30;
+            for (int i = 0; i < 3; ++i) {
+                double ti = hitSphere(cam.position, d, materials[i].centre, radius);
+                if (ti > 0.0 && ti < t) t = ti, k = i;
+            }
+            if (k < 0) {
+                // The sky seen behind the spheres is the cube map itself.
+                double e = relErr(rgb(out.at("full"), x, y), skyColor);
+                worstBackground = std::max(worstBackground, e);
+                EXPECT_LT(e, 0.005) << "sky, pixel " << x << "," << y;
+                continue;
+            }
+            const SphereMaterial& m = materials[k];
+            glm::dvec3 n = glm::normalize(cam.position + t * d - m.centre), v = -d;
+            if (glm::dot(n, v) < 0.3) continue; // away from the silhouette
+            ++samples[k];
+
+            // CPU values, with the G-buffer's storage precision applied to the material inputs.
+            const glm::vec3 base = unorm8(m.base);
+            // The G-buffer writes the Toksvig-widened roughness: for an unfiltered normal that only floors
+            // it at sqrt(kMinGgxAlpha) = 0.045, which moves the mirror's fit by 2.5 %.
+            const double roughness = shading::toksvigRoughness(shading::roughnessFromShininess(m.shininess), 1.0f);
+            const double occlusion = unorm8(m.vertexAo) * unorm8(m.cavity);
+            const float noV = std::clamp(static_cast<float>(glm::dot(n, v)), 1e-4f, 1.0f);
+            const glm::dvec3 r = glm::reflect(-v, n);
+            glm::dvec3 skyR =
+                glm::mix(skyColor, glm::max(shading::shRadiance(skySh, r), 0.0), std::clamp(roughness * 2.0, 0.0, 1.0));
+            glm::vec2 ab = shading::envBrdfApprox(noV, static_cast<float>(roughness));
+            glm::dvec3 specular =
+                (glm::dvec3(shading::specularF0(base, m.metallic)) * double(ab.x) + double(ab.y)) * skyR * occlusion;
+            glm::dvec3 diffuse = glm::dvec3(shading::diffuseAlbedo(base, m.metallic)) *
+                                 glm::max(shading::shIrradiance(skySh, n), 0.0) / kPi * occlusion;
+            glm::dvec3 emissive = glm::dvec3(m.emissive) * emissiveScale;
+
+            double es = relErr(rgb(out.at("spec"), x, y), specular);
+            double ef = relErr(rgb(out.at("full"), x, y), specular + diffuse + emissive);
+            worstSpec[k] = std::max(worstSpec[k], es);
+            worstFull[k] = std::max(worstFull[k], ef);
+            EXPECT_LT(es, 0.02) << m.name << " indirect specular, pixel " << x << "," << y << ": "
+                                << rgb(out.at("spec"), x, y).r << " vs " << specular.r;
+            EXPECT_LT(ef, 0.02) << m.name << " colour, pixel " << x << "," << y << ": " << rgb(out.at("full"), x, y).r
+                                << " vs " << (specular + diffuse + emissive).r;
+            // sky_ambient 0 and no sun: only the emissive is left.
+            glm::dvec3 emitted = rgb(out.at("emit"), x, y);
+            double ee = glm::length(emissive) > 0.0 ? relErr(emitted, emissive) : glm::length(emitted);
+            worstEmit[k] = std::max(worstEmit[k], ee);
+            EXPECT_LT(ee, 0.005) << m.name << " emissive, pixel " << x << "," << y << ": " << emitted.r << ","
+                                 << emitted.g << "," << emitted.b;
+        }
+    for (int k = 0; k < 3; ++k) {
+        std::printf("%s: %d pixels, indirect specular max relative error %.2g, colour %.2g, emissive alone %.2g\n",
+                    materials[k].name, samples[k], worstSpec[k], worstFull[k], worstEmit[k]);
+        EXPECT_GE(samples[k], 300) << materials[k].name;
+    }
+    std::printf("sky behind the spheres: max relative error %.2g\n", worstBackground);
+}
+
+} // namespace
+} // namespace vitrine::test
