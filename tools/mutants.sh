@@ -124,6 +124,11 @@ while IFS= read -r line || [ -n "$line" ]; do
     fi
     restore
 
+    # A regex that selects no test is a broken entry, not a catch (ctest fails with --no-tests=error).
+    if tac "$log" | sed -n '1,/^=== /p' | grep -q "No tests were found"; then
+        echo "BROKEN  $first: /$tests/ selects no test ($what)"
+        broken=$((broken + 1)); continue
+    fi
     if [ $status -ne 0 ]; then
         caught=$((caught + 1))
         failed=$(tac "$log" | sed -n '1,/^=== /p' | grep -oE '^\s*[0-9]+ - [^ ]+' | awk '{print $3}' | sort -u |

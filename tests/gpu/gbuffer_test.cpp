@@ -687,6 +687,42 @@ TEST_F(Gbuffer, SphereNormalsDecodeToAnalyticNormals) {
     EXPECT_LT(worstDepth, 4e-3); // half float at 2..4 m (step 2^-9 = 2e-3, truncated) plus the facets' sag
 }
 
+// A double-sided quad seen from behind: glTF shades a back face with the normal reversed, so the G-buffer
+// normal faces the camera (its vertex normal points away), and a single-sided copy of it is culled.
+TEST_F(Gbuffer, BackFacesOfDoubleSidedMaterialsFaceTheViewer) {
+    SceneBuilder b;
+    sc::Material twoSided = singleLayer(0.5f);
+    twoSided.doubleSided = true;
+    b.s.materials.push_back(twoSided);
+    b.s.materials.push_back(singleLayer(0.5f));
+    // Turned half a turn about Y, the quads' front faces point to -Z, away from the camera at the origin that
+    // looks down -Z: it sees their backs.
+    const glm::quat away = glm::angleAxis(3.14159265f, glm::vec3(0, 1, 0));
+    b.node("two_sided", b.mesh("two_sided", quadVertices(1.0f, {0, 0}, {1, 1}), kQuadIndices, 0), at({-1.2f, 0, -4}, away));
+    b.node("one_sided", b.mesh("one_sided", quadVertices(1.0f, {0, 0}, {1, 1}), kQuadIndices, 1), at({1.2f, 0, -4}, away));
+    b.cameraPath("look", 0.8f, {{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
+    const int w = 64, h = 32;
+    auto out = runGraph(gbufferGraph(b.write("back_faces"), w, h, json::object(), json::object()));
+    int twoSidedPixels = 0, oneSidedPixels = 0, facingViewer = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (out["depth"].at(x, y)[0] <= 0.0f) continue;
+            if (x < w / 2) {
+                ++twoSidedPixels;
+                const float* g = out["normal"].at(x, y);
+                // The camera is at the origin looking down -Z: a normal facing it has z > 0 in world space.
+                if (octDecode(g[0], g[1]).z > 0.99) ++facingViewer;
+            } else {
+                ++oneSidedPixels;
+            }
+        }
+    std::printf("back faces: %d double-sided pixels (%d facing the viewer), %d single-sided pixels drawn\n",
+                twoSidedPixels, facingViewer, oneSidedPixels);
+    EXPECT_GT(twoSidedPixels, 100);
+    EXPECT_EQ(facingViewer, twoSidedPixels);
+    EXPECT_EQ(oneSidedPixels, 0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // 4. Toksvig through the G-buffer
 
