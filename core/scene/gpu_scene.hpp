@@ -81,6 +81,11 @@ public:
     // Binding 0: the scene's Vertex (72 bytes): position, normal, tangent, uv0, uv1, color at locations 0-5.
     static std::vector<VkVertexInputBindingDescription> vertexBindings();
     static std::vector<VkVertexInputAttributeDescription> vertexAttributes();
+    // The vertex buffer (scene::Vertex, 72 bytes: 18 floats) and index buffer (uint32, relative to the
+    // primitive's vertexOffset), also storage buffers: a ray tracer fetches a hit's vertices from them
+    // (GpuBvhPrimitive, shaders/accel/bvh.h).
+    const GpuBuffer& vertexBuffer() const { return mVertices; }
+    const GpuBuffer& indexBuffer() const { return mIndices; }
     // Binds the vertex and index buffers. Then drawIndexed(cmd, draw) per draw.
     void bindGeometry(VkCommandBuffer cmd) const;
     void drawIndexed(VkCommandBuffer cmd, const GpuDraw& draw) const;

@@ -2,6 +2,7 @@
 // every triangle: the same triangle at the same t; watertightness on closed meshes; the dynamic level
 // following the pose; the BVH through the bake cache.
 #include "tests/unit/accel/accel_scenes.hpp"
+#include "tests/unit/accel/compare_hits.hpp"
 
 #include "core/scene/museum.hpp"
 
@@ -16,58 +17,11 @@ namespace {
 
 using namespace test;
 
-constexpr float kRelT = 1e-5f;
-
-bool closeT(float a, float b) {
-    return std::abs(a - b) <= kRelT * std::max(std::abs(a), std::abs(b));
-}
-
-// Compares BVH closest hits with brute force over the same rays. A different triangle at the same t is a
-// tie (shared edge, coplanar overlap) when brute force's own test also hits the BVH's triangle at that t
-// or the two triangles share a vertex; ties must stay rare.
-void expectSameHits(const SceneBvh& bvh, std::span<const GpuBvhInstance> top, const WorldTriangles& w,
-                    const std::vector<Ray>& rays, size_t& hits, size_t& ties) {
-    std::map<std::tuple<uint32_t, uint32_t, uint32_t>, uint32_t> indexOf;
-    for (uint32_t i = 0; i < w.refs.size(); ++i)
-        indexOf[{w.refs[i].instance, w.refs[i].primitive, w.refs[i].triangle}] = i;
-    size_t failures = 0;
-    hits = ties = 0;
-    for (size_t i = 0; i < rays.size() && failures < 10; ++i) {
-        const Ray& r = rays[i];
-        Hit h = traceClosest(bvh.arrays(), top, r);
-        BruteHit b = bruteForce(w, r);
-        ASSERT_EQ(h.valid(), b.valid()) << "ray " << i << ": BVH t " << h.t << ", brute force t " << b.t;
-        if (!b.valid()) continue;
-        ++hits;
-        GpuBvhTriangleRef ref = bvh.arrays().refs[h.triangle];
-        ref.instance = h.instance;
-        EXPECT_TRUE(closeT(h.t, b.t)) << "ray " << i << ": BVH t " << h.t << ", brute force t " << b.t;
-        if (sameSource(ref, w.refs[b.index])) continue;
-        auto it = indexOf.find({ref.instance, ref.primitive, ref.triangle});
-        ASSERT_NE(it, indexOf.end()) << "ray " << i << ": the BVH hit a triangle brute force does not know";
-        const glm::vec3* tb = &w.v[3 * b.index];
-        const glm::vec3* th = &w.v[3 * it->second];
-        bool sharesVertex = false;
-        for (int x = 0; x < 3; ++x)
-            for (int y = 0; y < 3; ++y)
-                sharesVertex = sharesVertex || tb[x] == th[y];
-        TraversalRay tr(r.origin, r.direction);
-        float t;
-        glm::vec2 uv;
-        bool alsoHit =
-            tr.intersectTriangle(th[0], th[1], th[2], r.tmin, std::numeric_limits<float>::infinity(), t, uv) &&
-            closeT(t, b.t);
-        if (closeT(h.t, b.t) && (alsoHit || sharesVertex)) {
-            ++ties;
-        } else {
-            ++failures;
-            ADD_FAILURE() << "ray " << i << ": BVH hit instance " << ref.instance << " primitive " << ref.primitive
-                          << " triangle " << ref.triangle << " at t " << h.t << "; brute force instance "
-                          << w.refs[b.index].instance << " primitive " << w.refs[b.index].primitive << " triangle "
-                          << w.refs[b.index].triangle << " at t " << b.t;
-        }
-    }
-    EXPECT_LE(ties, rays.size() / 100) << "too many ties";
+std::vector<Hit> traceAll(const SceneBvh& bvh, std::span<const GpuBvhInstance> top, const std::vector<Ray>& rays) {
+    std::vector<Hit> hits;
+    for (const Ray& r : rays)
+        hits.push_back(traceClosest(bvh.arrays(), top, r));
+    return hits;
 }
 
 TEST(BvhTraversal, ClosestHitMatchesBruteForceOnRandomSoup) {
@@ -79,7 +33,7 @@ TEST(BvhTraversal, ClosestHitMatchesBruteForceOnRandomSoup) {
     box.expand(box.max + 0.5f);
     std::vector<Ray> rays = randomRays(w, box, 20000, 5);
     size_t hits, ties;
-    expectSameHits(bvh, bvh.topLevel({}), w, rays, hits, ties);
+    expectSameHits(bvh, w, rays, traceAll(bvh, bvh.topLevel({}), rays), hits, ties);
     EXPECT_GT(hits, rays.size() / 2);
     std::printf("soup: %zu rays, %zu hits, %zu ties\n", rays.size(), hits, ties);
 }
@@ -120,7 +74,7 @@ TEST_F(MuseumBvh, ClosestHitMatchesBruteForceWithTheRobotPosed) {
         rays.push_back(r);
     }
     size_t hits, ties;
-    expectSameHits(*sBvh, sBvh->topLevel(pose), w, rays, hits, ties);
+    expectSameHits(*sBvh, w, rays, traceAll(*sBvh, sBvh->topLevel(pose), rays), hits, ties);
     EXPECT_GT(hits, rays.size() / 2);
     std::printf("museum: %zu rays, %zu hits, %zu ties\n", rays.size(), hits, ties);
 }
