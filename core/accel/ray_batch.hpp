@@ -26,7 +26,7 @@ public:
         std::vector<gpu_types::GpuRayHit> hits; // one per ray, same order
         double gpuMs = 0.0;                     // the dispatch alone (timestamps)
     };
-    // Closest hits, or any hit (anyHit: id.x is some hit's triangle, not necessarily the nearest). Waits.
+    // Closest hits, or occlusion (anyHit: bvhTraceAny; id.x is 0 when occluded, else VITRINE_BVH_NONE). Waits.
     Result trace(const GpuBvh& bvh, std::span<const gpu_types::GpuRay> rays, bool anyHit = false);
 
 private:

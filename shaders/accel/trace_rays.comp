@@ -14,15 +14,16 @@ void main() {
     uint index = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * push.rowWidth;
     if (index >= push.rayCount) return;
     GpuRay ray = rays[index];
-    BvhHit hit;
-    bool found;
-    if (push.anyHit != 0u) {
-        found = bvhTrace(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, true, hit);
-    } else {
-        found = bvhTraceClosest(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, hit);
-    }
     GpuRayHit h;
-    h.hit = vec4(found ? hit.t : uintBitsToFloat(0x7f800000u), hit.barycentrics, 0.0);
-    h.id = uvec4(hit.triangle, hit.instance, 0u, 0u);
+    if (push.anyHit != 0u) {
+        bool occluded = bvhTraceAny(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w);
+        h.hit = vec4(occluded ? 0.0 : uintBitsToFloat(0x7f800000u), 0.0, 0.0, 0.0);
+        h.id = uvec4(occluded ? 0u : VITRINE_BVH_NONE, VITRINE_BVH_NONE, 0u, 0u);
+    } else {
+        BvhHit hit;
+        bool found = bvhTraceClosest(ray.origin.xyz, ray.direction.xyz, ray.origin.w, ray.direction.w, hit);
+        h.hit = vec4(found ? hit.t : uintBitsToFloat(0x7f800000u), hit.barycentrics, 0.0);
+        h.id = uvec4(hit.triangle, hit.instance, 0u, 0u);
+    }
     hits[index] = h;
 }

@@ -20,7 +20,7 @@ struct GpuRayHit {
 
 VITRINE_PUSH_BEGIN(TraceRaysPush)
     uint rayCount;
-    uint anyHit;   // 1: stop at the first hit (id.x is that hit's triangle, hit.x its t)
+    uint anyHit;   // 1: bvhTraceAny (shadow rays): id.x is 0 when something is hit, else VITRINE_BVH_NONE
     uint rowWidth; // rays per row of the dispatch grid: index = x + y * rowWidth
     uint pad;
 VITRINE_PUSH_END(push)
