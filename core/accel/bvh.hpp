@@ -28,6 +28,9 @@ struct BvhBuildOptions {
     uint32_t maxLeafSize = 4; // triangles; SAH may stop splitting below it
     // SAH cost of one node visit (two box tests) relative to one triangle test.
     float traversalCost = 1.0f;
+    // Levels of nodes at most, <= kMaxDepth (the traversal stack). Binned SAH stays far below it on real
+    // scenes (the museum: 24); subtrees that would go deeper switch to object-median splits.
+    uint32_t maxDepth = kMaxDepth;
 
     bool operator==(const BvhBuildOptions&) const = default;
 };
@@ -100,7 +103,7 @@ struct BvhArrays {
 
 // Builds a bottom level over triangles with a binned SAH (centroid bins on all three axes) and appends it
 // to out. Triangles go to out in leaf order, each exactly once; degenerate ones are kept (they never hit).
-// Depth stays within kMaxDepth: deep subtrees switch to object-median splits.
+// Depth stays within options.maxDepth: deep subtrees switch to object-median splits.
 BvhBottomLevel buildBottomLevel(std::span<const BvhBuildTriangle> triangles, const BvhBuildOptions& options,
                                 BvhArrays& out);
 

@@ -28,8 +28,10 @@ class Builder {
 public:
     Builder(std::span<const BvhBuildTriangle> triangles, const BvhBuildOptions& options, BvhArrays& out)
         : mTriangles(triangles), mOptions(options), mOut(out) {
-        if (options.bins < 2 || options.bins > 256 || options.maxLeafSize < 1)
-            throw InternalError("BVH build: bins must be in [2, 256] and maxLeafSize at least 1");
+        if (options.bins < 2 || options.bins > 256 || options.maxLeafSize < 1 || options.maxDepth < 1 ||
+            options.maxDepth > kMaxDepth)
+            throw InternalError("BVH build: bins must be in [2, 256], maxLeafSize at least 1, maxDepth in [1, " +
+                                std::to_string(kMaxDepth) + "]");
         mBinBoxes.resize(options.bins);
         mBinCounts.resize(options.bins);
         mRightCost.resize(options.bins);
@@ -73,8 +75,9 @@ public:
         level.triangleCount = n;
         level.depth = mMaxDepth;
         level.sahCost = mCost;
-        if (mMaxDepth > kMaxDepth)
-            throw InternalError("BVH build: depth " + std::to_string(mMaxDepth) + " exceeds the traversal stack");
+        if (mMaxDepth > mOptions.maxDepth)
+            throw InternalError("BVH build: depth " + std::to_string(mMaxDepth) + " exceeds " +
+                                std::to_string(mOptions.maxDepth));
         return level;
     }
 
@@ -163,9 +166,10 @@ private:
         const uint32_t n = end - begin;
         if (n == 1) return leaf(begin, end, box);
         uint32_t mid;
-        // Median splits at least halve n per level, so depth + bit_width(n) never grows past kMaxDepth.
-        if (depth + static_cast<uint32_t>(std::bit_width(n)) >= kMaxDepth) {
-            if (n <= mOptions.maxLeafSize) return leaf(begin, end, box);
+        // Median splits at least halve n per level, so depth + bit_width(n) stops growing once they take
+        // over; only a maxDepth below log2 of the triangle count leaves leaves bigger than maxLeafSize.
+        if (depth + static_cast<uint32_t>(std::bit_width(n)) >= mOptions.maxDepth) {
+            if (n <= mOptions.maxLeafSize || depth > mOptions.maxDepth) return leaf(begin, end, box);
             mid = medianSplit(begin, end, centroids);
         } else {
             Split split = findSplit(begin, end, centroids);

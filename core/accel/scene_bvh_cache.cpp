@@ -18,8 +18,8 @@ struct Header {
     uint64_t sceneHash;
     uint32_t bins, maxLeafSize;
     float traversalCost;
+    uint32_t maxDepth;
     uint32_t nodes, triangles, refs, primitives, levels, dynamics;
-    uint32_t pad;
 };
 static_assert(sizeof(Header) == 56);
 
@@ -49,6 +49,7 @@ BakeKey SceneBvh::cacheKey(const scene::Scene& scene, const BvhBuildOptions& opt
     h.value(options.bins);
     h.value(options.maxLeafSize);
     h.value(options.traversalCost);
+    h.value(options.maxDepth);
     return {"bvh", h.result()};
 }
 
@@ -60,6 +61,7 @@ std::vector<uint8_t> SceneBvh::serialize() const {
     h.bins = mOptions.bins;
     h.maxLeafSize = mOptions.maxLeafSize;
     h.traversalCost = mOptions.traversalCost;
+    h.maxDepth = mOptions.maxDepth;
     h.nodes = static_cast<uint32_t>(mArrays.nodes.size());
     h.triangles = static_cast<uint32_t>(mArrays.triangles.size());
     h.refs = static_cast<uint32_t>(mArrays.refs.size());
@@ -84,7 +86,7 @@ std::optional<SceneBvh> SceneBvh::deserialize(std::span<const uint8_t> bytes) {
     if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.version != kVersion) return std::nullopt;
     SceneBvh bvh;
     bvh.mSceneHash = h.sceneHash;
-    bvh.mOptions = {h.bins, h.maxLeafSize, h.traversalCost};
+    bvh.mOptions = {h.bins, h.maxLeafSize, h.traversalCost, h.maxDepth};
     size_t offset = sizeof h;
     if (!take(bytes, offset, h.nodes, bvh.mArrays.nodes) || !take(bytes, offset, h.triangles, bvh.mArrays.triangles) ||
         !take(bytes, offset, h.refs, bvh.mArrays.refs) || !take(bytes, offset, h.primitives, bvh.mPrimitives) ||

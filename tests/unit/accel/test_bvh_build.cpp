@@ -166,7 +166,7 @@ TEST(BvhBuild, InputsThatDefeatSahStayWithinTheStack) {
         for (uint32_t k = 0; k < 3; ++k)
             same.indices.push_back(3 * i + k);
     }
-    // Triangles at geometrically growing distances: SAH peels one off per level, a list 300 deep.
+    // Triangles at geometrically growing distances: most centroids fall into one bin at every level.
     IndexedMesh chain;
     for (uint32_t i = 0; i < 300; ++i) {
         float x = std::pow(1.2f, static_cast<float>(i));
@@ -188,6 +188,18 @@ TEST(BvhBuild, InputsThatDefeatSahStayWithinTheStack) {
         checkSceneBvh(s, bvh);
         EXPECT_LE(bvh.levels()[0].depth, kMaxDepth);
     }
+}
+
+TEST(BvhBuild, DepthLimitSwitchesToMedianSplits) {
+    // Real scenes never come near the traversal stack's 64 levels (binned SAH keeps even the inputs above
+    // under 30), so the limit is exercised with a low one: 6000 triangles in at most 9 levels.
+    scene::Scene s = randomSoup(6000, 5);
+    BvhBuildOptions shallow;
+    shallow.maxDepth = 9;
+    SceneBvh bvh = SceneBvh::build(s, shallow);
+    checkSceneBvh(s, bvh);
+    EXPECT_LE(bvh.levels()[0].depth, 9u);
+    EXPECT_GT(SceneBvh::build(s).levels()[0].depth, 9u);
 }
 
 TEST(BvhBuild, TinyInputs) {
