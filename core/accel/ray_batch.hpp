@@ -2,7 +2,7 @@
 
 // Traces a batch of rays from the host through a GpuBvh with one compute dispatch
 // (shaders/accel/trace_rays.comp) and reads the hits back, with the dispatch's GPU time from timestamp
-// queries. For tests (GPU traversal against the CPU), `vitrine bench --bvh` and bakers whose rays start
+// queries and on the host. For tests (GPU traversal against the CPU), `vitrine bench --bvh` and bakers whose rays start
 // on the CPU; a render pass traces from its own shader through shaders/accel/bvh.glsl instead.
 
 #include "core/accel/gpu_bvh.hpp"
@@ -24,7 +24,8 @@ public:
 
     struct Result {
         std::vector<gpu_types::GpuRayHit> hits; // one per ray, same order
-        double gpuMs = 0.0;                     // the dispatch alone (timestamps)
+        double gpuMs = 0.0;  // the dispatch alone, by timestamp queries (not trustworthy on lavapipe)
+        double wallMs = 0.0; // its submission, from vkQueueSubmit until the fence signalled (host clock)
     };
     // Closest hits, or occlusion (anyHit: bvhTraceAny; id.x is 0 when occluded, else VITRINE_BVH_NONE). Waits.
     Result trace(const GpuBvh& bvh, std::span<const gpu_types::GpuRay> rays, bool anyHit = false);

@@ -13,6 +13,9 @@
 #include "tests/unit/accel/compare_hits.hpp"
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
 
 namespace vitrine::test {
 namespace {
@@ -229,6 +232,45 @@ TEST_F(GpuBvhTest, DynamicInstanceFollowsThePose) {
             EXPECT_NEAR(hits[i].t, expected[i], 1e-5f) << "t = " << time << ", ray " << i;
             EXPECT_EQ(hits[i].instance == boxInstance, expected[i] == 3.0f) << "t = " << time << ", ray " << i;
         }
+    }
+}
+
+// `vitrine bench --bvh` on the museum graph at a tiny size: it runs clean under validation and reports the
+// BVH (nodes, memory, cache) and one primary ray per pixel with a bounce ray per primary hit.
+TEST(GpuBvhBench, ReportsTheMuseumBvh) {
+    const std::filesystem::path out = std::filesystem::path(VITRINE_TEST_OUT) / "bench_bvh.json";
+    std::filesystem::create_directories(out.parent_path());
+    std::filesystem::remove(out);
+    const std::string command = std::string(VITRINE_BINARY) + " bench " + VITRINE_SOURCE_DIR +
+                                "/graphs/museum.json --frames 1 --warmup 0 --bvh --validate --quiet --json " +
+                                out.string() +
+                                " --set frame.width=64 --set frame.height=36 --set scene.params.texture_size=16"
+                                " --set shadow.params.resolution=256 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buffer[4096];
+    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+        output.append(buffer, n);
+    const int status = pclose(pipe);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+    std::ifstream in(out);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    ASSERT_EQ(j.at("bvh").size(), 1u);
+    const nlohmann::json& b = j["bvh"][0];
+    EXPECT_GT(b.at("triangles").get<size_t>(), 100000u);
+    EXPECT_GT(b.at("nodes").get<size_t>(), b["triangles"].get<size_t>() / 8);
+    EXPECT_GE(b.at("dynamic_instances").get<size_t>(), 7u); // the robot's parts
+    EXPECT_GT(b.at("gpu_bytes").get<size_t>(), b["triangles"].get<size_t>() * 48);
+    EXPECT_GT(b.at("build_ms").get<double>(), 0.0);
+    EXPECT_GT(b.at("cache_load_ms").get<double>(), 0.0);
+    EXPECT_TRUE(std::filesystem::exists(b.at("cache_file").get<std::string>()));
+    EXPECT_EQ(b.at("primary").at("rays").get<size_t>(), 64u * 36u);
+    EXPECT_GT(b["primary"].at("hits").get<size_t>(), 64u * 36u * 9 / 10);
+    EXPECT_EQ(b.at("incoherent").at("rays").get<size_t>(), b["primary"]["hits"].get<size_t>());
+    for (const char* kind : {"primary", "incoherent"}) {
+        EXPECT_GT(b[kind].at("wall_ms").get<double>(), 0.0) << kind;
+        EXPECT_GT(b[kind].at("cpu_rays_per_s").get<double>(), 0.0) << kind;
     }
 }
 
