@@ -1,5 +1,8 @@
 #include "core/scene/gpu_scene.hpp"
 
+#include "core/accel/gpu_bvh.hpp"
+#include "core/accel/scene_bvh.hpp"
+#include "core/bake/cache.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
@@ -30,6 +33,33 @@ gpu_types::GpuCamera CameraFrame::gpu() const {
     c.jitter = {jitter, prevJitter};
     c.time = {static_cast<float>(time), static_cast<float>(frame), 0.0f, 0.0f};
     return c;
+}
+
+SceneObject::SceneObject(std::shared_ptr<const scene::Scene> scene) : mScene(std::move(scene)) {}
+
+SceneObject::~SceneObject() = default;
+
+void SceneObject::releaseGpu() {
+    mGpuBvh.reset();
+    mGpu.reset();
+}
+
+GpuBvh& SceneObject::bvh(Context& ctx) {
+    if (!mGpuBvh) {
+        if (!mBvh) {
+            accel::SceneBvh::CacheStatus status;
+            mBvh = std::make_unique<accel::SceneBvh>(accel::SceneBvh::loadOrBuild(*mScene, BakeCache(defaultCacheDir()), {}, &status));
+            mBvhFromCache = status.fromCache;
+            if (status.fromCache) logInfo("scene '" + mScene->name + "': BVH loaded from the bake cache");
+            else logInfo("scene '" + mScene->name + "': BVH built in " + std::to_string(static_cast<int>(mBvh->buildMs())) + " ms");
+            if (!status.fromCache && !status.stored)
+                logWarning("scene '" + mScene->name + "': could not write the BVH to the bake cache under " +
+                           defaultCacheDir().string());
+        }
+        mGpuBvh = std::make_unique<GpuBvh>(ctx, *mBvh, mScene->name);
+        mGpuBvh->update(pose);
+    }
+    return *mGpuBvh;
 }
 
 GpuScene& SceneObject::gpu() const {

@@ -7,6 +7,7 @@
 
 #include "core/accel/gpu_bvh.hpp"
 #include "core/accel/ray_batch.hpp"
+#include "core/scene/gpu_scene.hpp"
 #include "core/scene/museum.hpp"
 #include "core/shader/compiler.hpp"
 #include "tests/unit/accel/accel_scenes.hpp"
@@ -201,9 +202,10 @@ TEST_F(GpuBvhTest, NoRayLeaksThroughEdgesOfAMovingCube) {
     expectWatertight(mTracer, s, s.evaluate(0.5), {1.0f, 0.5f, 0.0f}, 0.5f, 23);
 }
 
-TEST_F(GpuBvhTest, DynamicInstanceFollowsThePose) {
-    // A static floor and a box that moves 4 m along +x between t = 0 and t = 1; rays straight down.
+// A static floor and a box that moves 4 m along +x between t = 0 and t = 1.
+scene::Scene floorAndMovingBox() {
     scene::Scene s;
+    s.name = "mover";
     IndexedMesh floor;
     floor.positions = {{-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}};
     floor.indices = {0, 2, 1, 0, 3, 2};
@@ -211,16 +213,27 @@ TEST_F(GpuBvhTest, DynamicInstanceFollowsThePose) {
     uint32_t box = addRootNode(s, "box", addMesh(s, "box", tessellatedCube(2)), transform({0, 1, 0}));
     animateTranslation(s, box, {0, 1, 0}, {4, 1, 0});
     s.finalize();
-    SceneBvh bvh = SceneBvh::build(s);
-    GpuBvh gpuBvh(gpu(), bvh, "mover");
-    const uint32_t boxInstance = bvh.dynamicInstances().at(0).instance;
+    return s;
+}
+
+// Rays straight down from y = 5 at these x (z = 0.2).
+std::vector<Ray> downAt(std::initializer_list<float> xs) {
     std::vector<Ray> rays;
-    for (float x : {0.0f, 1.0f, 4.0f, 5.5f}) {
+    for (float x : xs) {
         Ray r;
         r.origin = {x, 5.0f, 0.2f};
         r.direction = {0.0f, -1.0f, 0.0f};
         rays.push_back(r);
     }
+    return rays;
+}
+
+TEST_F(GpuBvhTest, DynamicInstanceFollowsThePose) {
+    scene::Scene s = floorAndMovingBox();
+    SceneBvh bvh = SceneBvh::build(s);
+    GpuBvh gpuBvh(gpu(), bvh, "mover");
+    const uint32_t boxInstance = bvh.dynamicInstances().at(0).instance;
+    const std::vector<Ray> rays = downAt({0.0f, 1.0f, 4.0f, 5.5f});
     // Expected t per ray: 3 on the box's top (y = 2), 5 on the floor.
     const std::vector<std::pair<double, std::vector<float>>> cases = {
         {0.0, {3, 5, 5, 5}}, {0.25, {3, 3, 5, 5}}, {1.0, {5, 5, 3, 5}}};
@@ -233,6 +246,30 @@ TEST_F(GpuBvhTest, DynamicInstanceFollowsThePose) {
             EXPECT_EQ(hits[i].instance == boxInstance, expected[i] == 3.0f) << "t = " << time << ", ray " << i;
         }
     }
+}
+
+TEST_F(GpuBvhTest, SceneObjectUploadsItsBvhPosedAndCachesIt) {
+    // What a ray-tracing pass gets from its scene port: the BVH, posed at the frame it first asked in.
+    auto s = std::make_shared<scene::Scene>(floorAndMovingBox());
+    SceneObject first(s);
+    first.pose = s->evaluate(1.0);
+    EXPECT_FALSE(first.hasBvh());
+    GpuBvh& bvh = first.bvh(gpu());
+    EXPECT_TRUE(first.hasBvh());
+    EXPECT_EQ(&first.bvh(gpu()), &bvh);
+    std::vector<Hit> hits = trace(bvh, downAt({0.0f, 4.0f}));
+    EXPECT_NEAR(hits[0].t, 5.0f, 1e-5f); // floor where the box was at t = 0
+    EXPECT_NEAR(hits[1].t, 3.0f, 1e-5f); // the box's top, at x = 4 at t = 1
+    first.pose = s->evaluate(0.0);
+    bvh.update(first.pose); // what the scene node does every frame
+    hits = trace(bvh, downAt({0.0f, 4.0f}));
+    EXPECT_NEAR(hits[0].t, 3.0f, 1e-5f);
+    EXPECT_NEAR(hits[1].t, 5.0f, 1e-5f);
+
+    // Another run (another object) loads the same BVH from the bake cache instead of building it.
+    SceneObject second(s);
+    second.bvh(gpu());
+    EXPECT_TRUE(second.bvhFromCache());
 }
 
 // `vitrine bench --bvh` on the museum graph at a tiny size: it runs clean under validation and reports the
