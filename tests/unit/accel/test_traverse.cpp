@@ -204,10 +204,13 @@ TEST(SceneBvhCache, RoundTripsAndLoadsFromTheBakeCache) {
 
     // Another scene, or other build options, is another key.
     scene::Scene other = randomSoup(3000, 4);
-    SceneBvh::loadOrBuild(other, cache, {}, &status);
-    EXPECT_FALSE(status.fromCache);
     BvhBuildOptions leaves8;
     leaves8.maxLeafSize = 8;
+    EXPECT_NE(SceneBvh::cacheKey(s, {}).hash, SceneBvh::cacheKey(other, {}).hash);
+    EXPECT_NE(SceneBvh::cacheKey(s, {}).hash, SceneBvh::cacheKey(s, leaves8).hash);
+    EXPECT_EQ(SceneBvh::cacheKey(s, {}).hash, SceneBvh::cacheKey(randomSoup(3000, 2), {}).hash);
+    SceneBvh::loadOrBuild(other, cache, {}, &status);
+    EXPECT_FALSE(status.fromCache);
     SceneBvh::loadOrBuild(s, cache, leaves8, &status);
     EXPECT_FALSE(status.fromCache);
 
