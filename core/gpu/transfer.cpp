@@ -181,4 +181,17 @@ GpuBuffer recordUpload(Context& ctx, VkCommandBuffer cmd, const GpuImage& image,
     return staging;
 }
 
+GpuBuffer uploadBuffer(Context& ctx, const void* data, size_t bytes, VkBufferUsageFlags usage, const std::string& name) {
+    bytes = std::max<size_t>(bytes, 16);
+    GpuBuffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, name + ".staging");
+    std::memset(staging.mapped(), 0, bytes);
+    if (data) std::memcpy(staging.mapped(), data, bytes);
+    GpuBuffer buffer(ctx, bytes, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, name);
+    ctx.immediate([&](VkCommandBuffer cmd) {
+        VkBufferCopy copy{0, 0, bytes};
+        vkCmdCopyBuffer(cmd, staging.buffer(), buffer.buffer(), 1, &copy);
+    });
+    return buffer;
+}
+
 } // namespace vitrine

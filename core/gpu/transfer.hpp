@@ -17,6 +17,10 @@ Image unpackPixels(const void* data, uint32_t width, uint32_t height, VkFormat f
 // Waits for the GPU: for tests, the CLI's output writing and debugging, not per-frame work.
 Image readImage(Context& ctx, const GpuImage& image, VkImageLayout layout, uint32_t mip = 0, uint32_t layer = 0);
 
+// A device-local buffer filled with `bytes` of `data` (zeros where data is null) through a staging copy.
+// At least 16 bytes, so empty arrays still bind. Waits for the GPU: for uploads at load time.
+GpuBuffer uploadBuffer(Context& ctx, const void* data, size_t bytes, VkBufferUsageFlags usage, const std::string& name);
+
 // Records a copy of `pixels` into mip 0 / layer `layer` of `image`, which must be in
 // TRANSFER_DST_OPTIMAL. The staging buffer is returned so the caller keeps it alive (its
 // destruction is deferred anyway).

@@ -1,9 +1,13 @@
 #include "core/scene/gpu_scene.hpp"
 
+#include "core/accel/gpu_bvh.hpp"
+#include "core/accel/scene_bvh.hpp"
+#include "core/bake/cache.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/pipeline.hpp"
+#include "core/gpu/transfer.hpp"
 #include "core/gpu/vk_check.hpp"
 #include "core/shader/compiler.hpp"
 
@@ -29,6 +33,33 @@ gpu_types::GpuCamera CameraFrame::gpu() const {
     c.jitter = {jitter, prevJitter};
     c.time = {static_cast<float>(time), static_cast<float>(frame), 0.0f, 0.0f};
     return c;
+}
+
+SceneObject::SceneObject(std::shared_ptr<const scene::Scene> scene) : mScene(std::move(scene)) {}
+
+SceneObject::~SceneObject() = default;
+
+void SceneObject::releaseGpu() {
+    mGpuBvh.reset();
+    mGpu.reset();
+}
+
+GpuBvh& SceneObject::bvh(Context& ctx) {
+    if (!mGpuBvh) {
+        if (!mBvh) {
+            accel::SceneBvh::CacheStatus status;
+            mBvh = std::make_unique<accel::SceneBvh>(accel::SceneBvh::loadOrBuild(*mScene, BakeCache(defaultCacheDir()), {}, &status));
+            mBvhFromCache = status.fromCache;
+            if (status.fromCache) logInfo("scene '" + mScene->name + "': BVH loaded from the bake cache");
+            else logInfo("scene '" + mScene->name + "': BVH built in " + std::to_string(static_cast<int>(mBvh->buildMs())) + " ms");
+            if (!status.fromCache && !status.stored)
+                logWarning("scene '" + mScene->name + "': could not write the BVH to the bake cache under " +
+                           defaultCacheDir().string());
+        }
+        mGpuBvh = std::make_unique<GpuBvh>(ctx, *mBvh, mScene->name);
+        mGpuBvh->update(pose);
+    }
+    return *mGpuBvh;
 }
 
 GpuScene& SceneObject::gpu() const {
@@ -62,19 +93,6 @@ uint32_t mipCount(uint32_t w, uint32_t h) {
     return 1 + static_cast<uint32_t>(std::floor(std::log2(static_cast<double>(std::max(w, h)))));
 }
 
-GpuBuffer deviceBuffer(Context& ctx, const void* data, size_t bytes, VkBufferUsageFlags usage, const std::string& name) {
-    bytes = std::max<size_t>(bytes, 16);
-    GpuBuffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, name + ".staging");
-    std::memset(staging.mapped(), 0, bytes);
-    if (data) std::memcpy(staging.mapped(), data, bytes);
-    GpuBuffer buffer(ctx, bytes, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, name);
-    ctx.immediate([&](VkCommandBuffer cmd) {
-        VkBufferCopy copy{0, 0, bytes};
-        vkCmdCopyBuffer(cmd, staging.buffer(), buffer.buffer(), 1, &copy);
-    });
-    return buffer;
-}
-
 void imageBarrier(VkCommandBuffer cmd, VkImage image, uint32_t baseMip, uint32_t mips, VkImageLayout from, VkImageLayout to,
                   VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
                   VkAccessFlags2 dstAccess) {
@@ -102,9 +120,9 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
     try {
         const size_t vbytes = scene.vertices.size() * sizeof(scene::Vertex);
         const size_t ibytes = scene.indices.size() * sizeof(uint32_t);
-        mVertices = deviceBuffer(ctx, scene.vertices.data(), vbytes,
+        mVertices = uploadBuffer(ctx, scene.vertices.data(), vbytes,
                                  VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".vertices");
-        mIndices = deviceBuffer(ctx, scene.indices.data(), ibytes,
+        mIndices = uploadBuffer(ctx, scene.indices.data(), ibytes,
                                 VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".indices");
         mStats.geometryBytes = vbytes + ibytes;
 
@@ -133,9 +151,9 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
                 layers.push_back(gl);
             }
         }
-        mMaterials = deviceBuffer(ctx, materials.data(), materials.size() * sizeof(GpuMaterial),
+        mMaterials = uploadBuffer(ctx, materials.data(), materials.size() * sizeof(GpuMaterial),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".materials");
-        mLayers = deviceBuffer(ctx, layers.data(), layers.size() * sizeof(GpuLayer), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+        mLayers = uploadBuffer(ctx, layers.data(), layers.size() * sizeof(GpuLayer), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                scene.name + ".layers");
         mInstances = GpuBuffer(ctx, std::max<size_t>(1, scene.instances.size()) * sizeof(GpuInstance),
                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, scene.name + ".instances");

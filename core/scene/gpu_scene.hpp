@@ -19,7 +19,11 @@
 namespace vitrine {
 
 class Context;
+class GpuBvh;
 class ShaderCompiler;
+namespace accel {
+class SceneBvh;
+}
 
 // One frame's camera, as every consumer sees it (CPU mirror of gpu_types::GpuCamera).
 struct CameraFrame {
@@ -81,6 +85,11 @@ public:
     // Binding 0: the scene's Vertex (72 bytes): position, normal, tangent, uv0, uv1, color at locations 0-5.
     static std::vector<VkVertexInputBindingDescription> vertexBindings();
     static std::vector<VkVertexInputAttributeDescription> vertexAttributes();
+    // The vertex buffer (scene::Vertex, 72 bytes: 18 floats) and index buffer (uint32, relative to the
+    // primitive's vertexOffset), also storage buffers: a ray tracer fetches a hit's vertices from them
+    // (GpuBvhPrimitive, shaders/accel/bvh.h).
+    const GpuBuffer& vertexBuffer() const { return mVertices; }
+    const GpuBuffer& indexBuffer() const { return mIndices; }
     // Binds the vertex and index buffers. Then drawIndexed(cmd, draw) per draw.
     void bindGeometry(VkCommandBuffer cmd) const;
     void drawIndexed(VkCommandBuffer cmd, const GpuDraw& draw) const;
@@ -108,7 +117,8 @@ private:
 // What travels on a Scene port. CPU data from setup(); the GPU copy once a pass asks for it.
 class SceneObject final : public PortObject {
 public:
-    explicit SceneObject(std::shared_ptr<const scene::Scene> scene) : mScene(std::move(scene)) {}
+    explicit SceneObject(std::shared_ptr<const scene::Scene> scene);
+    ~SceneObject() override;
     const scene::Scene& scene() const { return *mScene; }
     std::shared_ptr<const scene::Scene> shared() const { return mScene; }
     bool uploaded() const { return mGpu != nullptr; }
@@ -117,7 +127,14 @@ public:
         return *mGpu;
     }
     GpuScene& gpu() const; // InternalError before the producer uploaded it
-    void releaseGpu() override { mGpu.reset(); }
+
+    // The scene's ray-tracing BVH on the GPU (core/accel/gpu_bvh.hpp), for passes that trace rays. The
+    // first call loads it from the bake cache ($VITRINE_CACHE_DIR/bake/bvh), or builds and stores it, and
+    // uploads it posed at `pose`; the scene node re-poses it every frame after that.
+    GpuBvh& bvh(Context& ctx);
+    bool hasBvh() const { return mGpuBvh != nullptr; }
+    bool bvhFromCache() const { return mBvhFromCache; }
+    void releaseGpu() override;
 
     // The pose of this frame and the last one (set by the scene node every frame).
     scene::ScenePose pose, previousPose;
@@ -127,6 +144,9 @@ public:
 private:
     std::shared_ptr<const scene::Scene> mScene;
     std::unique_ptr<GpuScene> mGpu;
+    std::unique_ptr<accel::SceneBvh> mBvh; // CPU copy, kept across releaseGpu()
+    std::unique_ptr<GpuBvh> mGpuBvh;
+    bool mBvhFromCache = false;
 };
 
 } // namespace vitrine

@@ -1,7 +1,8 @@
 #pragma once
 
 // A streaming 64-bit hash for content hashes (determinism tests, bake-cache keys). Not cryptographic;
-// stable across runs, builds and platforms of the same endianness. Internal to core/scene.
+// stable across runs, builds and platforms of the same endianness. Used by core/scene, and by core/bake
+// and core/accel for bake-cache checksums and keys.
 
 #include <cstdint>
 #include <cstring>

@@ -1,5 +1,6 @@
 #include "nodes/scene/scene_node.hpp"
 
+#include "core/accel/gpu_bvh.hpp"
 #include "core/base/error.hpp"
 #include "core/gpu/context.hpp"
 
@@ -135,6 +136,7 @@ void SceneNode::execute(ExecuteContext& ctx) {
     c.time = t;
     c.frame = frame;
     gpu.update(mScene->pose, mScene->previousPose, c);
+    if (mScene->hasBvh()) mScene->bvh(ctx.gpu()).update(mScene->pose);
 }
 
 } // namespace vitrine

@@ -9,6 +9,7 @@
 #include "core/image/io.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "core/shader/compiler.hpp"
+#include "tools/vitrine/bench_bvh.hpp"
 #include "tools/vitrine/cli.hpp"
 #include "tools/vitrine/output_dir.hpp"
 #include "tools/vitrine/render_output.hpp"
@@ -189,6 +190,18 @@ int benchCommand(const Args& args) {
                                {"draws", so->gpu().draws().size()}, {"geometry_bytes", st.geometryBytes},
                                {"texture_bytes", st.textureBytes}, {"upload_ms", st.uploadMs}});
     }
+    if (args.has("bvh")) {
+        const CameraFrame* camera = nullptr;
+        for (const auto& r : graph.resources)
+            if (auto* c = dynamic_cast<CameraObject*>(r.object.get())) {
+                camera = &c->current;
+                break;
+            }
+        j["bvh"] = nlohmann::json::array();
+        for (const auto& r : graph.resources)
+            if (auto* so = dynamic_cast<SceneObject*>(r.object.get())) j["bvh"].push_back(benchSceneBvh(ctx, shaders, r.name, *so, camera));
+        if (j["bvh"].empty()) throw UserError("bench --bvh: the graph " + graphArg(args) + " has no scene");
+    }
 
     if (args.has("json")) {
         std::string path = args.get("json");
@@ -215,6 +228,8 @@ int benchCommand(const Args& args) {
                         sc["resource"].get<std::string>().c_str(), sc["triangles"].get<size_t>(), sc["draws"].get<size_t>(),
                         mib(sc["geometry_bytes"].get<uint64_t>()).c_str(), mib(sc["texture_bytes"].get<uint64_t>()).c_str(),
                         sc["upload_ms"].get<double>());
+        if (j.contains("bvh"))
+            for (const auto& b : j["bvh"]) printSceneBvhBench(b);
     }
     return ctx.validationMessageCount() > 0 ? 2 : 0;
 }

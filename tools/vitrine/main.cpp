@@ -17,8 +17,10 @@ commands:
       OCIO display transform) and all outputs of a frame as one multi-layer EXR.
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
   nodes [--json]                    List node types with their ports and params.
-  bench GRAPH [--frames N] [--warmup N] [--json FILE] [--set K=V]...
+  bench GRAPH [--frames N] [--warmup N] [--json FILE] [--set K=V]... [--bvh]
       Per-node GPU ms (median of timestamp queries), CPU record ms, compile ms, memory.
+      --bvh: also the scene's ray-tracing BVH: build ms, nodes, memory, bake-cache load ms,
+      and rays/s of primary (one per pixel) and incoherent (bounce) rays.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
   compare A B [--reference R] [--frame N | --frames A:B] [--set K=V]... [--output NAME]
           [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]

@@ -1,0 +1,98 @@
+#include "core/bake/cache.hpp"
+
+#include "core/base/error.hpp"
+#include "core/scene/hash.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+namespace vitrine {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kMagic[8] = {'V', 'T', 'B', 'A', 'K', 'E', '0', '1'};
+
+// The file: this header, then the payload.
+struct Header {
+    char magic[8];
+    uint64_t key;
+    uint64_t size;
+    uint64_t checksum;
+};
+static_assert(sizeof(Header) == 32);
+
+uint64_t checksum(std::span<const uint8_t> bytes) {
+    scene::Hasher h;
+    h.bytes(bytes.data(), bytes.size());
+    return h.result();
+}
+
+void checkKind(const std::string& kind) {
+    bool ok = !kind.empty();
+    for (char c : kind)
+        ok = ok && ((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_');
+    if (!ok) throw InternalError("bake cache: kind '" + kind + "' must be made of [a-z0-9_]");
+}
+
+} // namespace
+
+BakeCache::BakeCache(fs::path root) : mDir(std::move(root) / "bake") {}
+
+fs::path BakeCache::pathOf(const BakeKey& key) const {
+    checkKind(key.kind);
+    char name[32];
+    std::snprintf(name, sizeof name, "%016llx.bin", static_cast<unsigned long long>(key.hash));
+    return mDir / key.kind / name;
+}
+
+std::optional<std::vector<uint8_t>> BakeCache::get(const BakeKey& key) const {
+    std::ifstream in(pathOf(key), std::ios::binary);
+    if (!in) return std::nullopt;
+    Header h{};
+    if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return std::nullopt;
+    if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.key != key.hash) return std::nullopt;
+    in.seekg(0, std::ios::end);
+    if (static_cast<uint64_t>(in.tellg()) != sizeof(Header) + h.size) return std::nullopt;
+    in.seekg(sizeof(Header));
+    std::vector<uint8_t> bytes(h.size);
+    if (h.size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(h.size)))
+        return std::nullopt;
+    if (checksum(bytes) != h.checksum) return std::nullopt;
+    return bytes;
+}
+
+bool BakeCache::put(const BakeKey& key, std::span<const uint8_t> bytes) const {
+    const fs::path path = pathOf(key);
+    std::error_code ec;
+    fs::create_directories(path.parent_path(), ec);
+    // Unique per process and call, so concurrent writers of the same key never share a temporary.
+    static std::atomic<uint32_t> sCounter{0};
+    const fs::path tmp = path.string() + ".tmp" + std::to_string(::getpid()) + "." + std::to_string(sCounter++);
+    Header h{};
+    std::memcpy(h.magic, kMagic, sizeof kMagic);
+    h.key = key.hash;
+    h.size = bytes.size();
+    h.checksum = checksum(bytes);
+    bool ok;
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out.write(reinterpret_cast<const char*>(&h), sizeof h);
+        out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+        out.close();
+        ok = static_cast<bool>(out);
+    }
+    if (ok) fs::rename(tmp, path, ec);
+    if (!ok || ec) {
+        fs::remove(tmp, ec);
+        return false;
+    }
+    return true;
+}
+
+} // namespace vitrine

@@ -1,0 +1,44 @@
+#pragma once
+
+// The bake cache: results of expensive CPU or GPU work (the ray-tracing BVH now; lightmaps, probes and
+// prefiltered maps later) stored on disk under a key that hashes everything the result depends on, so a
+// later run loads them instead of baking again. Bakers own their byte format; the cache only stores
+// bytes, checks that they come back whole and never hands out a partial or damaged file.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace vitrine {
+
+struct BakeKey {
+    std::string kind;  // what was baked ("bvh", "lightmap"): a folder of the cache, [a-z0-9_]+
+    uint64_t hash = 0; // of all inputs: the scene's content hash, the baker's format version, its parameters
+};
+
+class BakeCache {
+public:
+    // Results live in root/bake/<kind>/<hash>.bin. root: defaultCacheDir() (core/shader/compiler.hpp) for
+    // the renderer, a scratch directory in tests.
+    explicit BakeCache(std::filesystem::path root);
+
+    // The bytes stored under key; nullopt when there are none, or the file is unreadable, truncated, of
+    // another key or fails its checksum (the caller bakes again and put()s over it).
+    std::optional<std::vector<uint8_t>> get(const BakeKey& key) const;
+
+    // Stores bytes under key, replacing what was there. Atomic: written to a temporary file that is then
+    // renamed, so a concurrent reader sees the old file or the new one, never a partial one. Returns false
+    // (and leaves no temporary behind) when the cache cannot be written: the result is then just not cached.
+    bool put(const BakeKey& key, std::span<const uint8_t> bytes) const;
+
+    std::filesystem::path pathOf(const BakeKey& key) const;
+    const std::filesystem::path& dir() const { return mDir; }
+
+private:
+    std::filesystem::path mDir;
+};
+
+} // namespace vitrine

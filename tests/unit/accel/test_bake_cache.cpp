@@ -1,0 +1,117 @@
+// core/bake/cache: what goes in comes out whole, damaged or foreign files are misses, writes are atomic.
+#include "core/bake/cache.hpp"
+
+#include "core/base/error.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace vitrine {
+namespace {
+
+namespace fs = std::filesystem;
+
+class BakeCacheTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mRoot = fs::temp_directory_path() / ("vitrine_bake_test_" + std::to_string(::getpid()) + "_" +
+                                             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(mRoot);
+    }
+    void TearDown() override { fs::remove_all(mRoot); }
+    fs::path mRoot;
+};
+
+std::vector<uint8_t> bytes(size_t n, uint8_t seed) {
+    std::vector<uint8_t> v(n);
+    for (size_t i = 0; i < n; ++i)
+        v[i] = static_cast<uint8_t>(seed + i * 31);
+    return v;
+}
+
+TEST_F(BakeCacheTest, StoresAndLoadsBytes) {
+    BakeCache cache(mRoot);
+    const BakeKey key{"bvh", 0x1234abcdull};
+    EXPECT_FALSE(cache.get(key));
+    ASSERT_TRUE(cache.put(key, bytes(100000, 7)));
+    auto back = cache.get(key);
+    ASSERT_TRUE(back);
+    EXPECT_EQ(*back, bytes(100000, 7));
+    EXPECT_EQ(cache.pathOf(key), mRoot / "bake" / "bvh" / "000000001234abcd.bin");
+    // Another cache object on the same directory (a later run) sees it too; empty payloads are fine.
+    EXPECT_EQ(*BakeCache(mRoot).get(key), bytes(100000, 7));
+    ASSERT_TRUE(cache.put({"bvh", 1}, {}));
+    ASSERT_TRUE(cache.get({"bvh", 1}));
+    EXPECT_TRUE(cache.get({"bvh", 1})->empty());
+}
+
+TEST_F(BakeCacheTest, KeysAndKindsAreSeparate) {
+    BakeCache cache(mRoot);
+    ASSERT_TRUE(cache.put({"bvh", 1}, bytes(10, 1)));
+    ASSERT_TRUE(cache.put({"lightmap", 1}, bytes(10, 2)));
+    EXPECT_EQ(*cache.get({"bvh", 1}), bytes(10, 1));
+    EXPECT_EQ(*cache.get({"lightmap", 1}), bytes(10, 2));
+    EXPECT_FALSE(cache.get({"bvh", 2}));
+    EXPECT_THROW(cache.get({"../x", 1}), InternalError);
+    EXPECT_THROW(cache.put({"", 1}, bytes(1, 0)), InternalError);
+}
+
+TEST_F(BakeCacheTest, ReplacesAtomicallyAndLeavesNoTemporaries) {
+    BakeCache cache(mRoot);
+    const BakeKey key{"bvh", 42};
+    ASSERT_TRUE(cache.put(key, bytes(5000, 1)));
+    ASSERT_TRUE(cache.put(key, bytes(300, 2)));
+    EXPECT_EQ(*cache.get(key), bytes(300, 2));
+    size_t files = 0;
+    for (const auto& e : fs::directory_iterator(cache.pathOf(key).parent_path())) {
+        EXPECT_EQ(e.path().extension(), ".bin") << e.path();
+        ++files;
+    }
+    EXPECT_EQ(files, 1u);
+}
+
+TEST_F(BakeCacheTest, DamagedOrForeignFilesAreMisses) {
+    BakeCache cache(mRoot);
+    const BakeKey key{"bvh", 99};
+    ASSERT_TRUE(cache.put(key, bytes(4096, 3)));
+    const fs::path file = cache.pathOf(key);
+
+    // One payload byte flipped: the checksum fails.
+    {
+        std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(32 + 1000);
+        f.put(static_cast<char>(0x5a));
+    }
+    EXPECT_FALSE(cache.get(key));
+
+    // Truncated.
+    ASSERT_TRUE(cache.put(key, bytes(4096, 3)));
+    fs::resize_file(file, fs::file_size(file) - 1);
+    EXPECT_FALSE(cache.get(key));
+
+    // Another key's file under this key's name.
+    ASSERT_TRUE(cache.put({"bvh", 100}, bytes(4096, 3)));
+    fs::copy_file(cache.pathOf({"bvh", 100}), file, fs::copy_options::overwrite_existing);
+    EXPECT_FALSE(cache.get(key));
+
+    // Not a cache file at all.
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << "hello";
+    EXPECT_FALSE(cache.get(key));
+    // And a put repairs it.
+    ASSERT_TRUE(cache.put(key, bytes(64, 9)));
+    EXPECT_EQ(*cache.get(key), bytes(64, 9));
+}
+
+TEST_F(BakeCacheTest, UnwritableCacheIsReportedNotThrown) {
+    fs::create_directories(mRoot);
+    std::ofstream(mRoot / "bake") << "a file where the cache's folder should be";
+    BakeCache cache(mRoot);
+    EXPECT_FALSE(cache.put({"bvh", 1}, bytes(10, 0)));
+    EXPECT_FALSE(cache.get({"bvh", 1}));
+}
+
+} // namespace
+} // namespace vitrine

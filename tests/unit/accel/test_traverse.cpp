@@ -1,0 +1,236 @@
+// core/accel traversal on the CPU (the mirror of shaders/accel/bvh.glsl) against a brute-force loop over
+// every triangle: the same triangle at the same t; watertightness on closed meshes; the dynamic level
+// following the pose; the BVH through the bake cache.
+#include "tests/unit/accel/accel_scenes.hpp"
+#include "tests/unit/accel/compare_hits.hpp"
+
+#include "core/scene/museum.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+
+namespace vitrine::accel {
+namespace {
+
+using namespace test;
+
+std::vector<Hit> traceAll(const SceneBvh& bvh, std::span<const GpuBvhInstance> top, const std::vector<Ray>& rays) {
+    std::vector<Hit> hits;
+    for (const Ray& r : rays)
+        hits.push_back(traceClosest(bvh.arrays(), top, r));
+    return hits;
+}
+
+TEST(BvhTraversal, ClosestHitMatchesBruteForceOnRandomSoup) {
+    scene::Scene s = randomSoup(3000, 11);
+    SceneBvh bvh = SceneBvh::build(s);
+    WorldTriangles w = worldTriangles(s);
+    scene::Aabb box = s.bounds;
+    box.expand(box.min - 0.5f);
+    box.expand(box.max + 0.5f);
+    std::vector<Ray> rays = randomRays(w, box, 20000, 5);
+    size_t hits, ties;
+    expectSameHits(bvh, w, rays, traceAll(bvh, bvh.topLevel({}), rays), hits, ties);
+    EXPECT_GT(hits, rays.size() / 2);
+    std::printf("soup: %zu rays, %zu hits, %zu ties\n", rays.size(), hits, ties);
+}
+
+class MuseumBvh : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        scene::MuseumOptions o;
+        o.textureSize = 16;
+        sScene = std::make_unique<scene::Scene>(scene::buildMuseum(o));
+        sBvh = std::make_unique<SceneBvh>(SceneBvh::build(*sScene));
+    }
+    static void TearDownTestSuite() {
+        sBvh.reset();
+        sScene.reset();
+    }
+    static inline std::unique_ptr<scene::Scene> sScene;
+    static inline std::unique_ptr<SceneBvh> sBvh;
+};
+
+TEST_F(MuseumBvh, ClosestHitMatchesBruteForceWithTheRobotPosed) {
+    // 3.7 s into the walk: the robot is away from its rest pose, so its hits go through the dynamic level.
+    scene::ScenePose pose = sScene->evaluate(3.7);
+    WorldTriangles w = worldTriangles(*sScene, pose);
+    std::vector<Ray> rays = randomRays(w, sScene->bounds, 450, 7);
+    // And rays at the robot: the last instances are its parts.
+    std::vector<uint32_t> robot;
+    for (uint32_t i = 0; i < w.refs.size(); ++i)
+        if (sScene->instances[w.refs[i].instance].dynamic) robot.push_back(i);
+    ASSERT_FALSE(robot.empty());
+    std::mt19937 rng(3);
+    for (int i = 0; i < 150; ++i) {
+        uint32_t t = robot[rng() % robot.size()];
+        glm::vec3 c = (w.v[3 * t] + w.v[3 * t + 1] + w.v[3 * t + 2]) / 3.0f;
+        Ray r;
+        r.origin = c + 3.0f * randomUnit(rng);
+        r.direction = c - r.origin;
+        rays.push_back(r);
+    }
+    size_t hits, ties;
+    expectSameHits(*sBvh, w, rays, traceAll(*sBvh, sBvh->topLevel(pose), rays), hits, ties);
+    EXPECT_GT(hits, rays.size() / 2);
+    std::printf("museum: %zu rays, %zu hits, %zu ties\n", rays.size(), hits, ties);
+}
+
+TEST_F(MuseumBvh, AnyHitAgreesWithClosestHit) {
+    scene::ScenePose pose = sScene->evaluate(1.0);
+    std::vector<GpuBvhInstance> top = sBvh->topLevel(pose);
+    WorldTriangles w = worldTriangles(*sScene, pose);
+    std::vector<Ray> rays = randomRays(w, sScene->bounds, 3000, 9);
+    size_t occluded = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        Ray r = rays[i];
+        Hit closest = traceClosest(sBvh->arrays(), top, r);
+        // Shadow rays toward a point before, and just past, the closest hit.
+        r.tmax = closest.valid() ? closest.t * 0.999f : 5.0f;
+        EXPECT_FALSE(traceAny(sBvh->arrays(), top, r)) << "ray " << i;
+        if (!closest.valid()) continue;
+        r.tmax = closest.t * 1.001f;
+        EXPECT_TRUE(traceAny(sBvh->arrays(), top, r)) << "ray " << i;
+        // tmin past the first hit finds something farther, never that one again.
+        r.tmin = closest.t * 1.001f;
+        r.tmax = std::numeric_limits<float>::infinity();
+        Hit next = traceClosest(sBvh->arrays(), top, r);
+        if (next.valid()) {
+            EXPECT_GT(next.t, r.tmin);
+        }
+        ++occluded;
+    }
+    EXPECT_GT(occluded, rays.size() / 2);
+}
+
+// Rays from inside a closed mesh at its edges and vertices: none may leak, each meets the surface at t = 1.
+void expectWatertight(const scene::Scene& s, const scene::ScenePose& pose, glm::vec3 center, float radius, size_t count,
+                      uint32_t seed) {
+    SceneBvh bvh = SceneBvh::build(s);
+    std::vector<GpuBvhInstance> top = bvh.topLevel(pose);
+    WorldTriangles w = worldTriangles(s, pose);
+    std::vector<uint32_t> indices(w.v.size());
+    for (uint32_t i = 0; i < indices.size(); ++i)
+        indices[i] = i;
+    std::vector<Ray> rays = edgeRays(w.v, indices, center, radius, count, seed);
+    size_t leaks = 0, far = 0;
+    for (const Ray& r : rays) {
+        Hit h = traceClosest(bvh.arrays(), top, r);
+        if (!h.valid())
+            ++leaks;
+        else if (std::abs(h.t - 1.0f) > 1e-3f)
+            ++far;
+    }
+    EXPECT_EQ(leaks, 0u) << "of " << rays.size() << " rays";
+    EXPECT_EQ(far, 0u) << "rays that met the surface away from t = 1";
+}
+
+TEST(BvhWatertight, NoRayLeaksThroughEdgesOfAStaticSphere) {
+    // A rotated, scaled, moved icosphere (20480 triangles): the static level holds it pre-transformed.
+    scene::Scene s;
+    addRootNode(
+        s, "sphere", addMesh(s, "sphere", icosphere(5)),
+        transform({0.3f, 1.2f, -0.7f}, glm::angleAxis(0.4f, glm::normalize(glm::vec3(1, 1, 0))), glm::vec3(1.7f)));
+    s.finalize();
+    expectWatertight(s, {}, {0.3f, 1.2f, -0.7f}, 0.8f, 1000000, 17);
+}
+
+TEST(BvhWatertight, NoRayLeaksThroughEdgesOfAMovingCube) {
+    // A finely tessellated cube (27648 triangles, flat boxes along its faces) as a dynamic instance: rays
+    // are transformed into its object space.
+    scene::Scene s;
+    uint32_t node = addRootNode(s, "cube", addMesh(s, "cube", tessellatedCube(48)),
+                                transform({0, 0, 0}, glm::angleAxis(0.3f, glm::normalize(glm::vec3(0, 1, 1)))));
+    animateTranslation(s, node, {0.0f, 0.0f, 0.0f}, {2.0f, 1.0f, 0.0f});
+    s.finalize();
+    ASSERT_TRUE(s.instances[0].dynamic);
+    expectWatertight(s, s.evaluate(0.5), {1.0f, 0.5f, 0.0f}, 0.5f, 1000000, 23);
+}
+
+TEST(BvhDynamic, MovedInstanceIsHitAtItsNewPlace) {
+    // A static floor and a box that moves 4 m along +x between t = 0 and t = 1.
+    scene::Scene s;
+    IndexedMesh floor;
+    floor.positions = {{-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}};
+    floor.indices = {0, 2, 1, 0, 3, 2};
+    addRootNode(s, "floor", addMesh(s, "floor", floor));
+    uint32_t box = addRootNode(s, "box", addMesh(s, "box", tessellatedCube(2)), transform({0, 1, 0}));
+    animateTranslation(s, box, {0, 1, 0}, {4, 1, 0});
+    s.finalize();
+    SceneBvh bvh = SceneBvh::build(s);
+    ASSERT_EQ(bvh.dynamicInstances().size(), 1u);
+    const uint32_t boxInstance = bvh.dynamicInstances()[0].instance;
+
+    auto down = [&](const scene::ScenePose& pose, float x) {
+        Ray r;
+        r.origin = {x, 5.0f, 0.2f};
+        r.direction = {0.0f, -1.0f, 0.0f};
+        return traceClosest(bvh.arrays(), bvh.topLevel(pose), r);
+    };
+    for (double t : {0.0, 0.25, 1.0}) {
+        scene::ScenePose pose = s.evaluate(t);
+        const float x = static_cast<float>(4.0 * t);
+        Hit onBox = down(pose, x);
+        ASSERT_TRUE(onBox.valid());
+        EXPECT_EQ(onBox.instance, boxInstance) << "t = " << t;
+        EXPECT_NEAR(onBox.t, 3.0f, 1e-5f); // the box's top at y = 2
+        Hit beside = down(pose, x + 1.5f);
+        ASSERT_TRUE(beside.valid());
+        EXPECT_NE(beside.instance, boxInstance) << "t = " << t;
+        EXPECT_NEAR(beside.t, 5.0f, 1e-5f); // the floor
+    }
+    // Where the box was at t = 0 there is floor at t = 1, and where it is at t = 1 there was floor at t = 0.
+    EXPECT_NEAR(down(s.evaluate(1.0), 0.0f).t, 5.0f, 1e-5f);
+    EXPECT_NEAR(down(s.evaluate(0.0), 4.0f).t, 5.0f, 1e-5f);
+}
+
+TEST(SceneBvhCache, RoundTripsAndLoadsFromTheBakeCache) {
+    namespace fs = std::filesystem;
+    const fs::path root = fs::temp_directory_path() / ("vitrine_bvh_cache_test_" + std::to_string(::getpid()));
+    fs::remove_all(root);
+    BakeCache cache(root);
+    scene::Scene s = randomSoup(3000, 2);
+    SceneBvh::CacheStatus status;
+    SceneBvh built = SceneBvh::loadOrBuild(s, cache, {}, &status);
+    EXPECT_FALSE(status.fromCache);
+    EXPECT_TRUE(status.stored);
+    SceneBvh loaded = SceneBvh::loadOrBuild(s, cache, {}, &status);
+    EXPECT_TRUE(status.fromCache);
+    EXPECT_EQ(loaded.serialize(), built.serialize());
+    EXPECT_EQ(loaded.levels().size(), built.levels().size());
+
+    // Another scene, or other build options, is another key.
+    scene::Scene other = randomSoup(3000, 4);
+    BvhBuildOptions leaves8;
+    leaves8.maxLeafSize = 8;
+    EXPECT_NE(SceneBvh::cacheKey(s, {}).hash, SceneBvh::cacheKey(other, {}).hash);
+    EXPECT_NE(SceneBvh::cacheKey(s, {}).hash, SceneBvh::cacheKey(s, leaves8).hash);
+    EXPECT_EQ(SceneBvh::cacheKey(s, {}).hash, SceneBvh::cacheKey(randomSoup(3000, 2), {}).hash);
+    SceneBvh::loadOrBuild(other, cache, {}, &status);
+    EXPECT_FALSE(status.fromCache);
+    SceneBvh::loadOrBuild(s, cache, leaves8, &status);
+    EXPECT_FALSE(status.fromCache);
+
+    // A damaged file is rebuilt, not trusted.
+    const fs::path file = cache.pathOf(SceneBvh::cacheKey(s, {}));
+    fs::resize_file(file, fs::file_size(file) / 2);
+    SceneBvh rebuilt = SceneBvh::loadOrBuild(s, cache, {}, &status);
+    EXPECT_FALSE(status.fromCache);
+    EXPECT_EQ(rebuilt.serialize(), built.serialize());
+
+    // Bytes that pass the cache's checksum but not SceneBvh's own checks.
+    std::vector<uint8_t> bytes = built.serialize();
+    EXPECT_TRUE(SceneBvh::deserialize(bytes));
+    bytes.pop_back();
+    EXPECT_FALSE(SceneBvh::deserialize(bytes));
+    bytes = built.serialize();
+    bytes[4] ^= 1; // the version
+    EXPECT_FALSE(SceneBvh::deserialize(bytes));
+    fs::remove_all(root);
+}
+
+} // namespace
+} // namespace vitrine::accel
