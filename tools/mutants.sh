@@ -117,7 +117,7 @@ while IFS= read -r line || [ -n "$line" ]; do
         rm -rf "$cache"
         {
             echo "=== ${files[*]} :: ${edits[*]} :: $tests"
-            "${runner[@]}" -R "$tests" --no-tests=error -j "$(nproc)" --timeout 600 2>&1
+            "${runner[@]}" -R "$tests" --output-on-failure --no-tests=error -j "$(nproc)" --timeout 600 2>&1
         } >>"$log" 2>&1
         status=$?
         rm -rf "$cache"
