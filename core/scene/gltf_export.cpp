@@ -164,9 +164,13 @@ void Exporter::meshes() {
                 {"NORMAL", accessor(vertexView, base + offsetof(Vertex, normal), kFloat, p.vertexCount, "VEC3")},
                 {"TANGENT", accessor(vertexView, base + offsetof(Vertex, tangent), kFloat, p.vertexCount, "VEC4")},
                 {"TEXCOORD_0", accessor(vertexView, base + offsetof(Vertex, uv0), kFloat, p.vertexCount, "VEC2")},
-                {"TEXCOORD_1", accessor(vertexView, base + offsetof(Vertex, uv1), kFloat, p.vertexCount, "VEC2")},
                 {"COLOR_0", accessor(vertexView, base + offsetof(Vertex, color), kFloat, p.vertexCount, "VEC3")},
                 {"_AO", accessor(vertexView, base + offsetof(Vertex, color) + 12, kFloat, p.vertexCount, "SCALAR")}};
+            // TEXCOORD_1 is the lightmap parameterisation (or a UV set a material samples); without it the
+            // loader marks the primitive as not lightmapped.
+            if (p.lightmapUvs || usesUvSet(mScene.materials[p.material], 1))
+                attributes["TEXCOORD_1"] =
+                    accessor(vertexView, base + offsetof(Vertex, uv1), kFloat, p.vertexCount, "VEC2");
             int indices = accessor(indexView, size_t(p.firstIndex) * 4, kUnsignedInt, p.indexCount, "SCALAR");
             jm["primitives"].push_back(
                 {{"attributes", attributes}, {"indices", indices}, {"material", p.material}, {"mode", 4}});

@@ -155,6 +155,7 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, const std::st
     prim.vertexOffset = static_cast<uint32_t>(scene.vertices.size());
     prim.vertexCount = static_cast<uint32_t>(vertices.size());
     prim.material = p.material >= 0 ? static_cast<uint32_t>(p.material) : defaultMaterial(ctx);
+    prim.lightmapUvs = uv1.count > 0;
     scene.indices.insert(scene.indices.end(), indices.begin(), indices.end());
     scene.vertices.insert(scene.vertices.end(), vertices.begin(), vertices.end());
     scene.primitives.push_back(prim);

@@ -72,6 +72,10 @@ struct Primitive {
     uint32_t vertexOffset = 0;
     uint32_t vertexCount = 0;
     uint32_t material = 0;
+    // Its Vertex::uv1 is a lightmap parameterisation (charts without overlap inside [0, 1]²): set by the
+    // procedural museum for lightmapped meshes and by the glTF loader when TEXCOORD_1 is present. Static
+    // instances of such meshes get lightmaps (core/bake/lightmap_atlas.hpp).
+    bool lightmapUvs = false;
     Aabb bounds; // object space
 };
 

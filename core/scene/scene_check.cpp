@@ -81,7 +81,8 @@ uint64_t Scene::contentHash() const {
     h.array(indices);
     h.value(primitives.size());
     for (const Primitive& p : primitives) {
-        for (uint32_t v : {p.firstIndex, p.indexCount, p.vertexOffset, p.vertexCount, p.material})
+        for (uint32_t v : {p.firstIndex, p.indexCount, p.vertexOffset, p.vertexCount, p.material,
+                           static_cast<uint32_t>(p.lightmapUvs)})
             h.value(v);
     }
     h.value(meshes.size());

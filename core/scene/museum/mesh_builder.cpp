@@ -128,6 +128,7 @@ uint32_t MeshBuilder::commit(Scene& scene, bool lightmapped) {
         prim.vertexOffset = static_cast<uint32_t>(scene.vertices.size());
         prim.vertexCount = static_cast<uint32_t>(p.vertices.size());
         prim.material = p.material;
+        prim.lightmapUvs = lightmapped;
         scene.vertices.insert(scene.vertices.end(), p.vertices.begin(), p.vertices.end());
         scene.indices.insert(scene.indices.end(), p.indices.begin(), p.indices.end());
         scene.primitives.push_back(prim);
