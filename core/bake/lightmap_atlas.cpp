@@ -77,7 +77,8 @@ LightmapAtlas planLightmapAtlas(const scene::Scene& s, const LightmapAtlasOption
             continue;
         }
         // size² texels over the uv square: world area per texel = world / (uv size²) = 1 / texelsPerMeter².
-        const double size = std::ceil(o.texelsPerMeter * std::sqrt(a.world / a.uv));
+        // (The small allowance keeps float noise in the areas from adding a texel row to an exact size.)
+        const double size = std::ceil(o.texelsPerMeter * std::sqrt(a.world / a.uv) - 1e-3);
         LightmapRegion r;
         r.instance = i;
         r.size = static_cast<uint32_t>(std::clamp(size, double(o.minSize), double(o.maxSize)));
