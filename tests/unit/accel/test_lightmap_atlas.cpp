@@ -62,7 +62,9 @@ sc::Scene quads() {
     place(s, quadMesh(s, 1.0f, 0.5f, true), {10, 0, 0});       // 1 m² over a quarter of the uv square
     place(s, quadMesh(s, 2.0f, 1.0f, false), {15, 0, 0});      // no lightmap UVs
     place(s, quadMesh(s, 1.0f, 1.0f, true), {20, 0, 0}, 3.0f); // scaled by 3: 9 m²
+    place(s, quadMesh(s, 1.0f, 1.0f, true), {25, 0, 0});       // lightmap UVs, but animated (below)
     s.finalize();
+    s.instances[5].dynamic = true; // as if an animation moved it: probes, not a lightmap
     return s;
 }
 
@@ -74,7 +76,7 @@ TEST(LightmapAtlas, RegionSizeFollowsWorldAreaAndTexelDensity) {
     o.maxSize = 64;
     o.atlasWidth = 128;
     const LightmapAtlas a = planLightmapAtlas(s, o);
-    ASSERT_EQ(a.regionOfInstance.size(), 5u);
+    ASSERT_EQ(a.regionOfInstance.size(), 6u);
     auto sizeOf = [&](uint32_t instance) {
         const int32_t r = a.regionOfInstance[instance];
         return r < 0 ? 0u : a.regions[r].size;
@@ -86,9 +88,12 @@ TEST(LightmapAtlas, RegionSizeFollowsWorldAreaAndTexelDensity) {
     EXPECT_EQ(sizeOf(2), 16u);
     EXPECT_EQ(sizeOf(3), 0u);
     EXPECT_EQ(sizeOf(4), 24u);
-    ASSERT_EQ(a.skipped.size(), 1u);
+    EXPECT_EQ(sizeOf(5), 0u);
+    ASSERT_EQ(a.skipped.size(), 2u);
     EXPECT_EQ(a.skipped[0].first, 3u);
     EXPECT_NE(a.skipped[0].second.find("TEXCOORD_1"), std::string::npos);
+    EXPECT_EQ(a.skipped[1].first, 5u);
+    EXPECT_EQ(a.skipped[1].second, "dynamic");
 
     // The mapping of uv1 corners lands on the region's corner texels.
     for (const LightmapRegion& r : a.regions) {
