@@ -63,6 +63,12 @@ sc::Scene quads() {
     place(s, quadMesh(s, 2.0f, 1.0f, false), {15, 0, 0});      // no lightmap UVs
     place(s, quadMesh(s, 1.0f, 1.0f, true), {20, 0, 0}, 3.0f); // scaled by 3: 9 m²
     place(s, quadMesh(s, 1.0f, 1.0f, true), {25, 0, 0});       // lightmap UVs, but animated (below)
+    // A mesh of two primitives, only the first with lightmap UVs: the second's 16 m² do not count.
+    const uint32_t mixed = quadMesh(s, 2.0f, 1.0f, true);
+    quadMesh(s, 4.0f, 1.0f, false);
+    s.meshes[mixed].primitiveCount = 2;
+    s.meshes.pop_back();
+    place(s, mixed, {30, 0, 0});
     s.finalize();
     s.instances[5].dynamic = true; // as if an animation moved it: probes, not a lightmap
     return s;
@@ -76,7 +82,7 @@ TEST(LightmapAtlas, RegionSizeFollowsWorldAreaAndTexelDensity) {
     o.maxSize = 64;
     o.atlasWidth = 128;
     const LightmapAtlas a = planLightmapAtlas(s, o);
-    ASSERT_EQ(a.regionOfInstance.size(), 6u);
+    ASSERT_EQ(a.regionOfInstance.size(), 7u);
     auto sizeOf = [&](uint32_t instance) {
         const int32_t r = a.regionOfInstance[instance];
         return r < 0 ? 0u : a.regions[r].size;
@@ -89,6 +95,7 @@ TEST(LightmapAtlas, RegionSizeFollowsWorldAreaAndTexelDensity) {
     EXPECT_EQ(sizeOf(3), 0u);
     EXPECT_EQ(sizeOf(4), 24u);
     EXPECT_EQ(sizeOf(5), 0u);
+    EXPECT_EQ(sizeOf(6), 16u); // the lightmapped primitive's 2 m side only
     ASSERT_EQ(a.skipped.size(), 2u);
     EXPECT_EQ(a.skipped[0].first, 3u);
     EXPECT_NE(a.skipped[0].second.find("TEXCOORD_1"), std::string::npos);
