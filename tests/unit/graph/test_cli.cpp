@@ -105,6 +105,18 @@ const BadGraph kBadGraphRows[] = {
     {"graphs/fxaa_zoneplate.json", "--set nosuch.params.x=1", ": /nodes/nosuch: ", "the graph has no node 'nosuch'"},
     {"graphs/fxaa_zoneplate.json", "--set tonemap.params.exposure=100",
      ": /nodes/tonemap/params/exposure: ", "got 100"},
+    // Numbers a double cannot hold are the user's input (exit 1 with the position), not an internal error.
+    {"number_too_large.json", "", ":3:22: ", "the number '1e309' is too large"},
+    {"graphs/fxaa_zoneplate.json", "--set fxaa.params.subpix=1e309",
+     ": --set fxaa.params.subpix=1e309: ", "the number '1e309' is too large"},
+    {"graphs/fxaa_zoneplate.json", "--set frame.width.x=1", ": /frame/width: ", "cannot set 'x' inside 640"},
+    {"graphs/fxaa_zoneplate.json", "--set 'frame.write=[0]' --set frame.write.01=1",
+     ": /frame/write/01: ", "expected an array index in [0, 1]"},
+    // The glTF errors name the glTF file (the path is relative to the graph) and what is wrong in it.
+    {"gltf_number_too_large.json", "", ": /nodes/scene/params/path: ",
+     "number_too_large.gltf: JSON line 10, column 55: the number '1e309' is too large"},
+    {"gltf_bad_magic.json", "", ": /nodes/scene/params/path: ",
+     "bad_magic.glb: GLB header: magic is 'glTX' (0x58546C67); expected 'glTF'"},
 };
 
 std::string rowName(const testing::TestParamInfo<BadGraph>& info) {
