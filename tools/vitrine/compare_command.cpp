@@ -44,7 +44,9 @@ bool isImageFile(const fs::path& path) {
     return ext == ".exr" || ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr";
 }
 
-Input openInput(const std::string& role, const std::string& key, const fs::path& path, const Args& args) {
+// `frames`: the frame count --frame/--frames ask for (0: the graph's own), part of the graph before validation.
+Input openInput(const std::string& role, const std::string& key, const fs::path& path, const Args& args,
+                uint32_t frames) {
     const std::string expected = "expected a graph (.json) or an image (.exr, .png, .jpg, .hdr)";
     std::error_code ec;
     if (!fs::exists(path, ec)) throw UserError(path.string() + ": not found (compare " + role + ": " + expected + ")");
@@ -53,7 +55,7 @@ Input openInput(const std::string& role, const std::string& key, const fs::path&
     Input in{role, key, path, {}, {}, {}, {}};
     const std::string ext = lower(path.extension().string());
     if (ext == ".json") {
-        in.graph = loadGraph(path, args.all("set"));
+        in.graph = loadGraph(path, setsWithFrames(args, frames));
         in.output = pickOutput(*in.graph, args.get("output"));
     } else if (!isImageFile(path)) {
         throw UserError(path.string() + ": compare " + role + ": " + expected + ", got a '" + ext + "' file");
@@ -75,12 +77,9 @@ uint32_t parseIndex(const std::string& text, const std::string& option, const st
 }
 
 // --frame N picks the still; --frames a:b renders a..b for temporal metrics (the still defaults to b). Without either
-// the still is the last frame of the longest graph.
-FrameRange frameRange(const Args& args, const std::vector<Input*>& inputs) {
+// the still is the last frame of the longest graph (graphFrames).
+FrameRange frameRange(const Args& args, uint32_t graphFrames) {
     FrameRange r;
-    uint32_t graphFrames = 1;
-    for (const Input* in : inputs)
-        if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
     if (args.has("frames")) {
         const std::string text = args.get("frames");
         const auto colon = text.find(':');
@@ -143,14 +142,20 @@ std::string formatPsnr(double psnr) {
 
 int compareCommand(const Args& args) {
     if (args.positional.size() != 2) throw UserError("compare: expected two inputs, A and B (graphs or images)");
-    Input a = openInput("A", "a", args.positional[0], args);
-    Input b = openInput("B", "b", args.positional[1], args);
+    // --frame/--frames fix the frame count before the graphs are validated; without them each graph keeps its own.
+    const uint32_t askedFrames = args.has("frame") || args.has("frames") ? frameRange(args, 1).last + 1 : 0;
+    Input a = openInput("A", "a", args.positional[0], args, askedFrames);
+    Input b = openInput("B", "b", args.positional[1], args, askedFrames);
     std::optional<Input> reference;
-    if (args.has("reference")) reference = openInput("reference", "reference", args.get("reference"), args);
+    if (args.has("reference"))
+        reference = openInput("reference", "reference", args.get("reference"), args, askedFrames);
     std::vector<Input*> inputs = {&a, &b};
     if (reference) inputs.push_back(&*reference);
 
-    const FrameRange range = frameRange(args, inputs);
+    uint32_t graphFrames = 1;
+    for (const Input* in : inputs)
+        if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
+    const FrameRange range = frameRange(args, graphFrames);
     const bool hdr = args.has("hdr");
     double ppd = compare::kDefaultPixelsPerDegree;
     if (args.has("ppd")) {

@@ -16,7 +16,8 @@ commands:
       Render GRAPH headless; writes each output of the chosen frames as PNG (through the
       OCIO display transform) and all outputs of a frame as one multi-layer EXR.
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
-  nodes [--json]                    List node types with their ports and params.
+  nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
+                                    JSON on stdout (or in FILE).
   bench GRAPH [--frames N] [--warmup N] [--json FILE] [--set K=V]...
       Per-node GPU ms (median of timestamp queries), CPU record ms, compile ms, memory.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
@@ -51,7 +52,8 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv, {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
                                                "output", "ppd", "diff-scale", "manifest", "seed",
-                                               "texture-size"});
+                                               "texture-size"},
+                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
         if (args.command.empty() || args.command == "help" || args.has("help")) {
