@@ -141,5 +141,33 @@ TEST(BenchCli, JsonFileReportsSceneBuildApartFromGraphCompile) {
     EXPECT_NE(r.output.find("scene build"), std::string::npos) << r.output;
 }
 
+class RunKilledWhileWriting : public testing::TestWithParam<std::string> {};
+
+// A run whose writer dies halfway through a file (VITRINE_TEST_KILL_DURING_WRITE cuts the file being written to half
+// and SIGKILLs the process) leaves the file of the previous run as it was; a run that completes replaces it.
+TEST_P(RunKilledWhileWriting, LeavesThePreviousFileIntact) {
+    const std::string file = GetParam();
+    const fs::path out = freshDir("run_killed_" + file.substr(file.rfind('.') + 1));
+    const std::string base = "run " + quote(kZoneplate) + " " + kTiny + " --validate --quiet --out " + quote(out.string());
+    ASSERT_EQ(vitrine(base).status, 0);
+    const std::string before = readFile(out / file);
+    ASSERT_FALSE(before.empty());
+
+    const std::string changed = base + " --set pattern.params.max_frequency=0.1";
+    CliResult killed = vitrine(changed, "VITRINE_TEST_KILL_DURING_WRITE=" + file);
+    EXPECT_EQ(killed.signal, SIGKILL) << killed.output;
+    EXPECT_EQ(readFile(out / file), before) << file << " was changed by the killed run";
+    EXPECT_NO_THROW(loadImage(out / file));
+    EXPECT_FALSE(temporaryFiles(out).empty()) << "the killed run left no temporary file: did it write at all?";
+
+    ASSERT_EQ(vitrine(changed).status, 0);
+    EXPECT_NE(readFile(out / file), before) << "the changed graph renders the same " << file;
+}
+
+INSTANTIATE_TEST_SUITE_P(Outputs, RunKilledWhileWriting, testing::Values("final.png", "frame.0000.exr"),
+                         [](const testing::TestParamInfo<std::string>& info) {
+                             return info.param.substr(info.param.rfind('.') + 1);
+                         });
+
 } // namespace
 } // namespace vitrine::test

@@ -1,6 +1,7 @@
 // `vitrine compare A B [--reference R]`: renders graphs or loads images, computes PSNR, SSIM and FLIP (and, over
 // --frames a:b, flicker and error per frame), writes the images, heat maps, metrics.json and one self-contained
 // report.html. The metrics and the report come from core/compare; this file only gathers the inputs.
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/compare/report.hpp"
@@ -114,10 +115,7 @@ void requireSameSize(const Input& a, const Input& b) {
 }
 
 void writeBytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    file.close();
-    if (!file) throw UserError(path.string() + ": cannot write the file");
+    writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 // Writes NAME.png (and NAME.exr with the float values when `exr`) and returns the PNG for the report.
@@ -281,7 +279,7 @@ int compareCommand(const Args& args) {
     if (a.graph) report.graphA = a.graph->document;
     if (b.graph) report.graphB = b.graph->document;
 
-    std::ofstream(out.claim("metrics.json")) << compare::metricsJson(report).dump(2) << "\n";
+    writeFileAtomically(out.claim("metrics.json"), compare::metricsJson(report).dump(2) + "\n");
     compare::writeReport(out.claim("report.html"), report);
 
     for (const compare::PairMetrics& m : report.metrics)
