@@ -455,7 +455,7 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
     }
 }
 
-void Executor::run(const RunOptions& options) {
+uint32_t Executor::run(const RunOptions& options) {
     const FrameSettings& fs = mGraph.desc.frame;
     const uint32_t frames = options.frames ? options.frames : fs.frames;
     std::set<uint32_t> write(options.write.begin(), options.write.end());
@@ -488,9 +488,14 @@ void Executor::run(const RunOptions& options) {
             }
         }
         if (progress) progress->advance();
+        if (options.stop && options.stop() && mFrame + 1 < frames) {
+            mCtx.freeCommandBuffer(cmd);
+            return mFrame + 1; // mFrame stays the last frame run, as after a full run
+        }
     }
     mFrame = frames - 1;
     mCtx.freeCommandBuffer(cmd);
+    return frames;
 }
 
 const GpuImage& Executor::image(const std::string& resource) const {

@@ -141,6 +141,85 @@ TEST(BenchCli, JsonFileReportsSceneBuildApartFromGraphCompile) {
     EXPECT_NE(r.output.find("scene build"), std::string::npos) << r.output;
 }
 
+// Starts `vitrine ARGS` in the background with its output going to `log`; returns its pid.
+pid_t spawnVitrine(const std::vector<std::string>& args, const fs::path& log) {
+    pid_t pid = fork();
+    if (pid == 0) {
+        int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(fd, 1);
+        dup2(fd, 2);
+        std::vector<char*> argv = {const_cast<char*>(VITRINE_BINARY)};
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(VITRINE_BINARY, argv.data());
+        _exit(127);
+    }
+    return pid;
+}
+
+// Waits up to `seconds` for the child; -1 (and kills it) when it did not end.
+int waitFor(pid_t pid, int seconds, int& status) {
+    for (int i = 0; i < seconds * 20; ++i) {
+        if (waitpid(pid, &status, WNOHANG) == pid) return 0;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    return -1;
+}
+
+class RunInterrupted : public testing::TestWithParam<int> {};
+
+// A long run writing every frame is signalled once frame 3 is on disk. It must exit 130 after finishing the frame it
+// was in: every frame before the stop has all its files (two PNGs and the EXR), none after it has any.
+TEST_P(RunInterrupted, StopsAtAFrameBoundaryWithExit130) {
+    const int signal = GetParam();
+    const fs::path out = freshDir(std::string("run_interrupted_") + (signal == SIGINT ? "int" : "term"));
+    std::string write = "frame.write=[";
+    for (int f = 0; f < 400; ++f)
+        write += (f ? "," : "") + std::to_string(f);
+    write += "]";
+    const pid_t pid = spawnVitrine({"run", kZoneplate, "--frames", "1000000", "--set", "frame.width=32", "--set",
+                                    "frame.height=18", "--set", write, "--set", "outputs.raw=pattern.color", "--quiet",
+                                    "--out", out.string()},
+                                   out / "log.txt");
+    ASSERT_GT(pid, 0);
+    bool started = false;
+    for (int i = 0; i < 1200 && !started; ++i) {
+        started = fs::exists(out / "final.0003.png");
+        if (!started) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    kill(pid, signal);
+    int status = 0;
+    ASSERT_EQ(waitFor(pid, 120, status), 0) << "still running 120 s after the signal; log:\n"
+                                            << readFile(out / "log.txt");
+    ASSERT_TRUE(started) << "frame 3 never appeared; log:\n" << readFile(out / "log.txt");
+    const std::string log = readFile(out / "log.txt");
+    ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0) << "\n" << log;
+    EXPECT_EQ(WEXITSTATUS(status), 130) << log;
+    std::smatch m;
+    const std::string what = signal == SIGINT ? "interrupted \\(SIGINT\\)" : "terminated \\(SIGTERM\\)";
+    ASSERT_TRUE(std::regex_search(log, m, std::regex(what + ": stopped after (\\d+) of 1000000 frames"))) << log;
+    const uint32_t done = static_cast<uint32_t>(std::stoul(m[1]));
+    EXPECT_GE(done, 4u) << log;
+    EXPECT_LT(done, 1000000u) << log;
+    for (uint32_t f = 0; f < std::min(done, 400u); ++f) {
+        for (const std::string& name : {frameName("final", f, "png"), frameName("raw", f, "png"), frameName("frame", f, "exr")}) {
+            ASSERT_TRUE(fs::exists(out / name)) << name << " missing although " << done << " frames finished";
+            EXPECT_NO_THROW(loadImage(out / name)) << name;
+        }
+    }
+    for (uint32_t f = done; f < 400; ++f)
+        EXPECT_FALSE(fs::exists(out / frameName("final", f, "png")) || fs::exists(out / frameName("frame", f, "exr")))
+            << "frame " << f << " has files but the run said it stopped after " << done;
+    EXPECT_TRUE(temporaryFiles(out).empty()) << temporaryFiles(out).front();
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, RunInterrupted, testing::Values(SIGINT, SIGTERM),
+                         [](const testing::TestParamInfo<int>& info) {
+                             return std::string(info.param == SIGINT ? "Sigint" : "Sigterm");
+                         });
+
 class RunKilledWhileWriting : public testing::TestWithParam<std::string> {};
 
 // A run whose writer dies halfway through a file (VITRINE_TEST_KILL_DURING_WRITE cuts the file being written to half

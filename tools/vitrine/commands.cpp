@@ -11,11 +11,13 @@
 #include "core/scene/gpu_scene.hpp"
 #include "core/shader/compiler.hpp"
 #include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/interrupt.hpp"
 #include "tools/vitrine/output_dir.hpp"
 #include "tools/vitrine/render_output.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -73,7 +75,7 @@ int runCommand(const Args& args) {
     Executor executor(ctx, graph, shaders);
 
     const bool single = graph.desc.frame.write.size() == 1;
-    std::map<uint32_t, std::vector<std::pair<std::string, Image>>> frames;
+    std::vector<std::pair<std::string, Image>> layers; // the outputs of the frame being written
     RunOptions options;
     options.progress = !args.has("quiet");
     options.onOutput = [&](uint32_t frame, const std::string& name, const Image& image) {
@@ -81,15 +83,25 @@ int runCommand(const Args& args) {
         std::snprintf(suffix, sizeof suffix, ".%04u", frame);
         fs::path png = out.claim(name + (single ? "" : suffix) + ".png");
         writePng(png, image);
-        if (exrMode != "none") frames[frame].push_back({name, image});
-    };
-    executor.run(options);
-    for (auto& [frame, layers] : frames) {
-        char name[32];
-        std::snprintf(name, sizeof name, "frame.%04u.exr", frame);
+        if (exrMode == "none") return;
+        layers.push_back({name, image});
+        if (layers.size() < graph.outputs.size()) return;
+        // The frame's last output: its EXR now, so that a stopped run has every finished frame complete.
+        char exrName[32];
+        std::snprintf(exrName, sizeof exrName, "frame.%04u.exr", frame);
         std::vector<ExrLayer> exr;
-        for (const auto& [layer, image] : layers) exr.push_back({layer, &image});
-        writeExr(out.claim(name), exr, exrMode == "float" ? ExrPixelType::Float : ExrPixelType::Half);
+        for (const auto& [layer, layerImage] : layers) exr.push_back({layer, &layerImage});
+        writeExr(out.claim(exrName), exr, exrMode == "float" ? ExrPixelType::Float : ExrPixelType::Half);
+        layers.clear();
+    };
+    InterruptHandlers interrupts;
+    options.stop = [] { return InterruptHandlers::received() != 0; };
+    const uint32_t ran = executor.run(options);
+    if (int signal = InterruptHandlers::received(); signal && ran < graph.desc.frame.frames) {
+        logWarning(std::string(signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)") + ": stopped after " +
+                   std::to_string(ran) + " of " + std::to_string(graph.desc.frame.frames) +
+                   " frames; the files of the finished frames are in " + out.dir().string());
+        return kExitInterrupted;
     }
     if (ctx.validationMessageCount() > 0) {
         logWarning(std::to_string(ctx.validationMessageCount()) + " Vulkan validation message(s)");
