@@ -3,6 +3,7 @@
 // frame boundary with exit 130, a run killed while writing leaves the previous file intact, and a graph too large for
 // the device's memory is a user error naming the sizes. The real binary on the machine's Vulkan device (lavapipe in
 // CI), validation on, at small sizes.
+#include "core/gpu/memory_budget.hpp"
 #include "core/image/io.hpp"
 #include "gpu_test.hpp"
 
@@ -247,6 +248,52 @@ INSTANTIATE_TEST_SUITE_P(Outputs, RunKilledWhileWriting, testing::Values("final.
                          [](const testing::TestParamInfo<std::string>& info) {
                              return info.param.substr(info.param.rfind('.') + 1);
                          });
+
+// Enough 16384x16384 RGBA32F zone plates (4 GiB each) to exceed the largest heap of this device: the run must stop
+// before allocating, with exit 1 naming the graph, the frame size and the sizes involved.
+TEST(MemoryBudget, GraphTooLargeForTheDeviceIsAUserError) {
+    const MemoryBudget budget = queryMemoryBudget(gpu().physicalDevice());
+    VkDeviceSize largest = 0;
+    for (const HeapBudget& h : budget.heaps)
+        largest = std::max(largest, h.size);
+    const VkDeviceSize perImage = 16384ull * 16384ull * 16ull;
+    const size_t count = static_cast<size_t>(largest / perImage) + 1;
+    json graph = {{"format", "vitrine-graph/1"}, {"frame", {{"width", 16384}, {"height", 16384}}}};
+    for (size_t i = 0; i < count; ++i) {
+        graph["nodes"]["zp" + std::to_string(i)] = {{"type", "pattern.zoneplate"}};
+        graph["outputs"]["zp" + std::to_string(i)] = "zp" + std::to_string(i) + ".color";
+    }
+    const fs::path dir = freshDir("memory_budget_large");
+    std::ofstream(dir / "huge.json") << graph.dump(2);
+    const auto start = std::chrono::steady_clock::now();
+    CliResult r = vitrine("run " + quote((dir / "huge.json").string()) + " --validate --quiet --out " +
+                          quote((dir / "out").string()));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("huge.json: frame 16384x16384: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(" GiB"), std::string::npos) << r.output;
+    EXPECT_TRUE(r.output.find("per allocation") != std::string::npos ||
+                r.output.find("the graph's textures need") != std::string::npos)
+        << r.output;
+    EXPECT_LT(seconds, 60.0) << "it should stop before rendering anything";
+}
+
+// VITRINE_MEMORY_BUDGET lowers what the heaps may hold: the 1024x1024 zone plate + FXAA needs 48 MiB (a 32 MiB
+// transient heap for two overlapping RGBA32F textures, 16 MiB for the tone-mapped output).
+TEST(MemoryBudget, LoweredBudgetStopsAGraphThatNeedsMore) {
+    const fs::path out = freshDir("memory_budget_lowered");
+    const std::string args = "run " + quote(kZoneplate) + " --set frame.width=1024 --set frame.height=1024 --exr none " +
+                             "--validate --quiet --out " + quote(out.string());
+    CliResult low = vitrine(args, "VITRINE_MEMORY_BUDGET=40");
+    EXPECT_EQ(low.status, 1) << low.output;
+    EXPECT_NE(low.output.find("fxaa_zoneplate.json: frame 1024x1024: the graph's textures need 48.0 MiB"),
+              std::string::npos)
+        << low.output;
+    EXPECT_NE(low.output.find("VITRINE_MEMORY_BUDGET allows 40.0 MiB"), std::string::npos) << low.output;
+    EXPECT_FALSE(fs::exists(out / "final.png"));
+    CliResult enough = vitrine(args, "VITRINE_MEMORY_BUDGET=48");
+    EXPECT_EQ(enough.status, 0) << enough.output;
+}
 
 } // namespace
 } // namespace vitrine::test
