@@ -16,8 +16,7 @@ public:
     bool start_array(std::size_t elements) { return deeper() && Base::start_array(elements); }
     bool end_array() { return --mDepth, Base::end_array(); }
 
-    template <class Exception>
-    bool parse_error(std::size_t position, const std::string& token, const Exception& ex) {
+    template <class Exception> bool parse_error(std::size_t position, const std::string& token, const Exception& ex) {
         if (mMessage.empty()) {
             mPosition = position;
             mToken = token;
@@ -66,8 +65,10 @@ size_t tooDeepPosition(const std::string& text) {
     for (size_t i = 0; i < text.size(); ++i) {
         char c = text[i];
         if (inString) {
-            if (c == '\\') ++i;
-            else if (c == '"') inString = false;
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
         } else if (c == '"') {
             inString = true;
         } else if ((c == '[' || c == '{') && ++depth > kMaxJsonDepth) {

@@ -36,7 +36,8 @@ MemoryBudget queryMemoryBudget(VkPhysicalDevice physicalDevice) {
     for (uint32_t h = 0; h < m.memoryHeapCount; ++h) {
         HeapBudget heap{h, m.memoryHeaps[h].size, m.memoryHeaps[h].size, false};
         if (hasBudget && budget.heapBudget[h] > 0) {
-            heap.available = budget.heapBudget[h] > budget.heapUsage[h] ? budget.heapBudget[h] - budget.heapUsage[h] : 0;
+            heap.available =
+                budget.heapBudget[h] > budget.heapUsage[h] ? budget.heapBudget[h] - budget.heapUsage[h] : 0;
             heap.measured = true;
         }
         result.heaps.push_back(heap);
@@ -63,9 +64,12 @@ MemoryBudget queryMemoryBudget(VkPhysicalDevice physicalDevice) {
 
 std::string formatBytes(uint64_t bytes) {
     char text[32];
-    if (bytes >= (1ull << 30)) std::snprintf(text, sizeof text, "%.2f GiB", static_cast<double>(bytes) / (1ull << 30));
-    else if (bytes >= (1ull << 20)) std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1ull << 20));
-    else std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
+    if (bytes >= (1ull << 30))
+        std::snprintf(text, sizeof text, "%.2f GiB", static_cast<double>(bytes) / (1ull << 30));
+    else if (bytes >= (1ull << 20))
+        std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1ull << 20));
+    else
+        std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
     return text;
 }
 
@@ -88,9 +92,12 @@ std::string checkMemoryBudget(const GraphMemoryPlan& plan, const MemoryBudget& b
         if (heap >= budget.heaps.size()) continue;
         const HeapBudget& h = budget.heaps[heap];
         if (bytes <= h.available) continue;
-        std::string has = "memory heap " + std::to_string(heap) + " of " + budget.device + " has " + formatBytes(h.size);
-        if (!budget.source.empty()) has += ", of which " + budget.source + " allows " + formatBytes(h.available);
-        else if (h.measured) has += ", of which " + formatBytes(h.available) + " are available (VK_EXT_memory_budget)";
+        std::string has =
+            "memory heap " + std::to_string(heap) + " of " + budget.device + " has " + formatBytes(h.size);
+        if (!budget.source.empty())
+            has += ", of which " + budget.source + " allows " + formatBytes(h.available);
+        else if (h.measured)
+            has += ", of which " + formatBytes(h.available) + " are available (VK_EXT_memory_budget)";
         return "the graph's textures need " + formatBytes(bytes) + " of device memory, but " + has +
                "; the largest part is " + largest[heap] + " (" + formatBytes(largestBytes[heap]) + ")";
     }

@@ -18,11 +18,11 @@ struct HeapBudget {
 
 struct MemoryBudget {
     std::string device;
-    std::vector<HeapBudget> heaps;     // indexed by heap
-    std::vector<uint32_t> heapOfType;  // memory type index -> heap index
-    VkDeviceSize maxAllocation = 0;    // maxMemoryAllocationSize: the largest single vkAllocateMemory
-    bool enforced = true;              // false: VITRINE_MEMORY_BUDGET=off
-    std::string source;                // what `available` is: "" (the device), or "VITRINE_MEMORY_BUDGET"
+    std::vector<HeapBudget> heaps;    // indexed by heap
+    std::vector<uint32_t> heapOfType; // memory type index -> heap index
+    VkDeviceSize maxAllocation = 0;   // maxMemoryAllocationSize: the largest single vkAllocateMemory
+    bool enforced = true;             // false: VITRINE_MEMORY_BUDGET=off
+    std::string source;               // what `available` is: "" (the device), or "VITRINE_MEMORY_BUDGET"
 };
 
 // Reads heap sizes, the largest allocation and, when the device has VK_EXT_memory_budget, what each heap has left.
@@ -33,7 +33,7 @@ MemoryBudget queryMemoryBudget(VkPhysicalDevice physicalDevice);
 // What a compiled graph will allocate for its textures, per memory type, before anything is allocated.
 struct GraphMemoryPlan {
     struct Allocation {
-        std::string what;        // "the transient heap (12 textures, aliased)" or "texture gbuffer.normal"
+        std::string what; // "the transient heap (12 textures, aliased)" or "texture gbuffer.normal"
         uint32_t memoryType = 0;
         VkDeviceSize bytes = 0;
     };

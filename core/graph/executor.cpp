@@ -319,14 +319,16 @@ void Executor::createImages() {
     const uint32_t transientType =
         transient.empty() ? 0 : mCtx.allocator().findMemoryType(typeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     if (!transient.empty())
-        memoryPlan.allocations.push_back({"the transient heap (" + std::to_string(transient.size()) +
-                                              " textures, aliased)", transientType, plan.heapSize});
+        memoryPlan.allocations.push_back(
+            {"the transient heap (" + std::to_string(transient.size()) + " textures, aliased)", transientType,
+             plan.heapSize});
     for (const GraphResource& r : mGraph.resources) {
         if (r.transient() || !r.isTexture()) continue;
         VkMemoryRequirements req = GpuImage::requirements(mCtx, r.desc);
         uint32_t type = mCtx.allocator().findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
         for (int c = 0; c < (r.history ? 2 : 1); ++c)
-            memoryPlan.allocations.push_back({"texture " + r.name + (r.history ? " (history, 2 copies)" : ""), type, req.size});
+            memoryPlan.allocations.push_back(
+                {"texture " + r.name + (r.history ? " (history, 2 copies)" : ""), type, req.size});
     }
     const std::string tooLarge = checkMemoryBudget(memoryPlan, queryMemoryBudget(mCtx.physicalDevice()));
     if (!tooLarge.empty())

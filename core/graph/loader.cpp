@@ -94,9 +94,12 @@ void applySet(nlohmann::json& doc, const std::string& assignment) {
 
     nlohmann::json value;
     JsonTextError error;
-    if (std::optional<nlohmann::json> parsed = parseJsonText(text, error)) value = std::move(*parsed);
-    else if (error.kind == JsonTextError::Kind::Syntax) value = text;
-    else throw UserError("--set " + assignment + ": " + error.message);
+    if (std::optional<nlohmann::json> parsed = parseJsonText(text, error))
+        value = std::move(*parsed);
+    else if (error.kind == JsonTextError::Kind::Syntax)
+        value = text;
+    else
+        throw UserError("--set " + assignment + ": " + error.message);
 
     // Walked by hand rather than with a json_pointer, which throws its own exceptions when a number stands where
     // the key needs an object or an index is malformed.

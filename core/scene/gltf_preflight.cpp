@@ -124,7 +124,8 @@ std::string fourCC(uint32_t v) {
     std::string text;
     for (int i = 0; i < 4; ++i) {
         auto c = static_cast<unsigned char>(v >> (8 * i));
-        if (c >= 0x20 && c < 0x7F) text += static_cast<char>(c);
+        if (c >= 0x20 && c < 0x7F)
+            text += static_cast<char>(c);
         else {
             char esc[8];
             std::snprintf(esc, sizeof esc, "\\x%02X", c);
@@ -145,8 +146,8 @@ constexpr uint32_t kChunkBin = 0x004E4942u;
 std::string unwrapGlb(LoadContext& ctx, const std::vector<uint8_t>& bytes) {
     size_t size = bytes.size();
     if (size < 12) {
-        ctx.fail("GLB header", "the file has " + std::to_string(size) +
-                                   " bytes; expected a 12-byte header (magic, version, length)");
+        ctx.fail("GLB header",
+                 "the file has " + std::to_string(size) + " bytes; expected a 12-byte header (magic, version, length)");
     }
     uint32_t magic = readU32(bytes, 0), version = readU32(bytes, 4), length = readU32(bytes, 8);
     if (magic != kGlbMagic)
@@ -161,8 +162,9 @@ std::string unwrapGlb(LoadContext& ctx, const std::vector<uint8_t>& bytes) {
                                    std::to_string(size) + "; the rest is ignored");
     }
     if (length < 20) {
-        ctx.fail("GLB header", "length " + std::to_string(length) +
-                                   " leaves no room for the JSON chunk; expected at least 20 bytes (header + chunk header)");
+        ctx.fail("GLB header",
+                 "length " + std::to_string(length) +
+                     " leaves no room for the JSON chunk; expected at least 20 bytes (header + chunk header)");
     }
     uint32_t jsonLength = readU32(bytes, 12), jsonType = readU32(bytes, 16);
     if (jsonType != kChunkJson)
@@ -410,7 +412,8 @@ void preflight(LoadContext& ctx, const std::filesystem::path& file, const std::v
     if (!doc) {
         std::string where = "line " + std::to_string(error.line) + ", column " + std::to_string(error.column);
         std::string element = glb ? "GLB JSON chunk" : "JSON";
-        if (error.kind == JsonTextError::Kind::Syntax) ctx.fail(element, "not valid JSON (" + where + ": " + error.message + ")");
+        if (error.kind == JsonTextError::Kind::Syntax)
+            ctx.fail(element, "not valid JSON (" + where + ": " + error.message + ")");
         ctx.fail(element + " " + where, error.message);
     }
     ctx.doc = std::move(*doc);

@@ -43,9 +43,9 @@ std::string quote(const std::string& s) {
 }
 
 struct CliResult {
-    int status = -1;     // exit status, or -1 when the program did not exit normally
-    int signal = 0;      // the signal that ended it, if one did
-    std::string output;  // stdout and stderr
+    int status = -1;    // exit status, or -1 when the program did not exit normally
+    int signal = 0;     // the signal that ended it, if one did
+    std::string output; // stdout and stderr
 };
 
 // Runs `ENV vitrine ARGS` through the shell with stderr merged into stdout.
@@ -94,8 +94,8 @@ std::string frameName(const std::string& stem, uint32_t frame, const std::string
 
 TEST(RunCli, FramesCountBeforeValidation) {
     const fs::path out = freshDir("run_frames");
-    CliResult r = vitrine("run " + quote(kZoneplate) + " " + kTiny + " --frames 3 --set 'frame.write=[0,2]' --validate --quiet --out " +
-                          quote(out.string()));
+    CliResult r = vitrine("run " + quote(kZoneplate) + " " + kTiny +
+                          " --frames 3 --set 'frame.write=[0,2]' --validate --quiet --out " + quote(out.string()));
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(fs::exists(out / "final.0000.png")) << r.output;
     EXPECT_TRUE(fs::exists(out / "final.0002.png")) << r.output;
@@ -105,8 +105,9 @@ TEST(RunCli, FramesCountBeforeValidation) {
 
 TEST(CompareCli, FramesCountBeforeValidation) {
     const fs::path out = freshDir("compare_frames");
-    CliResult r = vitrine("compare " + quote(kZoneplate) + " " + quote(kSource + "/graphs/variants/no_fxaa.json") + " " +
-                          kTiny + " --frames 0:2 --set 'frame.write=[2]' --validate --quiet --out " + quote(out.string()));
+    CliResult r =
+        vitrine("compare " + quote(kZoneplate) + " " + quote(kSource + "/graphs/variants/no_fxaa.json") + " " + kTiny +
+                " --frames 0:2 --set 'frame.write=[2]' --validate --quiet --out " + quote(out.string()));
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_TRUE(fs::exists(out / "metrics.json")) << r.output;
 }
@@ -114,12 +115,13 @@ TEST(CompareCli, FramesCountBeforeValidation) {
 // The scene node's setup (building or loading the scene) is reported as scene_build, not inside compile_ms.graph.
 TEST(BenchCli, JsonFileReportsSceneBuildApartFromGraphCompile) {
     const fs::path dir = freshDir("bench_scene");
-    const json graph = {{"format", "vitrine-graph/1"},
-                        {"frame", {{"width", 32}, {"height", 18}}},
-                        {"nodes",
-                         {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", kSource + "/tests/data/gltf/quad.gltf"}}}}},
-                          {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}}}},
-                        {"outputs", {{"normal", "gbuffer.normal"}}}};
+    const json graph = {
+        {"format", "vitrine-graph/1"},
+        {"frame", {{"width", 32}, {"height", 18}}},
+        {"nodes",
+         {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", kSource + "/tests/data/gltf/quad.gltf"}}}}},
+          {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}}}},
+        {"outputs", {{"normal", "gbuffer.normal"}}}};
     std::ofstream(dir / "graph.json") << graph.dump(2);
     // 2 + 1 warm-up frames: frame.write may name frame 2 although the file has one frame.
     CliResult r = vitrine("bench " + quote((dir / "graph.json").string()) +
@@ -129,7 +131,8 @@ TEST(BenchCli, JsonFileReportsSceneBuildApartFromGraphCompile) {
     const json bench = json::parse(readFile(dir / "bench.json"), nullptr, false);
     ASSERT_TRUE(bench.is_object()) << readFile(dir / "bench.json");
     const json& compile = bench["compile_ms"];
-    ASSERT_TRUE(compile.contains("graph") && compile.contains("scene_build") && compile.contains("pipelines")) << compile;
+    ASSERT_TRUE(compile.contains("graph") && compile.contains("scene_build") && compile.contains("pipelines"))
+        << compile;
     double sceneSetup = -1.0, gbufferSetup = -1.0;
     for (const json& p : bench["passes"]) {
         if (p["id"] == "scene") sceneSetup = p["setup_ms"].get<double>();
@@ -150,7 +153,8 @@ pid_t spawnVitrine(const std::vector<std::string>& args, const fs::path& log) {
         dup2(fd, 1);
         dup2(fd, 2);
         std::vector<char*> argv = {const_cast<char*>(VITRINE_BINARY)};
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        for (const auto& a : args)
+            argv.push_back(const_cast<char*>(a.c_str()));
         argv.push_back(nullptr);
         execv(VITRINE_BINARY, argv.data());
         _exit(127);
@@ -180,10 +184,10 @@ TEST_P(RunInterrupted, StopsAtAFrameBoundaryWithExit130) {
     for (int f = 0; f < 400; ++f)
         write += (f ? "," : "") + std::to_string(f);
     write += "]";
-    const pid_t pid = spawnVitrine({"run", kZoneplate, "--frames", "1000000", "--set", "frame.width=32", "--set",
-                                    "frame.height=18", "--set", write, "--set", "outputs.raw=pattern.color", "--quiet",
-                                    "--out", out.string()},
-                                   out / "log.txt");
+    const pid_t pid =
+        spawnVitrine({"run", kZoneplate, "--frames", "1000000", "--set", "frame.width=32", "--set", "frame.height=18",
+                      "--set", write, "--set", "outputs.raw=pattern.color", "--quiet", "--out", out.string()},
+                     out / "log.txt");
     ASSERT_GT(pid, 0);
     bool started = false;
     for (int i = 0; i < 1200 && !started; ++i) {
@@ -205,7 +209,8 @@ TEST_P(RunInterrupted, StopsAtAFrameBoundaryWithExit130) {
     EXPECT_GE(done, 4u) << log;
     EXPECT_LT(done, 1000000u) << log;
     for (uint32_t f = 0; f < std::min(done, 400u); ++f) {
-        for (const std::string& name : {frameName("final", f, "png"), frameName("raw", f, "png"), frameName("frame", f, "exr")}) {
+        for (const std::string& name :
+             {frameName("final", f, "png"), frameName("raw", f, "png"), frameName("frame", f, "exr")}) {
             ASSERT_TRUE(fs::exists(out / name)) << name << " missing although " << done << " frames finished";
             EXPECT_NO_THROW(loadImage(out / name)) << name;
         }
@@ -228,7 +233,8 @@ class RunKilledWhileWriting : public testing::TestWithParam<std::string> {};
 TEST_P(RunKilledWhileWriting, LeavesThePreviousFileIntact) {
     const std::string file = GetParam();
     const fs::path out = freshDir("run_killed_" + file.substr(file.rfind('.') + 1));
-    const std::string base = "run " + quote(kZoneplate) + " " + kTiny + " --validate --quiet --out " + quote(out.string());
+    const std::string base =
+        "run " + quote(kZoneplate) + " " + kTiny + " --validate --quiet --out " + quote(out.string());
     ASSERT_EQ(vitrine(base).status, 0);
     const std::string before = readFile(out / file);
     ASSERT_FALSE(before.empty());
@@ -282,7 +288,8 @@ TEST(MemoryBudget, GraphTooLargeForTheDeviceIsAUserError) {
 // transient heap for two overlapping RGBA32F textures, 16 MiB for the tone-mapped output).
 TEST(MemoryBudget, LoweredBudgetStopsAGraphThatNeedsMore) {
     const fs::path out = freshDir("memory_budget_lowered");
-    const std::string args = "run " + quote(kZoneplate) + " --set frame.width=1024 --set frame.height=1024 --exr none " +
+    const std::string args = "run " + quote(kZoneplate) +
+                             " --set frame.width=1024 --set frame.height=1024 --exr none " +
                              "--validate --quiet --out " + quote(out.string());
     CliResult low = vitrine(args, "VITRINE_MEMORY_BUDGET=40");
     EXPECT_EQ(low.status, 1) << low.output;

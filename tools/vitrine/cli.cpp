@@ -58,8 +58,10 @@ Args parse(int argc, char** argv, const std::vector<std::string>& valued,
             bool takes = mayOmit || listed(valued, name);
             if (takes && !hasValue) {
                 bool nextIsValue = i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0;
-                if (nextIsValue) value = argv[++i];
-                else if (!mayOmit) throw UserError("--" + name + " needs a value");
+                if (nextIsValue)
+                    value = argv[++i];
+                else if (!mayOmit)
+                    throw UserError("--" + name + " needs a value");
             } else if (!takes && hasValue) {
                 throw UserError("--" + name + " takes no value");
             }

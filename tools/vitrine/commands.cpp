@@ -98,8 +98,8 @@ int runCommand(const Args& args) {
     options.stop = [] { return InterruptHandlers::received() != 0; };
     const uint32_t ran = executor.run(options);
     if (int signal = InterruptHandlers::received(); signal && ran < graph.desc.frame.frames) {
-        logWarning(std::string(signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)") + ": stopped after " +
-                   std::to_string(ran) + " of " + std::to_string(graph.desc.frame.frames) +
+        logWarning(std::string(signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)") +
+                   ": stopped after " + std::to_string(ran) + " of " + std::to_string(graph.desc.frame.frames) +
                    " frames; the files of the finished frames are in " + out.dir().string());
         return kExitInterrupted;
     }
@@ -157,10 +157,11 @@ int benchCommand(const Args& args) {
     double graphMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - compileStart).count();
     // Scene nodes build (the museum) or load (glTF) their scene in setup(): reported apart from compiling the graph.
     double sceneMs = 0.0;
+    auto outputsScene = [&](const PassUse& u) {
+        return u.output && graph.resources[u.resource].kind == PortKind::Scene;
+    };
     for (const CompiledPass& p : graph.passes)
-        if (std::any_of(p.uses.begin(), p.uses.end(),
-                        [&](const PassUse& u) { return u.output && graph.resources[u.resource].kind == PortKind::Scene; }))
-            sceneMs += p.setupMs;
+        if (std::any_of(p.uses.begin(), p.uses.end(), outputsScene)) sceneMs += p.setupMs;
     graphMs -= sceneMs;
 
     Context ctx(contextOptions(args));

@@ -50,10 +50,10 @@ validation messages with --validate), 3 `golden check` found images beyond toler
 int main(int argc, char** argv) {
     using namespace vitrine;
     try {
-        cli::Args args = cli::parse(argc, argv, {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                               "output", "ppd", "diff-scale", "manifest", "seed",
-                                               "texture-size"},
-                                     {{"nodes", {"json"}}});
+        cli::Args args = cli::parse(argc, argv,
+                                    {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
+                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size"},
+                                    {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
         if (args.command.empty() || args.command == "help" || args.has("help")) {

@@ -115,10 +115,10 @@ const BadGraph kBadGraphRows[] = {
     {"graphs/fxaa_zoneplate.json", "--set 'frame.write=[0]' --set frame.write.01=1",
      ": /frame/write/01: ", "expected an array index in [0, 1]"},
     // The glTF errors name the glTF file (the path is relative to the graph) and what is wrong in it.
-    {"gltf_number_too_large.json", "", ": /nodes/scene/params/path: ",
-     "number_too_large.gltf: JSON line 10, column 55: the number '1e309' is too large"},
-    {"gltf_bad_magic.json", "", ": /nodes/scene/params/path: ",
-     "bad_magic.glb: GLB header: magic is 'glTX' (0x58546C67); expected 'glTF'"},
+    {"gltf_number_too_large.json", "",
+     ": /nodes/scene/params/path: ", "number_too_large.gltf: JSON line 10, column 55: the number '1e309' is too large"},
+    {"gltf_bad_magic.json", "",
+     ": /nodes/scene/params/path: ", "bad_magic.glb: GLB header: magic is 'glTX' (0x58546C67); expected 'glTF'"},
     // --frames is frame.frames before validation: frame.write may name frames the file alone does not have.
     {"graphs/fxaa_zoneplate.json", "--frames 4 --set 'frame.write=[0,4]'",
      ": /frame/write/1: ", "expected an integer in [0, 3], got 4"},
@@ -232,8 +232,8 @@ TEST(GraphCli, BenchJsonStillNeedsAFile) {
 }
 
 TEST(GraphCli, FramesCountBeforeValidation) {
-    CliResult museum = vitrine("validate " + quote(kSource + "/graphs/museum.json") +
-                               " --frames 24 --set 'frame.write=[0,12,23]'");
+    CliResult museum =
+        vitrine("validate " + quote(kSource + "/graphs/museum.json") + " --frames 24 --set 'frame.write=[0,12,23]'");
     EXPECT_EQ(museum.status, 0) << museum.output;
     EXPECT_NE(museum.output.find("museum.json: ok"), std::string::npos) << museum.output;
     CliResult zero = vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " --frames 0");

@@ -21,15 +21,15 @@ MemoryBudget twoHeaps() {
 
 TEST(MemoryBudget, FitsWhenEveryHeapHoldsItsShare) {
     GraphMemoryPlan plan;
-    plan.allocations = {{"the transient heap", 0, 500 * kMiB}, {"texture a.color", 1, 500 * kMiB},
-                        {"texture b.color", 2, 256 * kMiB}};
+    plan.allocations = {
+        {"the transient heap", 0, 500 * kMiB}, {"texture a.color", 1, 500 * kMiB}, {"texture b.color", 2, 256 * kMiB}};
     EXPECT_EQ(checkMemoryBudget(plan, twoHeaps()), "");
 }
 
 TEST(MemoryBudget, SumsAllocationsOfOneHeapAcrossMemoryTypes) {
     GraphMemoryPlan plan;
-    plan.allocations = {{"the transient heap", 0, 500 * kMiB}, {"texture a.color", 1, 500 * kMiB},
-                        {"texture b.color", 1, 100 * kMiB}};
+    plan.allocations = {
+        {"the transient heap", 0, 500 * kMiB}, {"texture a.color", 1, 500 * kMiB}, {"texture b.color", 1, 100 * kMiB}};
     const std::string message = checkMemoryBudget(plan, twoHeaps());
     EXPECT_NE(message.find("need 1.07 GiB of device memory, but memory heap 0 of test device has 1.00 GiB"),
               std::string::npos)
