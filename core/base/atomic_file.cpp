@@ -55,7 +55,8 @@ void writeFileAtomically(const fs::path& path, const std::function<void(const fs
     const fs::path directory = path.parent_path();
     std::error_code ec;
     if (!directory.empty() && !fs::is_directory(directory, ec))
-        throw UserError(path.string() + ": cannot write, directory '" + directory.string() + "' does not exist");
+        throw UserError(path.string() + ": cannot open for writing: directory '" + directory.string() +
+                        "' does not exist");
     const fs::path temporary = temporaryFor(path);
     try {
         write(temporary);
