@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs every Debian package vitrine needs to build, run and test. Idempotent: packages
 # already present are skipped by apt. Needs root (or sudo) on Debian 12 (bookworm).
+# --fuzz: also clang and its runtime libraries for tools/fuzz.sh (libFuzzer, ASan, UBSan: on bookworm
+# libclang_rt.fuzzer-x86_64.a is in libclang-rt-14-dev, which the libclang-rt-dev package pulls in; clang only
+# recommends it, and recommendations are not installed here).
 set -euo pipefail
 
 packages=(
@@ -11,6 +14,9 @@ packages=(
     libopenexr-dev libimath-dev libopencolorio-dev
     libgtest-dev libgmock-dev libbenchmark-dev
 )
+if [ "${1:-}" = "--fuzz" ]; then
+    packages+=(clang libclang-rt-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -1,5 +1,6 @@
 #include "core/compare/report.hpp"
 
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 
 #include <algorithm>
@@ -179,13 +180,7 @@ nlohmann::json metricsJson(const ReportInput& input) {
 }
 
 void writeReport(const std::filesystem::path& path, const ReportInput& input) {
-    const std::string html = renderReportHtml(input);
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    if (!file)
-        throw UserError("compare report: cannot open '" + path.string() + "' for writing (expected a writable path)");
-    file.write(html.data(), static_cast<std::streamsize>(html.size()));
-    file.close();
-    if (!file) throw UserError("compare report: failed to write '" + path.string() + "'");
+    writeFileAtomically(path, renderReportHtml(input));
 }
 
 std::string escapeHtml(std::string_view text) {

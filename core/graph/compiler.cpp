@@ -190,7 +190,9 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
         }
 
         Setup setup(g, p, decl);
+        auto setupStart = std::chrono::steady_clock::now();
         p.node->setup(setup);
+        p.setupMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - setupStart).count();
         for (const auto& u : p.uses)
             if (u.output && !g.resources[u.resource].isTexture() && !g.resources[u.resource].object)
                 throw InternalError("node " + decl.id + " (" + decl.schema->type + ") set no object on output '" + u.port + "'");

@@ -49,6 +49,7 @@ struct CompiledPass {
     std::unique_ptr<Params> params;
     std::vector<PassUse> uses;
     std::vector<PipelineRequest> pipelines;
+    double setupMs = 0.0; // the node's setup() at compile time (scene nodes build or load their scene there)
 };
 
 struct CompiledGraph {

@@ -4,6 +4,7 @@
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/formats.hpp"
+#include "core/gpu/memory_budget.hpp"
 #include "core/gpu/pipeline.hpp"
 #include "core/gpu/profiler.hpp"
 #include "core/gpu/transfer.hpp"
@@ -309,11 +310,37 @@ void Executor::createImages() {
     AliasPlan plan = planAliasing(requests);
     mMemory.transientAliased = plan.heapSize;
     mMemory.transientUnaliased = plan.unaliasedSize;
+    if (!transient.empty() && typeBits == 0)
+        throw InternalError("transient textures share no memory type; cannot alias them");
+
+    // Everything the textures will take, checked against the device before the first allocation: a graph too large
+    // for the device is the user's to change (frame size, outputs), not a driver failure halfway through.
+    GraphMemoryPlan memoryPlan;
+    const uint32_t transientType =
+        transient.empty() ? 0 : mCtx.allocator().findMemoryType(typeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    if (!transient.empty())
+        memoryPlan.allocations.push_back(
+            {"the transient heap (" + std::to_string(transient.size()) + " textures, aliased)", transientType,
+             plan.heapSize});
+    for (const GraphResource& r : mGraph.resources) {
+        if (r.transient() || !r.isTexture()) continue;
+        VkMemoryRequirements req = GpuImage::requirements(mCtx, r.desc);
+        uint32_t type = mCtx.allocator().findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        for (int c = 0; c < (r.history ? 2 : 1); ++c)
+            memoryPlan.allocations.push_back(
+                {"texture " + r.name + (r.history ? " (history, 2 copies)" : ""), type, req.size});
+    }
+    const std::string tooLarge = checkMemoryBudget(memoryPlan, queryMemoryBudget(mCtx.physicalDevice()));
+    if (!tooLarge.empty())
+        throw UserError(mGraph.desc.file + ": frame " + std::to_string(mGraph.desc.frame.width) + "x" +
+                        std::to_string(mGraph.desc.frame.height) + ": " + tooLarge +
+                        "; use a smaller frame.width/frame.height or fewer outputs (VITRINE_MEMORY_BUDGET=off skips "
+                        "this check, for devices that can use more than they report)");
+
     if (!transient.empty()) {
-        if (typeBits == 0) throw InternalError("transient textures share no memory type; cannot alias them");
         VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
         info.allocationSize = plan.heapSize;
-        info.memoryTypeIndex = mCtx.allocator().findMemoryType(typeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        info.memoryTypeIndex = transientType;
         VK_CHECK(vkAllocateMemory(mCtx.device(), &info, nullptr, &mTransientHeap));
     }
 
@@ -455,7 +482,7 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
     }
 }
 
-void Executor::run(const RunOptions& options) {
+uint32_t Executor::run(const RunOptions& options) {
     const FrameSettings& fs = mGraph.desc.frame;
     const uint32_t frames = options.frames ? options.frames : fs.frames;
     std::set<uint32_t> write(options.write.begin(), options.write.end());
@@ -488,9 +515,14 @@ void Executor::run(const RunOptions& options) {
             }
         }
         if (progress) progress->advance();
+        if (options.stop && options.stop() && mFrame + 1 < frames) {
+            mCtx.freeCommandBuffer(cmd);
+            return mFrame + 1; // mFrame stays the last frame run, as after a full run
+        }
     }
     mFrame = frames - 1;
     mCtx.freeCommandBuffer(cmd);
+    return frames;
 }
 
 const GpuImage& Executor::image(const std::string& resource) const {

@@ -33,6 +33,9 @@ struct RunOptions {
     bool progress = true;
     // Called for every graph output of every written frame, after the frame completed.
     std::function<void(uint32_t frame, const std::string& output, const Image& image)> onOutput;
+    // Asked after every frame (once its outputs went to onOutput): true ends the run at that frame boundary.
+    // `vitrine run` stops there on Ctrl-C / SIGTERM.
+    std::function<bool()> stop;
 };
 
 // Phase 7: turns a CompiledGraph into Vulkan objects (physical images, the aliased transient
@@ -45,7 +48,8 @@ public:
     Executor(const Executor&) = delete;
     Executor& operator=(const Executor&) = delete;
 
-    void run(const RunOptions& options = {});
+    // Runs the frames and returns how many completed (fewer than asked when options.stop ended the run).
+    uint32_t run(const RunOptions& options = {});
 
     const std::vector<FrameTiming>& timings() const { return mTimings; }
     const MemoryStats& memory() const { return mMemory; }

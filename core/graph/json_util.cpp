@@ -1,6 +1,7 @@
 #include "core/graph/json_util.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/json_text.hpp"
 
 #include <fstream>
 #include <sstream>
@@ -8,25 +9,12 @@
 namespace vitrine {
 
 nlohmann::json parseJson(const std::string& text, const std::string& file) {
-    try {
-        return nlohmann::json::parse(text);
-    } catch (const nlohmann::json::parse_error& e) {
-        size_t line = 1, column = 1;
-        size_t end = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
-        for (size_t i = 0; i < end; ++i) {
-            if (text[i] == '\n') {
-                ++line;
-                column = 1;
-            } else {
-                ++column;
-            }
-        }
-        std::string what = e.what();
-        // nlohmann prefixes "[json.exception.parse_error.101] parse error at line 3, column 5: ".
-        auto colon = what.find(": ", what.find("parse error"));
-        std::string detail = colon == std::string::npos ? what : what.substr(colon + 2);
-        throw UserError(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": JSON syntax error: " + detail);
-    }
+    JsonTextError error;
+    std::optional<nlohmann::json> json = parseJsonText(text, error);
+    if (!json)
+        throw UserError(file + ":" + std::to_string(error.line) + ":" + std::to_string(error.column) + ": " +
+                        error.describe());
+    return std::move(*json);
 }
 
 nlohmann::json readJsonFile(const std::filesystem::path& path) {
@@ -50,7 +38,8 @@ std::string pointerToken(const std::string& key) {
 }
 
 std::string brief(const nlohmann::json& value) {
-    std::string s = value.dump();
+    // Strings from --set may hold bytes that are not UTF-8; an error message must not throw.
+    std::string s = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     if (s.size() > 60) s = s.substr(0, 57) + "...";
     return s;
 }

@@ -1,6 +1,7 @@
 #include "core/graph/loader.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/json_text.hpp"
 #include "core/graph/json_util.hpp"
 #include "core/graph/registry.hpp"
 
@@ -13,7 +14,9 @@ namespace fs = std::filesystem;
 namespace {
 
 nlohmann::json loadWithBases(const fs::path& file, std::vector<fs::path>& chain) {
-    fs::path canonical = fs::weakly_canonical(file);
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(file, ec);
+    if (ec) canonical = file.lexically_normal();
     if (std::find(chain.begin(), chain.end(), canonical) != chain.end()) {
         std::string cycle;
         for (const auto& p : chain) cycle += p.filename().string() + " -> ";
@@ -26,7 +29,6 @@ nlohmann::json loadWithBases(const fs::path& file, std::vector<fs::path>& chain)
     if (it == doc.end()) return doc;
     if (!it->is_string()) throw UserError(file.string() + ": /extends: expected a path to the base graph, got " + brief(*it));
     fs::path base = file.parent_path() / it->get<std::string>();
-    std::error_code ec;
     if (!fs::is_regular_file(base, ec))
         throw UserError(file.string() + ": /extends: base graph " + base.string() + " does not exist");
     nlohmann::json merged = loadWithBases(base, chain);
@@ -50,10 +52,30 @@ nlohmann::json loadGraphDocument(const fs::path& file, const std::vector<std::st
     return doc;
 }
 
+namespace {
+
+// The value of a JSON array index token: decimal without leading zeros (RFC 6901), at most `size` (which appends);
+// "-" appends too. -1 when the token is neither.
+int64_t arrayIndex(const std::string& token, size_t size) {
+    if (token == "-") return static_cast<int64_t>(size);
+    if (token.empty() || token.size() > 9 || (token.size() > 1 && token[0] == '0') ||
+        !std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; }))
+        return -1;
+    int64_t index = std::stoll(token);
+    return index <= static_cast<int64_t>(size) ? index : -1;
+}
+
+} // namespace
+
 void applySet(nlohmann::json& doc, const std::string& assignment) {
     auto eq = assignment.find('=');
     if (eq == std::string::npos || eq == 0)
         throw UserError("--set " + assignment + ": expected KEY=VALUE, e.g. tonemap.params.exposure=1.5");
+    try {
+        (void)nlohmann::json(assignment).dump();
+    } catch (const nlohmann::json::type_error&) {
+        throw UserError("--set: the assignment is not valid UTF-8 text");
+    }
     std::string key = assignment.substr(0, eq);
     std::string text = assignment.substr(eq + 1);
     std::vector<std::string> parts;
@@ -65,16 +87,43 @@ void applySet(nlohmann::json& doc, const std::string& assignment) {
     }
     if (std::any_of(parts.begin(), parts.end(), [](const auto& p) { return p.empty(); }))
         throw UserError("--set " + assignment + ": empty component in key '" + key + "'");
+    if (parts[0] != "frame" && parts[0] != "outputs") parts.insert(parts.begin(), "nodes");
+    if (parts[0] == "nodes" && !(doc.contains("nodes") && doc["nodes"].is_object() && doc["nodes"].contains(parts[1])))
+        throw UserError("/nodes/" + pointerToken(parts[1]) + ": --set " + assignment + ": the graph has no node '" +
+                        parts[1] + "'");
+
+    nlohmann::json value;
+    JsonTextError error;
+    if (std::optional<nlohmann::json> parsed = parseJsonText(text, error))
+        value = std::move(*parsed);
+    else if (error.kind == JsonTextError::Kind::Syntax)
+        value = text;
+    else
+        throw UserError("--set " + assignment + ": " + error.message);
+
+    // Walked by hand rather than with a json_pointer, which throws its own exceptions when a number stands where
+    // the key needs an object or an index is malformed.
+    nlohmann::json* at = &doc;
     std::string pointer;
-    if (parts[0] != "frame" && parts[0] != "outputs") pointer = "/nodes";
-    for (const auto& p : parts) pointer += "/" + pointerToken(p);
-    nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
-    if (value.is_discarded()) value = text;
-    nlohmann::json::json_pointer ptr(pointer);
-    if (pointer.rfind("/nodes/", 0) == 0 && !doc.contains(nlohmann::json::json_pointer("/nodes/" + pointerToken(parts[0]))))
-        throw UserError("/nodes/" + pointerToken(parts[0]) + ": --set " + assignment + ": the graph has no node '" +
-                        parts[0] + "'");
-    doc[ptr] = value;
+    for (const std::string& part : parts) {
+        const std::string parent = pointer.empty() ? "/" : pointer;
+        pointer += "/" + pointerToken(part);
+        if (at->is_null()) *at = nlohmann::json::object();
+        if (at->is_object()) {
+            at = &(*at)[part];
+        } else if (at->is_array()) {
+            int64_t index = arrayIndex(part, at->size());
+            if (index < 0)
+                throw UserError(pointer + ": --set " + assignment + ": expected an array index in [0, " +
+                                std::to_string(at->size()) + "] or '-' (the last two append)");
+            if (static_cast<size_t>(index) == at->size()) at->push_back(nullptr);
+            at = &(*at)[static_cast<size_t>(index)];
+        } else {
+            throw UserError(parent + ": --set " + assignment + ": cannot set '" + part + "' inside " + brief(*at) +
+                            "; expected an object here");
+        }
+    }
+    *at = std::move(value);
 }
 
 GraphDesc loadGraph(const fs::path& file, const std::vector<std::string>& sets) {

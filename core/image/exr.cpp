@@ -1,5 +1,6 @@
 #include "core/image/io.hpp"
 
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/image/io_detail.hpp"
 
@@ -255,10 +256,12 @@ void writeExr(const std::filesystem::path& path, const std::vector<ExrLayer>& la
                                Imf::Slice(pixelType, base + c * sampleSize, 4 * sampleSize, 4 * sampleSize * width));
         }
     }
-    withExrErrors(path, "cannot write OpenEXR file", [&] {
-        Imf::OutputFile file(path.string().c_str(), header);
-        file.setFrameBuffer(frameBuffer);
-        file.writePixels(height);
+    writeFileAtomically(path, [&](const std::filesystem::path& temporary) {
+        withExrErrors(temporary, "cannot write OpenEXR file", [&] {
+            Imf::OutputFile file(temporary.string().c_str(), header);
+            file.setFrameBuffer(frameBuffer);
+            file.writePixels(height);
+        });
     });
 }
 

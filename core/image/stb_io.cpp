@@ -1,5 +1,6 @@
 #include "core/image/io.hpp"
 
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/image/io_detail.hpp"
 
@@ -94,11 +95,7 @@ void writePng(const std::filesystem::path& path, const Image& linear, const Colo
               const std::string& display, const std::string& view) {
     detail::requireParentDirectory(path);
     const std::vector<unsigned char> png = encodePng(linear, config, display, view);
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) throw UserError(path.string() + ": cannot open for writing (" + std::strerror(errno) + ")");
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-    out.close();
-    if (!out) throw UserError(path.string() + ": cannot write the PNG data (" + std::strerror(errno) + ")");
+    writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
 }
 
 } // namespace vitrine

@@ -37,6 +37,10 @@ inline constexpr const char* kLayersExtension = "VITRINE_material_layers";
 Scene loadGltf(const std::filesystem::path& file);
 // Same, and collects what was ignored (unsupported features, extra attributes) into warnings.
 Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings);
+// The bytes of a file already read, as if loaded from `file` (its name for messages and the GLB check, its
+// folder for external files). For the fuzzer and for callers that hold the file in memory.
+Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesystem::path& file,
+                         std::vector<std::string>& warnings);
 
 // Writes the scene as one self-contained .glb: geometry (one interleaved vertex buffer view), materials
 // with VITRINE_material_layers plus a plain metallic-roughness fallback made from layer 0, textures as

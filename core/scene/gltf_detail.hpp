@@ -33,6 +33,7 @@ struct LoadContext {
     std::string file; // as the user named it
     std::filesystem::path baseDir;
     Json doc;
+    bool glb = false;            // the file is a GLB container (else glTF JSON)
     std::vector<uint8_t> glbBin; // GLB binary chunk, empty for .gltf
     const tinygltf::Model* model = nullptr;
     Scene* scene = nullptr;
@@ -64,9 +65,12 @@ size_t topLevelCount(const LoadContext& ctx, const char* name);
 // Fails unless value is an integer index in [0, topLevelCount(target)).
 uint32_t checkIndex(const LoadContext& ctx, const Json& value, const std::string& element, const char* target);
 
-// Step 1: read the file, unwrap a GLB, parse the JSON, and check everything tinygltf would index or read
-// without checking: required extensions, cross-references, byte ranges, external files.
-void readAndPreflight(LoadContext& ctx, const std::filesystem::path& file, std::vector<uint8_t>& bytes);
+// Step 1: read the file (UserError when it cannot be opened).
+std::vector<uint8_t> readGltfFile(const LoadContext& ctx, const std::filesystem::path& file);
+// Step 2: unwrap a GLB, parse the JSON, and check everything tinygltf would index or read without checking:
+// required extensions, cross-references, byte ranges, external files. `file` decides, with the bytes, whether
+// they are a GLB.
+void preflight(LoadContext& ctx, const std::filesystem::path& file, const std::vector<uint8_t>& bytes);
 
 // Accessors, fully bounds-checked. Values are converted to float (normalised integers per glTF) and
 // returned as `components` floats per element; element names the use for messages.

@@ -3,6 +3,7 @@
 #include "core/scene/gltf.hpp"
 #include "core/scene/gltf_detail.hpp"
 
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 
 #include <cmath>
@@ -511,10 +512,7 @@ std::vector<uint8_t> Exporter::run() {
 void exportGlb(const Scene& scene, const std::filesystem::path& file) {
     scene.validate();
     std::vector<uint8_t> bytes = Exporter(scene).run();
-    std::ofstream out(file, std::ios::binary);
-    if (!out) throw UserError(file.string() + ": cannot open for writing");
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw UserError(file.string() + ": write failed (disk full?)");
+    writeFileAtomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 } // namespace vitrine::scene

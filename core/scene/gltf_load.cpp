@@ -414,23 +414,22 @@ void loadNodesAndScene(LoadContext& ctx) {
 
 namespace vitrine::scene {
 
-Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings) {
+Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesystem::path& file,
+                         std::vector<std::string>& warnings) {
     using namespace gltf;
     LoadContext ctx;
     ctx.file = file.string();
     ctx.baseDir = file.parent_path();
     ctx.warnings = &warnings;
-    std::vector<uint8_t> bytes;
-    readAndPreflight(ctx, file, bytes);
+    preflight(ctx, file, bytes);
 
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
     std::string err, warn;
-    bool glb = std::memcmp(bytes.data(), "glTF", 4) == 0;
-    bool ok = glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()),
-                                                ctx.baseDir.string())
-                  : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
-                                               static_cast<unsigned>(bytes.size()), ctx.baseDir.string());
+    bool ok = ctx.glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                                    static_cast<unsigned>(bytes.size()), ctx.baseDir.string())
+                      : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+                                                   static_cast<unsigned>(bytes.size()), ctx.baseDir.string());
     std::istringstream lines(warn);
     for (std::string line; std::getline(lines, line);) {
         if (!line.empty()) ctx.warn("tinygltf", line);
@@ -446,6 +445,12 @@ Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warn
     loadNodesAndScene(ctx);
     scene.validate();
     return scene;
+}
+
+Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings) {
+    gltf::LoadContext ctx;
+    ctx.file = file.string();
+    return loadGltfFromMemory(gltf::readGltfFile(ctx, file), file, warnings);
 }
 
 Scene loadGltf(const std::filesystem::path& file) {

@@ -5,7 +5,11 @@
 #include "core/scene/gltf_detail.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/json_text.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <set>
@@ -115,19 +119,57 @@ std::string urlDecode(const std::string& s) {
     return out;
 }
 
-// Splits a GLB into its JSON text and binary chunk, checking every length against the file.
+// A chunk type or magic number as text and hex, e.g. "'BIN\0' (0x004E4942)", for messages.
+std::string fourCC(uint32_t v) {
+    std::string text;
+    for (int i = 0; i < 4; ++i) {
+        auto c = static_cast<unsigned char>(v >> (8 * i));
+        if (c >= 0x20 && c < 0x7F)
+            text += static_cast<char>(c);
+        else {
+            char esc[8];
+            std::snprintf(esc, sizeof esc, "\\x%02X", c);
+            text += c == 0 ? std::string("\\0") : std::string(esc);
+        }
+    }
+    char hex[16];
+    std::snprintf(hex, sizeof hex, "0x%08X", v);
+    return "'" + text + "' (" + hex + ")";
+}
+
+constexpr uint32_t kGlbMagic = 0x46546C67u; // "glTF"
+constexpr uint32_t kChunkJson = 0x4E4F534Au;
+constexpr uint32_t kChunkBin = 0x004E4942u;
+
+// Splits a GLB into its JSON text and binary chunk, checking the header (magic, version, length) and each chunk's
+// type and length against the file, with messages that say which field is wrong.
 std::string unwrapGlb(LoadContext& ctx, const std::vector<uint8_t>& bytes) {
     size_t size = bytes.size();
-    if (size < 12) ctx.fail("GLB header", "file has " + std::to_string(size) + " bytes; expected a 12-byte header");
-    uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8);
-    if (version != 2) ctx.fail("GLB header", "version " + std::to_string(version) + "; expected 2");
+    if (size < 12) {
+        ctx.fail("GLB header",
+                 "the file has " + std::to_string(size) + " bytes; expected a 12-byte header (magic, version, length)");
+    }
+    uint32_t magic = readU32(bytes, 0), version = readU32(bytes, 4), length = readU32(bytes, 8);
+    if (magic != kGlbMagic)
+        ctx.fail("GLB header", "magic is " + fourCC(magic) + "; expected " + fourCC(kGlbMagic) + " (a binary glTF)");
+    if (version != 2) ctx.fail("GLB header", "version " + std::to_string(version) + "; expected 2 (glTF 2.0)");
     if (length > size) {
-        ctx.fail("GLB header", "declares " + std::to_string(length) + " bytes but the file has " +
+        ctx.fail("GLB header", "length declares " + std::to_string(length) + " bytes but the file has " +
                                    std::to_string(size) + " (truncated file?)");
     }
-    if (length < 20) ctx.fail("GLB chunk 0 (JSON)", "missing; expected a JSON chunk after the header");
+    if (length < size) {
+        ctx.warn("GLB header", "length declares " + std::to_string(length) + " bytes but the file has " +
+                                   std::to_string(size) + "; the rest is ignored");
+    }
+    if (length < 20) {
+        ctx.fail("GLB header",
+                 "length " + std::to_string(length) +
+                     " leaves no room for the JSON chunk; expected at least 20 bytes (header + chunk header)");
+    }
     uint32_t jsonLength = readU32(bytes, 12), jsonType = readU32(bytes, 16);
-    if (jsonType != 0x4E4F534Au) ctx.fail("GLB chunk 0", "type is not JSON; expected the JSON chunk first");
+    if (jsonType != kChunkJson)
+        ctx.fail("GLB chunk 0", "type is " + fourCC(jsonType) + "; expected " + fourCC(kChunkJson) + " first");
+    if (jsonLength == 0) ctx.fail("GLB chunk 0 (JSON)", "is empty; expected the glTF JSON");
     if (uint64_t(20) + jsonLength > length) {
         ctx.fail("GLB chunk 0 (JSON)", "declares " + std::to_string(jsonLength) + " bytes but only " +
                                            std::to_string(length - 20) + " remain (truncated file?)");
@@ -137,14 +179,32 @@ std::string unwrapGlb(LoadContext& ctx, const std::vector<uint8_t>& bytes) {
     if (at < length) {
         if (at + 8 > length) ctx.fail("GLB chunk 1", "header is cut short (truncated file?)");
         uint32_t binLength = readU32(bytes, at), binType = readU32(bytes, at + 4);
-        if (binType != 0x004E4942u) ctx.fail("GLB chunk 1", "type is not BIN; expected the binary chunk");
+        if (binType != kChunkBin)
+            ctx.fail("GLB chunk 1", "type is " + fourCC(binType) + "; expected " + fourCC(kChunkBin));
         if (at + 8 + binLength > length) {
             ctx.fail("GLB chunk 1 (BIN)", "declares " + std::to_string(binLength) + " bytes but only " +
                                               std::to_string(length - at - 8) + " remain (truncated file?)");
         }
+        if (binLength < 4 || binLength % 4 != 0) {
+            ctx.fail("GLB chunk 1 (BIN)", "length " + std::to_string(binLength) +
+                                              "; expected a multiple of 4 (chunks are padded to 4 bytes), at least 4");
+        }
         ctx.glbBin.assign(bytes.begin() + at + 8, bytes.begin() + at + 8 + binLength);
     }
     return text;
+}
+
+// A GLB is recognised by its magic whatever the file is called; a file named .glb, or one that starts with bytes no
+// JSON text has, is read as a GLB too, so that a damaged header is reported as such and not as "not valid JSON".
+bool looksLikeGlb(const std::filesystem::path& file, const std::vector<uint8_t>& bytes) {
+    if (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) return true;
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".glb") return true;
+    if (ext == ".gltf") return false;
+    for (size_t i = 0; i < std::min<size_t>(bytes.size(), 12); ++i)
+        if (bytes[i] < 0x09 || (bytes[i] > 0x0D && bytes[i] < 0x20)) return true;
+    return false;
 }
 
 void checkRequiredExtensions(const LoadContext& ctx) {
@@ -335,19 +395,28 @@ void checkReferences(const LoadContext& ctx) {
 
 } // namespace
 
-void readAndPreflight(LoadContext& ctx, const std::filesystem::path& file, std::vector<uint8_t>& bytes) {
+std::vector<uint8_t> readGltfFile(const LoadContext& ctx, const std::filesystem::path& file) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw UserError(ctx.file + ": cannot open the file (does it exist and is it readable?)");
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void preflight(LoadContext& ctx, const std::filesystem::path& file, const std::vector<uint8_t>& bytes) {
     if (bytes.empty()) ctx.fail("file", "is empty; expected glTF JSON or a GLB container");
 
-    bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    bool glb = looksLikeGlb(file, bytes);
+    ctx.glb = glb;
     std::string text = glb ? unwrapGlb(ctx, bytes) : std::string(bytes.begin(), bytes.end());
-    try {
-        ctx.doc = Json::parse(text);
-    } catch (const Json::parse_error& e) {
-        ctx.fail(glb ? "GLB JSON chunk" : "JSON", std::string("not valid JSON (") + e.what() + ")");
+    JsonTextError error;
+    std::optional<Json> doc = parseJsonText(text, error);
+    if (!doc) {
+        std::string where = "line " + std::to_string(error.line) + ", column " + std::to_string(error.column);
+        std::string element = glb ? "GLB JSON chunk" : "JSON";
+        if (error.kind == JsonTextError::Kind::Syntax)
+            ctx.fail(element, "not valid JSON (" + where + ": " + error.message + ")");
+        ctx.fail(element + " " + where, error.message);
     }
+    ctx.doc = std::move(*doc);
     if (!ctx.doc.is_object()) ctx.fail("(root)", "expected a JSON object");
     const Json* asset = object(ctx, ctx.doc, "asset", "");
     if (!asset) ctx.fail("asset", "missing; expected {\"version\": \"2.0\"}");

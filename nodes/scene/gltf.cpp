@@ -25,7 +25,14 @@ public:
         if (path.empty()) ctx.failParam("path", "expected the path of a .gltf or .glb file");
         std::filesystem::path file = ctx.resolvePath(path);
         if (!std::filesystem::exists(file)) ctx.failParam("path", "file not found: " + file.string());
-        publish(ctx, std::make_shared<const scene::Scene>(scene::loadGltf(file)));
+        std::shared_ptr<const scene::Scene> scene;
+        try {
+            scene = std::make_shared<const scene::Scene>(scene::loadGltf(file));
+        } catch (const UserError& e) {
+            // The glTF error names its file and element; the graph's file and param say where the path came from.
+            ctx.failParam("path", e.what());
+        }
+        publish(ctx, std::move(scene));
     }
 };
 

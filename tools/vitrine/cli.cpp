@@ -25,7 +25,24 @@ uint32_t Args::getUint(const std::string& name, uint32_t fallback) const {
     return static_cast<uint32_t>(std::stoul(v));
 }
 
-Args parse(int argc, char** argv, const std::vector<std::string>& valued) {
+Args parse(int argc, char** argv, const std::vector<std::string>& valued,
+           const std::map<std::string, std::vector<std::string>>& optional) {
+    auto listed = [](const std::vector<std::string>& list, const std::string& name) {
+        return std::find(list.begin(), list.end(), name) != list.end();
+    };
+    // The command decides which options have optional values, so find it first: the first argument that is neither
+    // an option nor the value of one.
+    std::string command;
+    for (int i = 1; i < argc; ++i) {
+        std::string s = argv[i];
+        if (s.rfind("--", 0) != 0 || s.size() == 2) {
+            command = s;
+            break;
+        }
+        if (s.find('=') == std::string::npos && listed(valued, s.substr(2))) ++i;
+    }
+    auto commandOptional = optional.find(command);
+
     Args a;
     for (int i = 1; i < argc; ++i) {
         std::string s = argv[i];
@@ -37,10 +54,14 @@ Args parse(int argc, char** argv, const std::vector<std::string>& valued) {
                 value = name.substr(eq + 1);
                 name = name.substr(0, eq);
             }
-            bool takes = std::find(valued.begin(), valued.end(), name) != valued.end();
+            bool mayOmit = commandOptional != optional.end() && listed(commandOptional->second, name);
+            bool takes = mayOmit || listed(valued, name);
             if (takes && !hasValue) {
-                if (i + 1 >= argc) throw UserError("--" + name + " needs a value");
-                value = argv[++i];
+                bool nextIsValue = i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0;
+                if (nextIsValue)
+                    value = argv[++i];
+                else if (!mayOmit)
+                    throw UserError("--" + name + " needs a value");
             } else if (!takes && hasValue) {
                 throw UserError("--" + name + " takes no value");
             }

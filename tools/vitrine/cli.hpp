@@ -18,8 +18,13 @@ struct Args {
     uint32_t getUint(const std::string& name, uint32_t fallback) const;
 };
 
-// Options that take a value; everything else starting with -- is a flag.
-Args parse(int argc, char** argv, const std::vector<std::string>& valued);
+// `valued`: options that take a value (`--out DIR` or `--out=DIR`); everything else starting with -- is a flag.
+// `optional`: per command, options whose value may be left out (`nodes --json` prints to stdout, `nodes --json FILE`
+// writes FILE): they take the next argument unless it starts with "--" or there is none, and take the value "" then.
+// An option named in both is optional for the commands listed and needs its value for every other command
+// (`bench --json FILE`).
+Args parse(int argc, char** argv, const std::vector<std::string>& valued,
+           const std::map<std::string, std::vector<std::string>>& optional = {});
 
 int runCommand(const Args& args);
 int validateCommand(const Args& args);

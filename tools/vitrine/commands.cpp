@@ -1,3 +1,4 @@
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
@@ -11,11 +12,13 @@
 #include "core/shader/compiler.hpp"
 #include "tools/vitrine/bench_bvh.hpp"
 #include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/interrupt.hpp"
 #include "tools/vitrine/output_dir.hpp"
 #include "tools/vitrine/render_output.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -33,14 +36,13 @@ std::string graphArg(const Args& args) {
     return args.positional[0];
 }
 
-CompiledGraph compileFromArgs(const Args& args) {
-    GraphDesc desc = loadGraph(graphArg(args), args.all("set"));
-    if (args.has("frames")) {
-        desc.frame.frames = std::max(1u, args.getUint("frames", 1));
-        for (auto& w : desc.frame.write) w = std::min(w, desc.frame.frames - 1);
-        if (!args.has("write-all")) desc.frame.write = {desc.frame.frames - 1};
+// `frames`: the frame count the command runs (0: --frames N, else the graph's own); see setsWithFrames().
+CompiledGraph compileFromArgs(const Args& args, uint32_t frames = 0) {
+    if (frames == 0 && args.has("frames")) {
+        frames = args.getUint("frames", 1);
+        if (frames == 0) throw UserError("--frames: expected at least 1");
     }
-    return compileGraph(std::move(desc));
+    return compileGraph(loadGraph(graphArg(args), setsWithFrames(args, frames, args.has("write-all"))));
 }
 
 double median(std::vector<double> v) {
@@ -74,7 +76,7 @@ int runCommand(const Args& args) {
     Executor executor(ctx, graph, shaders);
 
     const bool single = graph.desc.frame.write.size() == 1;
-    std::map<uint32_t, std::vector<std::pair<std::string, Image>>> frames;
+    std::vector<std::pair<std::string, Image>> layers; // the outputs of the frame being written
     RunOptions options;
     options.progress = !args.has("quiet");
     options.onOutput = [&](uint32_t frame, const std::string& name, const Image& image) {
@@ -82,15 +84,25 @@ int runCommand(const Args& args) {
         std::snprintf(suffix, sizeof suffix, ".%04u", frame);
         fs::path png = out.claim(name + (single ? "" : suffix) + ".png");
         writePng(png, image);
-        if (exrMode != "none") frames[frame].push_back({name, image});
-    };
-    executor.run(options);
-    for (auto& [frame, layers] : frames) {
-        char name[32];
-        std::snprintf(name, sizeof name, "frame.%04u.exr", frame);
+        if (exrMode == "none") return;
+        layers.push_back({name, image});
+        if (layers.size() < graph.outputs.size()) return;
+        // The frame's last output: its EXR now, so that a stopped run has every finished frame complete.
+        char exrName[32];
+        std::snprintf(exrName, sizeof exrName, "frame.%04u.exr", frame);
         std::vector<ExrLayer> exr;
-        for (const auto& [layer, image] : layers) exr.push_back({layer, &image});
-        writeExr(out.claim(name), exr, exrMode == "float" ? ExrPixelType::Float : ExrPixelType::Half);
+        for (const auto& [layer, layerImage] : layers) exr.push_back({layer, &layerImage});
+        writeExr(out.claim(exrName), exr, exrMode == "float" ? ExrPixelType::Float : ExrPixelType::Half);
+        layers.clear();
+    };
+    InterruptHandlers interrupts;
+    options.stop = [] { return InterruptHandlers::received() != 0; };
+    const uint32_t ran = executor.run(options);
+    if (int signal = InterruptHandlers::received(); signal && ran < graph.desc.frame.frames) {
+        logWarning(std::string(signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)") +
+                   ": stopped after " + std::to_string(ran) + " of " + std::to_string(graph.desc.frame.frames) +
+                   " frames; the files of the finished frames are in " + out.dir().string());
+        return kExitInterrupted;
     }
     if (ctx.validationMessageCount() > 0) {
         logWarning(std::to_string(ctx.validationMessageCount()) + " Vulkan validation message(s)");
@@ -116,7 +128,10 @@ int validateCommand(const Args& args) {
 int nodesCommand(const Args& args) {
     const NodeRegistry& registry = NodeRegistry::global();
     if (args.has("json")) {
-        std::cout << registry.toJson().dump(2) << "\n";
+        const std::string path = args.get("json");
+        const std::string text = registry.toJson().dump(2) + "\n";
+        if (path.empty() || path == "-") std::cout << text;
+        else writeFileAtomically(path, text);
         return 0;
     }
     for (const NodeSchema* s : registry.all()) {
@@ -135,12 +150,20 @@ int nodesCommand(const Args& args) {
 }
 
 int benchCommand(const Args& args) {
-    auto compileStart = std::chrono::steady_clock::now();
-    CompiledGraph graph = compileFromArgs(args);
-    double graphMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - compileStart).count();
     const uint32_t frames = args.getUint("frames", 20);
     const uint32_t warmup = args.getUint("warmup", 2);
     if (frames == 0) throw UserError("--frames: expected at least 1");
+    auto compileStart = std::chrono::steady_clock::now();
+    CompiledGraph graph = compileFromArgs(args, frames + warmup);
+    double graphMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - compileStart).count();
+    // Scene nodes build (the museum) or load (glTF) their scene in setup(): reported apart from compiling the graph.
+    double sceneMs = 0.0;
+    auto outputsScene = [&](const PassUse& u) {
+        return u.output && graph.resources[u.resource].kind == PortKind::Scene;
+    };
+    for (const CompiledPass& p : graph.passes)
+        if (std::any_of(p.uses.begin(), p.uses.end(), outputsScene)) sceneMs += p.setupMs;
+    graphMs -= sceneMs;
 
     Context ctx(contextOptions(args));
     ShaderCompiler shaders;
@@ -158,7 +181,7 @@ int benchCommand(const Args& args) {
     j["height"] = graph.desc.frame.height;
     j["frames"] = frames;
     j["warmup"] = warmup;
-    j["compile_ms"] = {{"graph", graphMs}, {"pipelines", executor.pipelineMs()}};
+    j["compile_ms"] = {{"graph", graphMs}, {"scene_build", sceneMs}, {"pipelines", executor.pipelineMs()}};
     j["memory_bytes"] = {{"transient_aliased", executor.memory().transientAliased},
                          {"transient_unaliased", executor.memory().transientUnaliased},
                          {"persistent", executor.memory().persistent}};
@@ -168,7 +191,7 @@ int benchCommand(const Args& args) {
         std::vector<double> ms;
         for (size_t f = warmup; f < timings.size(); ++f) ms.push_back(timings[f].passGpuMs[p]);
         j["passes"].push_back({{"id", graph.passes[p].id}, {"type", graph.passes[p].schema->type},
-                               {"gpu_ms_median", median(ms)},
+                               {"setup_ms", graph.passes[p].setupMs}, {"gpu_ms_median", median(ms)},
                                {"gpu_ms_min", *std::min_element(ms.begin(), ms.end())},
                                {"gpu_ms_max", *std::max_element(ms.begin(), ms.end())}});
     }
@@ -206,7 +229,7 @@ int benchCommand(const Args& args) {
     if (args.has("json")) {
         std::string path = args.get("json");
         if (path == "-") std::cout << j.dump(2) << "\n";
-        else std::ofstream(path) << j.dump(2) << "\n";
+        else writeFileAtomically(path, j.dump(2) + "\n");
     }
     if (!args.has("json") || args.get("json") != "-") {
         std::printf("%s on %s, %ux%u, median of %u frames (after %u warm-up)\n", graphArg(args).c_str(),
@@ -216,8 +239,8 @@ int benchCommand(const Args& args) {
             std::printf("  %-20s %-20s %10.3f\n", p["id"].get<std::string>().c_str(), p["type"].get<std::string>().c_str(),
                         p["gpu_ms_median"].get<double>());
         std::printf("  %-41s %10.3f\n", "total GPU", median(total));
-        std::printf("  CPU record %.3f ms; compile: graph %.2f ms, pipelines %.1f ms\n", median(record), graphMs,
-                    executor.pipelineMs());
+        std::printf("  CPU record %.3f ms; compile: graph %.2f ms, pipelines %.1f ms; scene build %.1f ms\n",
+                    median(record), graphMs, executor.pipelineMs(), sceneMs);
         const MemoryStats& m = executor.memory();
         std::printf("  transient memory: %s aliased, %s without aliasing (%.0f%%); persistent %s\n",
                     mib(m.transientAliased).c_str(), mib(m.transientUnaliased).c_str(),

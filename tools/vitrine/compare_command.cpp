@@ -1,6 +1,7 @@
 // `vitrine compare A B [--reference R]`: renders graphs or loads images, computes PSNR, SSIM and FLIP (and, over
 // --frames a:b, flicker and error per frame), writes the images, heat maps, metrics.json and one self-contained
 // report.html. The metrics and the report come from core/compare; this file only gathers the inputs.
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/compare/report.hpp"
@@ -44,7 +45,9 @@ bool isImageFile(const fs::path& path) {
     return ext == ".exr" || ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".hdr";
 }
 
-Input openInput(const std::string& role, const std::string& key, const fs::path& path, const Args& args) {
+// `frames`: the frame count --frame/--frames ask for (0: the graph's own), part of the graph before validation.
+Input openInput(const std::string& role, const std::string& key, const fs::path& path, const Args& args,
+                uint32_t frames) {
     const std::string expected = "expected a graph (.json) or an image (.exr, .png, .jpg, .hdr)";
     std::error_code ec;
     if (!fs::exists(path, ec)) throw UserError(path.string() + ": not found (compare " + role + ": " + expected + ")");
@@ -53,7 +56,7 @@ Input openInput(const std::string& role, const std::string& key, const fs::path&
     Input in{role, key, path, {}, {}, {}, {}};
     const std::string ext = lower(path.extension().string());
     if (ext == ".json") {
-        in.graph = loadGraph(path, args.all("set"));
+        in.graph = loadGraph(path, setsWithFrames(args, frames));
         in.output = pickOutput(*in.graph, args.get("output"));
     } else if (!isImageFile(path)) {
         throw UserError(path.string() + ": compare " + role + ": " + expected + ", got a '" + ext + "' file");
@@ -75,12 +78,9 @@ uint32_t parseIndex(const std::string& text, const std::string& option, const st
 }
 
 // --frame N picks the still; --frames a:b renders a..b for temporal metrics (the still defaults to b). Without either
-// the still is the last frame of the longest graph.
-FrameRange frameRange(const Args& args, const std::vector<Input*>& inputs) {
+// the still is the last frame of the longest graph (graphFrames).
+FrameRange frameRange(const Args& args, uint32_t graphFrames) {
     FrameRange r;
-    uint32_t graphFrames = 1;
-    for (const Input* in : inputs)
-        if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
     if (args.has("frames")) {
         const std::string text = args.get("frames");
         const auto colon = text.find(':');
@@ -115,10 +115,7 @@ void requireSameSize(const Input& a, const Input& b) {
 }
 
 void writeBytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
-    std::ofstream file(path, std::ios::binary | std::ios::trunc);
-    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    file.close();
-    if (!file) throw UserError(path.string() + ": cannot write the file");
+    writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 // Writes NAME.png (and NAME.exr with the float values when `exr`) and returns the PNG for the report.
@@ -143,14 +140,20 @@ std::string formatPsnr(double psnr) {
 
 int compareCommand(const Args& args) {
     if (args.positional.size() != 2) throw UserError("compare: expected two inputs, A and B (graphs or images)");
-    Input a = openInput("A", "a", args.positional[0], args);
-    Input b = openInput("B", "b", args.positional[1], args);
+    // --frame/--frames fix the frame count before the graphs are validated; without them each graph keeps its own.
+    const uint32_t askedFrames = args.has("frame") || args.has("frames") ? frameRange(args, 1).last + 1 : 0;
+    Input a = openInput("A", "a", args.positional[0], args, askedFrames);
+    Input b = openInput("B", "b", args.positional[1], args, askedFrames);
     std::optional<Input> reference;
-    if (args.has("reference")) reference = openInput("reference", "reference", args.get("reference"), args);
+    if (args.has("reference"))
+        reference = openInput("reference", "reference", args.get("reference"), args, askedFrames);
     std::vector<Input*> inputs = {&a, &b};
     if (reference) inputs.push_back(&*reference);
 
-    const FrameRange range = frameRange(args, inputs);
+    uint32_t graphFrames = 1;
+    for (const Input* in : inputs)
+        if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
+    const FrameRange range = frameRange(args, graphFrames);
     const bool hdr = args.has("hdr");
     double ppd = compare::kDefaultPixelsPerDegree;
     if (args.has("ppd")) {
@@ -276,7 +279,7 @@ int compareCommand(const Args& args) {
     if (a.graph) report.graphA = a.graph->document;
     if (b.graph) report.graphB = b.graph->document;
 
-    std::ofstream(out.claim("metrics.json")) << compare::metricsJson(report).dump(2) << "\n";
+    writeFileAtomically(out.claim("metrics.json"), compare::metricsJson(report).dump(2) + "\n");
     compare::writeReport(out.claim("report.html"), report);
 
     for (const compare::PairMetrics& m : report.metrics)

@@ -2,6 +2,7 @@
 // (tests/golden/manifest.json) lists graphs to render and the FLIP tolerances per device class; golden images live
 // beside it in <device class>/<name>.exr. `accept` renders and (re)writes goldens, `check` renders and compares, and
 // on failure writes the images, a FLIP heat map and a report.html per failing image into --out.
+#include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/compare/report.hpp"
@@ -135,8 +136,8 @@ fs::path writeFailureReport(OutputDir& out, const GoldenCase& c, const Image& ac
                             const compare::PairComparison& pair) {
     auto image = [&](const std::string& file, const std::string& label, const Image& img) {
         compare::ReportImage r{label, encodePng(img), img.width, img.height};
-        std::ofstream(out.claim(c.name + "/" + file), std::ios::binary)
-            .write(reinterpret_cast<const char*>(r.png.data()), static_cast<std::streamsize>(r.png.size()));
+        writeFileAtomically(out.claim(c.name + "/" + file),
+                            std::string_view(reinterpret_cast<const char*>(r.png.data()), r.png.size()));
         return r;
     };
     compare::ReportInput report;
@@ -148,7 +149,7 @@ fs::path writeFailureReport(OutputDir& out, const GoldenCase& c, const Image& ac
     report.differenceMaps.push_back(image("diff.png", "|rendered − golden|",
                                           compare::falseColor(compare::absoluteDifference(actual, golden), 1.0)));
     report.metrics.push_back(pair.metrics);
-    std::ofstream(out.claim(c.name + "/metrics.json")) << compare::metricsJson(report).dump(2) << "\n";
+    writeFileAtomically(out.claim(c.name + "/metrics.json"), compare::metricsJson(report).dump(2) + "\n");
     const fs::path html = out.claim(c.name + "/report.html");
     compare::writeReport(html, report);
     return html;

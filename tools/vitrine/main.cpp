@@ -16,7 +16,8 @@ commands:
       Render GRAPH headless; writes each output of the chosen frames as PNG (through the
       OCIO display transform) and all outputs of a frame as one multi-layer EXR.
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
-  nodes [--json]                    List node types with their ports and params.
+  nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
+                                    JSON on stdout (or in FILE).
   bench GRAPH [--frames N] [--warmup N] [--json FILE] [--set K=V]... [--bvh]
       Per-node GPU ms (median of timestamp queries), CPU record ms, compile ms, memory.
       --bvh: also the scene's ray-tracing BVH: build ms, nodes, memory, bake-cache load ms,
@@ -51,9 +52,10 @@ validation messages with --validate), 3 `golden check` found images beyond toler
 int main(int argc, char** argv) {
     using namespace vitrine;
     try {
-        cli::Args args = cli::parse(argc, argv, {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                               "output", "ppd", "diff-scale", "manifest", "seed",
-                                               "texture-size"});
+        cli::Args args = cli::parse(argc, argv,
+                                    {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
+                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size"},
+                                    {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
         if (args.command.empty() || args.command == "help" || args.has("help")) {

@@ -16,6 +16,17 @@ ContextOptions contextOptions(const Args& args) {
     return o;
 }
 
+std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite) {
+    std::vector<std::string> sets;
+    if (frames > 0) {
+        sets.push_back("frame.frames=" + std::to_string(frames));
+        if (!keepWrite) sets.push_back("frame.write=[" + std::to_string(frames - 1) + "]");
+    }
+    const std::vector<std::string>& given = args.all("set");
+    sets.insert(sets.end(), given.begin(), given.end());
+    return sets;
+}
+
 std::string deviceClass(const Context& ctx) {
     std::string name = ctx.deviceInfo().name;
     std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });

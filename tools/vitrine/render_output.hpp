@@ -17,6 +17,12 @@ namespace vitrine::cli {
 // --device and --validate.
 ContextOptions contextOptions(const Args& args);
 
+// The --set assignments of the command line, preceded by `frame.frames=FRAMES` and `frame.write=[FRAMES - 1]` when
+// frames > 0 (`--frames`): the command line's frame count is part of the document before validation, so that
+// `--frames 24 --set frame.write=[0,12,23]` names frames the file alone does not have. An explicit --set of frame.*
+// still wins. keepWrite: only frame.frames (`run --write-all` keeps the file's frame.write).
+std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite = false);
+
 // "lavapipe" for Mesa's CPU device (lavapipe / llvmpipe), else "gpu": golden images and their tolerances are kept
 // per device class, because a CPU rasteriser and a GPU round differently.
 std::string deviceClass(const Context& ctx);

@@ -2,10 +2,12 @@
 // ones: exit status 1 for a user error, with a message naming the file, the JSON pointer (or
 // line:column) and what was wrong. Runs the real CLI with the real node types; no GPU.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <fstream>
 #include <regex>
 #include <set>
 #include <string>
@@ -105,6 +107,21 @@ const BadGraph kBadGraphRows[] = {
     {"graphs/fxaa_zoneplate.json", "--set nosuch.params.x=1", ": /nodes/nosuch: ", "the graph has no node 'nosuch'"},
     {"graphs/fxaa_zoneplate.json", "--set tonemap.params.exposure=100",
      ": /nodes/tonemap/params/exposure: ", "got 100"},
+    // Numbers a double cannot hold are the user's input (exit 1 with the position), not an internal error.
+    {"number_too_large.json", "", ":3:22: ", "the number '1e309' is too large"},
+    {"graphs/fxaa_zoneplate.json", "--set fxaa.params.subpix=1e309",
+     ": --set fxaa.params.subpix=1e309: ", "the number '1e309' is too large"},
+    {"graphs/fxaa_zoneplate.json", "--set frame.width.x=1", ": /frame/width: ", "cannot set 'x' inside 640"},
+    {"graphs/fxaa_zoneplate.json", "--set 'frame.write=[0]' --set frame.write.01=1",
+     ": /frame/write/01: ", "expected an array index in [0, 1]"},
+    // The glTF errors name the glTF file (the path is relative to the graph) and what is wrong in it.
+    {"gltf_number_too_large.json", "",
+     ": /nodes/scene/params/path: ", "number_too_large.gltf: JSON line 10, column 55: the number '1e309' is too large"},
+    {"gltf_bad_magic.json", "",
+     ": /nodes/scene/params/path: ", "bad_magic.glb: GLB header: magic is 'glTX' (0x58546C67); expected 'glTF'"},
+    // --frames is frame.frames before validation: frame.write may name frames the file alone does not have.
+    {"graphs/fxaa_zoneplate.json", "--frames 4 --set 'frame.write=[0,4]'",
+     ": /frame/write/1: ", "expected an integer in [0, 3], got 4"},
 };
 
 std::string rowName(const testing::TestParamInfo<BadGraph>& info) {
@@ -177,6 +194,51 @@ TEST(GraphCli, RunWithMissingGraphExitsOne) {
     CliResult r = vitrine("run " + quote(missing) + " --out " + quote(out) + " --quiet");
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("does_not_exist.json: no such file"), std::string::npos) << r.output;
+}
+
+// Only stdout, stderr dropped: for commands whose output is parsed.
+CliResult vitrineStdout(const std::string& args) {
+    return vitrine(args + " 2>/dev/null");
+}
+
+TEST(GraphCli, NodesJsonPrintsTheSchemasToStdout) {
+    CliResult r = vitrineStdout("nodes --json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    nlohmann::json schemas = nlohmann::json::parse(r.output, nullptr, false);
+    ASSERT_TRUE(schemas.is_array()) << r.output.substr(0, 200);
+    std::set<std::string> types;
+    for (const auto& s : schemas)
+        types.insert(s.value("type", ""));
+    EXPECT_TRUE(types.count("aa.fxaa")) << r.output.substr(0, 200);
+    EXPECT_TRUE(types.count("scene.museum")) << r.output.substr(0, 200);
+}
+
+TEST(GraphCli, NodesJsonFileWritesTheSchemas) {
+    std::string file = testing::TempDir() + "vitrine_nodes_schema.json";
+    std::remove(file.c_str());
+    CliResult r = vitrine("nodes --json " + quote(file));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output, "");
+    std::ifstream in(file);
+    nlohmann::json schemas = nlohmann::json::parse(in, nullptr, false);
+    EXPECT_TRUE(schemas.is_array() && schemas.size() > 10) << file;
+}
+
+// bench --json takes a file (the optional value is only nodes'), and says so before touching the GPU.
+TEST(GraphCli, BenchJsonStillNeedsAFile) {
+    CliResult r = vitrine("bench " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " --json");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("--json needs a value"), std::string::npos) << r.output;
+}
+
+TEST(GraphCli, FramesCountBeforeValidation) {
+    CliResult museum =
+        vitrine("validate " + quote(kSource + "/graphs/museum.json") + " --frames 24 --set 'frame.write=[0,12,23]'");
+    EXPECT_EQ(museum.status, 0) << museum.output;
+    EXPECT_NE(museum.output.find("museum.json: ok"), std::string::npos) << museum.output;
+    CliResult zero = vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " --frames 0");
+    EXPECT_EQ(zero.status, 1) << zero.output;
+    EXPECT_NE(zero.output.find("--frames: expected at least 1"), std::string::npos) << zero.output;
 }
 
 TEST(GraphCli, ValidateWithoutAGraphIsAUserError) {

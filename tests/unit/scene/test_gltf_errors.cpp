@@ -68,6 +68,42 @@ TEST_F(GltfErrors, TruncatedGlb) {
     }
 }
 
+// A damaged GLB header is reported field by field, not as "not valid JSON".
+TEST_F(GltfErrors, GlbHeaderFieldsAreNamed) {
+    const std::vector<uint8_t> good = glb();
+    auto patched = [&](size_t at, uint32_t value) {
+        std::vector<uint8_t> b = good;
+        for (int i = 0; i < 4; ++i)
+            b[at + i] = static_cast<uint8_t>(value >> (8 * i));
+        return b;
+    };
+    auto expectFor = [&](const std::string& name, const std::vector<uint8_t>& bytes,
+                         const std::vector<std::string>& parts) {
+        test::writeBytes(mDir / name, bytes);
+        std::vector<std::string> all = {name};
+        all.insert(all.end(), parts.begin(), parts.end());
+        expectUserError([&] { loadGltf(mDir / name); }, all);
+    };
+    expectFor("magic.glb", patched(0, 0x58546C67u), {"GLB header: magic is 'glTX' (0x58546C67); expected 'glTF'"});
+    // Whatever the name: bytes no JSON text starts with are read as a GLB header.
+    expectFor("magic.bin", patched(0, 0x00000001u), {"GLB header: magic is '\\x01\\0\\0\\0'"});
+    expectFor("version.glb", patched(4, 1), {"GLB header: version 1; expected 2"});
+    expectFor("long.glb", patched(8, static_cast<uint32_t>(good.size() + 4)), {"GLB header: length declares"});
+    expectFor("short.glb", patched(8, 16), {"GLB header: length 16 leaves no room for the JSON chunk"});
+    expectFor("chunk0.glb", patched(16, 0x004E4942u), {"GLB chunk 0: type is 'BIN\\0' (0x004E4942); expected 'JSON'"});
+    const uint32_t jsonLength = good[12] | good[13] << 8 | good[14] << 16 | uint32_t(good[15]) << 24;
+    expectFor("chunk1.glb", patched(20 + jsonLength + 4, 0x4E4F534Au), {"GLB chunk 1: type is 'JSON'"});
+    expectFor("bin_length.glb", patched(20 + jsonLength, 6), {"GLB chunk 1 (BIN): length 6; expected a multiple of 4"});
+    expectFor("empty_json.glb", patched(12, 0), {"GLB chunk 0 (JSON): is empty"});
+}
+
+TEST_F(GltfErrors, NumbersTooLargeAndNestingTooDeep) {
+    test::writeText(mDir / "big.gltf", "{\"asset\": {\"version\": \"2.0\"},\n \"scene\": 1e999}");
+    expectUserError([&] { loadGltf(mDir / "big.gltf"); }, {"big.gltf: JSON line 2, column 11", "'1e999' is too large"});
+    test::writeText(mDir / "deep.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '['));
+    expectUserError([&] { loadGltf(mDir / "deep.gltf"); }, {"deep.gltf: JSON line 1, column", "nesting deeper than"});
+}
+
 TEST_F(GltfErrors, MissingBufferFile) {
     mDoc["buffers"][0]["uri"] = "missing.bin";
     auto file = write("missing_buffer.gltf", mDoc);
