@@ -104,6 +104,17 @@ public:
         record(id, push, pushSize, width, height, depth, {}, {});
     }
 
+    void computeBarrier() override {
+        VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+        b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+        b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        b.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.memoryBarrierCount = 1;
+        dep.pMemoryBarriers = &b;
+        vkCmdPipelineBarrier2(mCmd, &dep);
+    }
+
     void dispatchWithSets(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,
                           std::span<const VkDescriptorSetLayout> layouts, std::span<const VkDescriptorSet> sets) override {
         record(id, push, pushSize, width, height, 1, layouts, sets);

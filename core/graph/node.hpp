@@ -117,6 +117,11 @@ public:
                                   uint32_t height, std::span<const VkDescriptorSetLayout> layouts,
                                   std::span<const VkDescriptorSet> sets) = 0;
 
+    // Orders this pass's earlier dispatches before its later ones (a memory dependency from compute-shader
+    // writes to compute-shader reads and writes), for a pass that refines its own StorageReadWrite outputs
+    // over several dispatches (render.pathtrace splits its samples so no invocation runs long).
+    virtual void computeBarrier() = 0;
+
     // Records a copy of `pixels` into mip 0 / `layer` of an output whose port usage is TransferDst.
     virtual void upload(const std::string& port, const Image& pixels, uint32_t layer = 0) = 0;
 

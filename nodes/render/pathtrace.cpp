@@ -41,6 +41,7 @@ NodeSchema schema() {
     color.name = "color";
     color.format = VK_FORMAT_R32G32B32A32_SFLOAT;
     color.size = SizeRule::frame();
+    color.usage = Usage::StorageReadWrite; // refined by each of the frame's dispatches
     color.doc = "Mean radiance (cd/m², rgb) of all samples since the last restart; a = 1";
     OutputPort stats = color;
     stats.name = "stats";
@@ -48,7 +49,7 @@ NodeSchema schema() {
                 "samples' luminance; w: standard error of the mean luminance (cd/m²)";
     s.outputs = {color, stats};
     s.params = {
-        {"spp", ParamType::Int, 16, 1.0, 65536.0, {}, "Samples per pixel per frame"},
+        {"spp", ParamType::Int, 16, 1.0, 1024.0, {}, "Samples per pixel per frame (for more, accumulate frames with a still camera)"},
         {"max_bounces", ParamType::Int, 8, 1.0, 64.0, {},
          "Surfaces that reflect light along a path (1: direct light only; Russian roulette ends most paths sooner)"},
         {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance (as lighting.deferred)"},
@@ -88,13 +89,20 @@ public:
         push.scales = {p.getFloat("sun_scale"), p.getFloat("sky_scale"), p.getFloat("emissive_scale"), 0.0f};
         uint32_t flags = (reset ? PATHTRACE_RESET : 0u) | (ctx.hasInput("env_cdf") ? PATHTRACE_ENV_CDF : 0u) |
                          (p.getBool("antialias") ? PATHTRACE_ANTIALIAS : 0u);
-        uint32_t seed = static_cast<uint32_t>(p.getInt("seed"));
-        push.counts = {static_cast<uint32_t>(p.getInt("spp")), static_cast<uint32_t>(p.getInt("max_bounces")),
-                       ctx.frameIndex() * 0x9E3779B9u ^ (seed * 0x85EBCA6Bu + 0x27D4EB2Fu), flags};
+        const uint32_t seed = static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu;
+        const uint32_t spp = static_cast<uint32_t>(p.getInt("spp"));
         const ImageDesc& out = ctx.output("color").desc();
         std::array<VkDescriptorSetLayout, 3> layouts = {bvh.setLayout(), gpu.setLayout(), mGeometryLayout};
         std::array<VkDescriptorSet, 3> sets = {bvh.set(), gpu.set(), mGeometrySet};
-        ctx.dispatchWithSets(mPipeline, &push, sizeof(push), out.width, out.height, layouts, sets);
+        for (uint32_t done = 0, chunk = 0; done < spp; ++chunk) {
+            const uint32_t count = std::min(PATHTRACE_SAMPLES_PER_DISPATCH, spp - done);
+            push.counts = {count, static_cast<uint32_t>(p.getInt("max_bounces")),
+                           (ctx.frameIndex() * 0x9E3779B9u + chunk * 0x632BE5ABu) ^ seed,
+                           flags | (done > 0 ? PATHTRACE_CONTINUE : 0u)};
+            if (done > 0) ctx.computeBarrier();
+            ctx.dispatchWithSets(mPipeline, &push, sizeof(push), out.width, out.height, layouts, sets);
+            done += count;
+        }
     }
 
     void releaseGpu() override {

@@ -84,7 +84,7 @@ BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, float NoV) 
     b.roughness = roughness;
     float s = luminance(schlickFresnel(specularF0(baseColor, metallic), NoV));
     float d = luminance(diffuseAlbedo(baseColor, metallic));
-    b.specularProbability = clamp(s / max(s + d, 1e-6), 0.1, 0.9);
+    b.specularProbability = max(s / max(s + d, 1e-6), 0.1); // 1 for metals: no diffuse lobe
     return b;
 }
 

@@ -19,8 +19,8 @@ layout(set = 0, binding = 1) uniform sampler2D in_sky_sh;
 layout(set = 0, binding = 2) uniform sampler2D in_env_cdf;
 layout(set = 0, binding = 3) uniform sampler2D in_history;
 layout(set = 0, binding = 4) uniform sampler2D in_history_stats;
-layout(set = 0, binding = 5) writeonly uniform image2D out_color;
-layout(set = 0, binding = 6) writeonly uniform image2D out_stats;
+layout(set = 0, binding = 5, rgba32f) uniform image2D out_color;
+layout(set = 0, binding = 6, rgba32f) uniform image2D out_stats;
 
 const float kInfinity = 3.4e38; // rays end nowhere (traversal compares t against this)
 
@@ -125,9 +125,10 @@ void main() {
     vec3 colorB = sum / max(nB, 1.0);
     vec3 color = colorB;
     float n = nB, meanY = mean, M2 = m2;
-    if ((push.counts.w & PATHTRACE_RESET) == 0u) {
-        vec3 colorA = texelFetch(in_history, p, 0).rgb;
-        vec4 statsA = texelFetch(in_history_stats, p, 0);
+    bool more = (push.counts.w & PATHTRACE_CONTINUE) != 0u;
+    if (more || (push.counts.w & PATHTRACE_RESET) == 0u) {
+        vec3 colorA = more ? imageLoad(out_color, p).rgb : texelFetch(in_history, p, 0).rgb;
+        vec4 statsA = more ? imageLoad(out_stats, p) : texelFetch(in_history_stats, p, 0);
         float nA = statsA.x;
         n = nA + nB;
         color = (colorA * nA + colorB * nB) / max(n, 1.0);
