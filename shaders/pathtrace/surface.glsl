@@ -43,6 +43,20 @@ vec2 vertexVec2(uint v, uint offset) {
     return vec2(sceneVertices[b], sceneVertices[b + 1u]);
 }
 
+// Whether the rasteriser would cull what the ray hit: the back of a triangle whose material is single sided
+// (gbuffer.layered culls those; the BVH reports both sides). The front is counter-clockwise in world space.
+bool pathCulled(BvhHit hit, vec3 direction) {
+    GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
+    if (materials[ref.material].info.w != 0u) return false;
+    GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];
+    uint base = prim.firstIndex + 3u * ref.triangle;
+    mat3 world = mat3(instances[hit.instance].world);
+    vec3 p0 = world * vertexVec3(sceneIndices[base] + prim.vertexOffset, 0u);
+    vec3 p1 = world * vertexVec3(sceneIndices[base + 1u] + prim.vertexOffset, 0u);
+    vec3 p2 = world * vertexVec3(sceneIndices[base + 2u] + prim.vertexOffset, 0u);
+    return dot(cross(p1 - p0, p2 - p0), direction) > 0.0;
+}
+
 PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
     GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];

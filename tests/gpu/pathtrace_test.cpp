@@ -157,7 +157,8 @@ TEST_F(PathTrace, WhiteFurnaceSphereReturnsTheEnvironment) {
 // Energy after N bounces: the camera at the centre of a closed emissive mirror sphere (F0 = a). Each path
 // bounces radially, so L = Le (1 + a + ... + a^N) exactly; N = 1, 3, 10 checks max_bounces, and N = 10
 // runs Russian roulette from the third surface (unbiased: the mean holds). Bound 1 % on the mean over
-// the image (a uniform sky outside must not leak in: the sphere is closed).
+// the image (a uniform sky outside must not leak in: the sphere is closed). The sphere is double sided; made
+// single sided, the camera inside sees the sky through its culled back faces.
 TEST_F(PathTrace, ClosedEmissiveMirrorSphereSumsTheGeometricSeries) {
     const int W = 24, H = 24;
     const double a = 0.7, Le = 5.0;
@@ -165,6 +166,7 @@ TEST_F(PathTrace, ClosedEmissiveMirrorSphereSumsTheGeometricSeries) {
     uint32_t material = b.material("mirror", glm::vec3(static_cast<float>(a)), 1.0f, 1.0f);
     b.s.materials[material].emissiveFactor = glm::vec3(1.0f);
     b.s.materials[material].emissiveStrength = static_cast<float>(Le);
+    b.s.materials[material].doubleSided = true; // seen from inside: a single-sided sphere is culled, as raster does
     b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(4.0f, 64, 32), material)));
     b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, 1.0f);
     auto glb = b.write();
@@ -181,6 +183,12 @@ TEST_F(PathTrace, ClosedEmissiveMirrorSphereSumsTheGeometricSeries) {
         std::printf("closed sphere, %d bounces: mean %.5f, expected %.5f\n", bounces, mean, expected);
         EXPECT_LT(std::abs(mean / expected - 1.0), 0.01);
     }
+    // Single sided, the sphere is culled from inside (as gbuffer.layered culls it): the camera sees the sky.
+    b.s.materials[material].doubleSided = false;
+    b.s.name = "closed_sphere_single_sided";
+    auto single = b.write();
+    auto out = runGraph(traceGraph(single, uniformSky(single, 1000.0), {{"spp", 1}}, W, H));
+    EXPECT_NEAR(rgb(out.at("color"), W / 2, H / 2).g, 1000.0, 1.0) << "back faces of a single-sided material are culled";
 }
 
 // A diffuse plane (base 0.5, smooth dielectric) under a uniform sky C receives E = pi C, so its Lambert
