@@ -1,10 +1,10 @@
 // render.pathtrace: progressive path-traced reference of the scene camera (shaders/render/pathtrace.comp).
+#include "shaders/render/pathtrace.h"
 #include "core/accel/gpu_bvh.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/vk_check.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
-#include "shaders/render/pathtrace.h"
 
 #include <algorithm>
 #include <array>
@@ -29,8 +29,18 @@ NodeSchema schema() {
         return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
     };
     s.inputs = {
-        {"scene", PortKind::Scene, {}, false, Usage::Sampled, "The scene to trace (its BVH is built or loaded on first use)"},
-        {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera (unjittered; the tracer jitters itself)"},
+        {"scene",
+         PortKind::Scene,
+         {},
+         false,
+         Usage::Sampled,
+         "The scene to trace (its BVH is built or loaded on first use)"},
+        {"camera",
+         PortKind::Camera,
+         {},
+         false,
+         Usage::Sampled,
+         "The frame's camera (unjittered; the tracer jitters itself)"},
         tex("sky", "A sky node's cube map (radiance of the environment, without the sun disk: sun_in_cubemap false)"),
         tex("sky_sh", "A sky node's `sh`: sun illuminance (texel 9, lux) and direction (texel 10)"),
         tex("env_cdf", "sky.env_cdf of the same cube map (without it the sky is found by BRDF sampling only)", true),
@@ -49,14 +59,55 @@ NodeSchema schema() {
                 "samples' luminance; w: standard error of the mean luminance (cd/m²)";
     s.outputs = {color, stats};
     s.params = {
-        {"spp", ParamType::Int, 16, 1.0, 1024.0, {}, "Samples per pixel per frame (for more, accumulate frames with a still camera)"},
-        {"max_bounces", ParamType::Int, 8, 1.0, 64.0, {},
+        {"spp",
+         ParamType::Int,
+         16,
+         1.0,
+         1024.0,
+         {},
+         "Samples per pixel per frame (for more, accumulate frames with a still camera)"},
+        {"max_bounces",
+         ParamType::Int,
+         8,
+         1.0,
+         64.0,
+         {},
          "Surfaces that reflect light along a path (1: direct light only; Russian roulette ends most paths sooner)"},
-        {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance (as lighting.deferred)"},
-        {"sky_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky cube map's radiance (0: sun and emitters only)"},
-        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of emissive surfaces (as lighting.deferred)"},
-        {"antialias", ParamType::Bool, true, {}, {}, {}, "Jitter camera rays over the pixel (off: through pixel centres)"},
-        {"seed", ParamType::Int, 0, 0.0, 2147483647.0, {}, "Random sequence (independent estimates for noise measurements)"},
+        {"sun_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         100.0,
+         {},
+         "Multiplier of the sky model's sun illuminance (as lighting.deferred)"},
+        {"sky_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         100.0,
+         {},
+         "Multiplier of the sky cube map's radiance (0: sun and emitters only)"},
+        {"emissive_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         1e6,
+         {},
+         "Multiplier of emissive surfaces (as lighting.deferred)"},
+        {"antialias",
+         ParamType::Bool,
+         true,
+         {},
+         {},
+         {},
+         "Jitter camera rays over the pixel (off: through pixel centres)"},
+        {"seed",
+         ParamType::Int,
+         0,
+         0.0,
+         2147483647.0,
+         {},
+         "Random sequence (independent estimates for noise measurements)"},
     };
     return s;
 }
@@ -67,9 +118,11 @@ public:
         mScene = ctx.objectAs<SceneObject>("scene");
         mCamera = ctx.objectAs<CameraObject>("camera");
         if (ctx.hasInput("history") != ctx.hasInput("history_stats"))
-            ctx.failParam("spp", "connect both history (this node's color@prev) and history_stats (stats@prev), or neither");
+            ctx.failParam("spp",
+                          "connect both history (this node's color@prev) and history_stats (stats@prev), or neither");
         size_t textures = std::max<size_t>(1, mScene->scene().textures.size());
-        mPipeline = ctx.computePipeline("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 3);
+        mPipeline =
+            ctx.computePipeline("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 3);
     }
 
     void execute(ExecuteContext& ctx) override {
@@ -79,7 +132,8 @@ public:
 
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
-        bool moved = cam.viewProjNoJitter != mLastViewProj || mScene->pose.instanceWorld != mScene->previousPose.instanceWorld;
+        bool moved =
+            cam.viewProjNoJitter != mLastViewProj || mScene->pose.instanceWorld != mScene->previousPose.instanceWorld;
         bool reset = !ctx.hasInput("history") || !ctx.inputValid("history") || moved;
         mLastViewProj = cam.viewProjNoJitter;
 

@@ -16,8 +16,12 @@ NodeSchema schema() {
     s.doc = "Importance-sampling table of a sky cube map: texels weighted by luminance x solid angle, a CDF per "
             "texel row and one over the rows (layout in shaders/sky/env_cdf.comp). Rebuilt every frame on the GPU "
             "(one workgroup; a 64² cube takes a few ms on lavapipe), so it follows a sky that changes.";
-    s.inputs = {{"sky", PortKind::Texture, {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT}, false,
-                 Usage::Sampled, "A sky node's cube map (cd/m²)"}};
+    s.inputs = {{"sky",
+                 PortKind::Texture,
+                 {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R16G16B16A16_SFLOAT},
+                 false,
+                 Usage::Sampled,
+                 "A sky node's cube map (cd/m²)"}};
     OutputPort cdf;
     cdf.name = "cdf";
     cdf.format = VK_FORMAT_R32_SFLOAT;

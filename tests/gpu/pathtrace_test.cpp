@@ -43,8 +43,11 @@ json uniformSky(const std::filesystem::path& glb, double c) {
 }
 
 json pathtraceNode(json params, bool history = false) {
-    json in = {{"scene", "scene.scene"}, {"camera", "scene.camera"}, {"sky", "sky.cubemap"},
-               {"sky_sh", "sky.sh"},     {"env_cdf", "env_cdf.cdf"}};
+    json in = {{"scene", "scene.scene"},
+               {"camera", "scene.camera"},
+               {"sky", "sky.cubemap"},
+               {"sky_sh", "sky.sh"},
+               {"env_cdf", "env_cdf.cdf"}};
     if (history) {
         in["history"] = "pt.color@prev";
         in["history_stats"] = "pt.stats@prev";
@@ -64,7 +67,9 @@ json traceGraph(const std::filesystem::path& glb, json sky, json ptParams, int w
     return g;
 }
 
-double schlick(double f0, double cosine) { return f0 + (1.0 - f0) * std::pow(1.0 - cosine, 5.0); }
+double schlick(double f0, double cosine) {
+    return f0 + (1.0 - f0) * std::pow(1.0 - cosine, 5.0);
+}
 
 // Directional albedo of the shared BRDF (core/shading, the CPU mirror of brdf.glsl) for a view at NoV:
 // the integral of brdfCosine over the hemisphere, midpoint rule in (cos theta, phi), 256 x 256 cells.
@@ -76,7 +81,8 @@ double directionalAlbedo(double NoV, glm::vec3 base, float metallic, float rough
         double u = (i + 0.5) / nu, r = std::sqrt(1.0 - u * u);
         for (int j = 0; j < nphi; ++j) {
             double phi = 2.0 * kPi * (j + 0.5) / nphi;
-            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(u));
+            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                        static_cast<float>(u));
             sum += shading::brdfCosine(n, v, l, base, metallic, roughness).g;
         }
     }
@@ -112,7 +118,8 @@ TEST_F(PathTrace, WhiteFurnaceSphereReturnsTheEnvironment) {
         std::vector<double> albedo;
         if (c.shininess < 1.0f)
             for (int i = 0; i <= 64; ++i)
-                albedo.push_back(directionalAlbedo(0.2 + 0.8 * i / 64.0, glm::vec3(1.0f), c.metallic, 1.0f - c.shininess));
+                albedo.push_back(
+                    directionalAlbedo(0.2 + 0.8 * i / 64.0, glm::vec3(1.0f), c.metallic, 1.0f - c.shininess));
         auto roughAlbedo = [&](double NoV) {
             double f = std::clamp((NoV - 0.2) / 0.8 * 64.0, 0.0, 63.999);
             int i = static_cast<int>(f);
@@ -131,7 +138,7 @@ TEST_F(PathTrace, WhiteFurnaceSphereReturnsTheEnvironment) {
                 glm::dvec3 nrm = glm::normalize(cam.position + t * d);
                 double NoV = glm::dot(nrm, -d);
                 if (NoV < 0.2) continue; // tessellated silhouette
-                double expected = c.shininess < 1.0f ? C * roughAlbedo(NoV)
+                double expected = c.shininess < 1.0f  ? C * roughAlbedo(NoV)
                                   : c.metallic > 0.5f ? C
                                                       : C * (1.0 + schlick(0.04, NoV));
                 glm::dvec3 got = rgb(img, x, y);
@@ -143,9 +150,10 @@ TEST_F(PathTrace, WhiteFurnaceSphereReturnsTheEnvironment) {
                 ++n;
             }
         double mean = sumRatio / n;
-        std::printf("furnace %s: %d pixels, mean ratio %.5f, worst pixel %.3f, within 2 standard errors %.3f, background "
-                    "error %.2g\n",
-                    c.name, n, mean, worst, double(within2) / n, background);
+        std::printf(
+            "furnace %s: %d pixels, mean ratio %.5f, worst pixel %.3f, within 2 standard errors %.3f, background "
+            "error %.2g\n",
+            c.name, n, mean, worst, double(within2) / n, background);
         ASSERT_GT(n, 500);
         EXPECT_LT(std::abs(mean - 1.0), 0.01);
         EXPECT_LT(worst, 0.25);
@@ -188,7 +196,8 @@ TEST_F(PathTrace, ClosedEmissiveMirrorSphereSumsTheGeometricSeries) {
     b.s.name = "closed_sphere_single_sided";
     auto single = b.write();
     auto out = runGraph(traceGraph(single, uniformSky(single, 1000.0), {{"spp", 1}}, W, H));
-    EXPECT_NEAR(rgb(out.at("color"), W / 2, H / 2).g, 1000.0, 1.0) << "back faces of a single-sided material are culled";
+    EXPECT_NEAR(rgb(out.at("color"), W / 2, H / 2).g, 1000.0, 1.0)
+        << "back faces of a single-sided material are culled";
 }
 
 // A diffuse plane (base 0.5, smooth dielectric) under a uniform sky C receives E = pi C, so its Lambert
@@ -271,7 +280,8 @@ TEST_F(PathTrace, DirectSunMatchesDeferredLighting) {
                 worst = std::max(worst, e);
                 EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << ": " << pt.r << " vs " << deferred.r;
                 glm::dvec3 cpu = glm::dvec3(shading::shadeDirectional(
-                    glm::vec3(nrm), glm::vec3(-d), glm::vec3(l), base, metallic, shading::roughnessFromShininess(shininess),
+                    glm::vec3(nrm), glm::vec3(-d), glm::vec3(l), base, metallic,
+                    shading::roughnessFromShininess(shininess),
                     glm::vec3(rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale / kPi)));
                 worstCpu = std::max(worstCpu, relErr(pt, cpu));
                 ++n;
@@ -285,8 +295,8 @@ TEST_F(PathTrace, DirectSunMatchesDeferredLighting) {
 
 // Accumulation through color@prev / stats@prev with a still camera: after 16 frames of 4 samples the
 // count is 64, the estimated standard error is ~1/4 of one frame's (1/sqrt(N)), and the means agree (the
-// rough plane has no closed form; one frame's mean over the plane is within 5 % of 16 frames'). With the camera moving (a glTF
-// animation of the camera node) every frame restarts: the count stays at 4.
+// rough plane has no closed form; one frame's mean over the plane is within 5 % of 16 frames'). With the camera moving
+// (a glTF animation of the camera node) every frame restarts: the count stays at 4.
 TEST_F(PathTrace, AccumulationConvergesAndRestartsWhenTheCameraMoves) {
     const int W = 32, H = 24;
     const double C = 100.0, albedo = 0.5;
@@ -304,7 +314,8 @@ TEST_F(PathTrace, AccumulationConvergesAndRestartsWhenTheCameraMoves) {
             s.times = {0.0f, 10.0f};
             s.values = {glm::vec4(0.0f, 2.0f, 3.0f, 0.0f), glm::vec4(2.0f, 2.0f, 3.0f, 0.0f)};
             anim.samplers.push_back(s);
-            anim.channels.push_back({static_cast<uint32_t>(b.s.nodes.size() - 1), scene::AnimationPath::Translation, 0});
+            anim.channels.push_back(
+                {static_cast<uint32_t>(b.s.nodes.size() - 1), scene::AnimationPath::Translation, 0});
             b.s.animations.push_back(anim);
         }
         return std::pair{b.write(), b.s};
