@@ -56,8 +56,8 @@ public:
             if (u.output && u.port == port) return mGraph.resources[u.resource].desc;
         throw InternalError("node " + mDecl.id + " asks for undeclared output '" + port + "'");
     }
-    PipelineId computePipeline(const std::string& shader, const ShaderDefines& defines) override {
-        mPass.pipelines.push_back({shader, defines, {}});
+    PipelineId computePipeline(const std::string& shader, const ShaderDefines& defines, uint32_t nodeSets) override {
+        mPass.pipelines.push_back({shader, defines, {}, nodeSets});
         return static_cast<PipelineId>(mPass.pipelines.size() - 1);
     }
     PipelineId computePipelineSource(const std::string& name, const std::string& source) override {

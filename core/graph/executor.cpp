@@ -32,6 +32,10 @@ struct Executor::Pipeline {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     ShaderReflection reflection;
     std::vector<Target> targets;
+    // Pipelines whose sets 1..nodeSets the node binds: created on the first dispatchWithSets() from its layouts.
+    uint32_t nodeSets = 0;
+    CompiledShader compiled;
+    std::vector<VkDescriptorSetLayout> nodeLayouts;
 };
 
 namespace {
@@ -98,12 +102,38 @@ public:
 
     void dispatch(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,
                   uint32_t depth) override {
+        record(id, push, pushSize, width, height, depth, {}, {});
+    }
+
+    void computeBarrier() override {
+        VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+        b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+        b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        b.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.memoryBarrierCount = 1;
+        dep.pMemoryBarriers = &b;
+        vkCmdPipelineBarrier2(mCmd, &dep);
+    }
+
+    void dispatchWithSets(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,
+                          std::span<const VkDescriptorSetLayout> layouts, std::span<const VkDescriptorSet> sets) override {
+        record(id, push, pushSize, width, height, 1, layouts, sets);
+    }
+
+private:
+    void record(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height, uint32_t depth,
+                std::span<const VkDescriptorSetLayout> layouts, std::span<const VkDescriptorSet> sets) {
         auto& pipelines = mEx.mPipelines[mPassIndex];
         if (id >= pipelines.size()) throw InternalError("node " + pass().id + ": unknown pipeline " + std::to_string(id));
-        const Executor::Pipeline& p = *pipelines[id];
+        Executor::Pipeline& p = *pipelines[id];
         if (pushSize != p.reflection.pushConstantSize)
             throw InternalError("node " + pass().id + ": pushes " + std::to_string(pushSize) + " bytes but " + p.shader +
                                 " declares a push-constant block of " + std::to_string(p.reflection.pushConstantSize));
+        if (layouts.size() != p.nodeSets || sets.size() != p.nodeSets)
+            throw InternalError("node " + pass().id + ": " + p.shader + " takes " + std::to_string(p.nodeSets) +
+                                " node sets, the dispatch binds " + std::to_string(sets.size()));
+        if (p.nodeSets) mEx.createNodeSetPipeline(p, layouts, pass().id);
         VkDescriptorSet set = VK_NULL_HANDLE;
         if (p.setLayout) {
             VkDescriptorSetAllocateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -148,12 +178,14 @@ public:
         }
         vkCmdBindPipeline(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
         if (set) vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
+        if (!sets.empty())
+            vkCmdBindDescriptorSets(mCmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 1, static_cast<uint32_t>(sets.size()),
+                                    sets.data(), 0, nullptr);
         if (pushSize) vkCmdPushConstants(mCmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushSize, push);
         const uint32_t* ls = p.reflection.localSize;
         vkCmdDispatch(mCmd, (width + ls[0] - 1) / ls[0], (height + ls[1] - 1) / ls[1], (depth + ls[2] - 1) / ls[2]);
     }
 
-private:
     const CompiledPass& pass() const { return mEx.mGraph.passes[mPassIndex]; }
     const PassUse* findUse(const std::string& port, bool output) const {
         for (const auto& u : pass().uses)
@@ -380,7 +412,10 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
             std::vector<VkDescriptorSetLayoutBinding> bindings;
             for (const auto& b : shader.reflection.bindings) {
                 std::string where = "shader " + request.shader + " (node " + pass.id + ", " + pass.schema->type + ")";
-                if (b.set != 0) throw InternalError(where + ": binding '" + b.name + "' is in set " + std::to_string(b.set) + "; nodes use set 0");
+                if (b.set != 0 && b.set <= request.nodeSets) continue; // bound by the node
+                if (b.set != 0)
+                    throw InternalError(where + ": binding '" + b.name + "' is in set " + std::to_string(b.set) +
+                                        "; nodes use set 0 (and sets 1.." + std::to_string(request.nodeSets) + " of their own)");
                 if (b.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
                     if (b.name != "Uniforms")
                         throw InternalError(where + ": uniform block '" + b.name + "' must be named Uniforms (filled by setUniforms())");
@@ -408,11 +443,16 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
                 bindings.push_back({b.binding, b.type, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr});
                 p->targets.push_back({b.binding, b.type, port, output});
             }
-            if (!bindings.empty()) {
+            if (!bindings.empty() || request.nodeSets) {
                 VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
                 li.bindingCount = static_cast<uint32_t>(bindings.size());
                 li.pBindings = bindings.data();
                 VK_CHECK(vkCreateDescriptorSetLayout(device, &li, nullptr, &p->setLayout));
+            }
+            if (request.nodeSets) {
+                p->nodeSets = request.nodeSets;
+                p->compiled = std::move(shader);
+                continue;
             }
             VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, shader.reflection.pushConstantSize};
             VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
@@ -427,6 +467,27 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
         }
     }
     mPipelineMs = msSince(start);
+}
+
+void Executor::createNodeSetPipeline(Pipeline& p, std::span<const VkDescriptorSetLayout> layouts, const std::string& passId) {
+    if (p.pipeline) {
+        if (!std::equal(layouts.begin(), layouts.end(), p.nodeLayouts.begin(), p.nodeLayouts.end()))
+            throw InternalError("node " + passId + ": " + p.shader + " was created with other descriptor set layouts");
+        return;
+    }
+    VkDevice device = mCtx.device();
+    std::vector<VkDescriptorSetLayout> all = {p.setLayout};
+    all.insert(all.end(), layouts.begin(), layouts.end());
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, p.reflection.pushConstantSize};
+    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pl.setLayoutCount = static_cast<uint32_t>(all.size());
+    pl.pSetLayouts = all.data();
+    pl.pushConstantRangeCount = range.size ? 1 : 0;
+    pl.pPushConstantRanges = &range;
+    VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &p.layout));
+    p.pipeline = createComputePipeline(device, p.compiled, p.layout);
+    p.nodeLayouts.assign(layouts.begin(), layouts.end());
+    mCtx.setName(reinterpret_cast<uint64_t>(p.pipeline), VK_OBJECT_TYPE_PIPELINE, passId + ":" + p.shader);
 }
 
 void Executor::recordFrame(VkCommandBuffer cmd) {

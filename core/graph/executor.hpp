@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace vitrine {
@@ -70,6 +71,7 @@ private:
     void destroy();
     void createImages();
     void createPipelines(ShaderCompiler& shaders);
+    void createNodeSetPipeline(Pipeline& p, std::span<const VkDescriptorSetLayout> layouts, const std::string& passId);
     uint32_t physicalOf(uint32_t resource, bool previous) const;
     void recordFrame(VkCommandBuffer cmd);
 

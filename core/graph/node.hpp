@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <typeinfo>
 
@@ -67,7 +68,11 @@ public:
     virtual bool hasInput(const std::string& port) const = 0;
     virtual const ImageDesc& input(const std::string& port) const = 0;
     virtual ImageDesc& output(const std::string& port) = 0;
-    virtual PipelineId computePipeline(const std::string& shaderPath, const ShaderDefines& defines = {}) = 0;
+    // nodeSets > 0: the shader's sets 1..nodeSets are the node's own (a scene's, a BVH's: layouts that exist
+    // only once the scene is on the GPU), bound through ExecuteContext::dispatchWithSets(); set 0 is still
+    // bound from the ports.
+    virtual PipelineId computePipeline(const std::string& shaderPath, const ShaderDefines& defines = {},
+                                       uint32_t nodeSets = 0) = 0;
     // A compute pipeline from GLSL the node generated itself; `name` appears in errors.
     virtual PipelineId computePipelineSource(const std::string& name, const std::string& source) = 0;
     // Object ports (scene/camera/buffer kinds). setObject() is for outputs; object() for inputs.
@@ -103,6 +108,19 @@ public:
     // width x height with the shader's local size.
     virtual void dispatch(PipelineId pipeline, const void* push, uint32_t pushSize, uint32_t width,
                           uint32_t height, uint32_t depth = 1) = 0;
+
+    // dispatch() for a pipeline declared with nodeSets: binds `sets` (made with `layouts`) at sets 1..n after
+    // the ports' set 0. The pipeline is created on its first dispatch, from these layouts, which must not
+    // change afterwards. For passes that trace the scene (render.pathtrace binds the scene, its BVH and
+    // geometry).
+    virtual void dispatchWithSets(PipelineId pipeline, const void* push, uint32_t pushSize, uint32_t width,
+                                  uint32_t height, std::span<const VkDescriptorSetLayout> layouts,
+                                  std::span<const VkDescriptorSet> sets) = 0;
+
+    // Orders this pass's earlier dispatches before its later ones (a memory dependency from compute-shader
+    // writes to compute-shader reads and writes), for a pass that refines its own StorageReadWrite outputs
+    // over several dispatches (render.pathtrace splits its samples so no invocation runs long).
+    virtual void computeBarrier() = 0;
 
     // Records a copy of `pixels` into mip 0 / `layer` of an output whose port usage is TransferDst.
     virtual void upload(const std::string& port, const Image& pixels, uint32_t layer = 0) = 0;

@@ -1,7 +1,8 @@
 // The scene's descriptor set (core/scene/gpu_scene.cpp, createDescriptors) and layered-material
 // evaluation (MUSEUM_SPEC §2). Include after #version; define VITRINE_SCENE_SET (default 0) and
 // VITRINE_SCENE_TEXTURES (the scene's texture count) before including, and VITRINE_SCENE_FRAGMENT in
-// fragment shaders (for uvGradients()).
+// fragment shaders (for uvGradients()). Compute shaders whose invocations evaluate different materials
+// (ray tracers) define VITRINE_SCENE_DIVERGENT_TEXTURES (see sceneTexture()) and pass zero gradients (LOD 0).
 #ifndef SCENE_SCENE_GLSL
 #define SCENE_SCENE_GLSL
 #extension GL_GOOGLE_include_directive : require
@@ -43,13 +44,27 @@ UvGradients uvGradients(vec2 uv0, vec2 uv1) {
 }
 #endif
 
+// The scene texture `index`. In a draw the index is the same for every invocation (dynamically uniform).
+// A ray tracer's invocations hit different materials, and without descriptor indexing (lavapipe has no
+// shaderSampledImageArrayNonUniformIndexing) an array of samplers may only be indexed with a dynamically
+// uniform value: VITRINE_SCENE_DIVERGENT_TEXTURES walks the array with a loop index, which is uniform.
+vec4 sceneTexture(int index, vec2 uv, vec2 ddx, vec2 ddy) {
+#ifdef VITRINE_SCENE_DIVERGENT_TEXTURES
+    vec4 texel = vec4(0.0);
+    for (int t = 0; t < VITRINE_SCENE_TEXTURES; ++t)
+        if (t == index) texel = textureGrad(sceneTextures[t], uv, ddx, ddy);
+    return texel;
+#else
+    return textureGrad(sceneTextures[index], uv, ddx, ddy);
+#endif
+}
+
 // The texel a reference points at; 1 without a texture (so "factor x texel" is the factor).
-// The texture index is the same for the whole draw (dynamically uniform).
 vec4 sampleRef(GpuTexRef r, vec2 uv0, vec2 uv1, UvGradients g) {
     if (r.info.x < 0) return vec4(1.0);
     vec4 d = r.info.y == 0 ? g.uv0 : g.uv1;
     mat2 m = mat2(r.row0.x, r.row1.x, r.row0.y, r.row1.y); // the transform's linear part (columns)
-    return textureGrad(sceneTextures[r.info.x], refUv(r, uv0, uv1), m * d.xy, m * d.zw);
+    return sceneTexture(r.info.x, refUv(r, uv0, uv1), m * d.xy, m * d.zw);
 }
 
 float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }

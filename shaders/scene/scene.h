@@ -65,7 +65,9 @@ struct GpuCamera {
     vec4 time;                // x: seconds, y: frame index, z: ev100 (physical camera), w: 0
 };
 
-// Push constants of every scene draw.
+// Push constants of every scene draw. Compute passes that read the scene with push constants of their own
+// (ray tracers: a stage has one push-constant block) define VITRINE_SCENE_NO_DRAW_PUSH.
+#if defined(__cplusplus) || !defined(VITRINE_SCENE_NO_DRAW_PUSH)
 VITRINE_PUSH_BEGIN(SceneDrawPush)
     mat4 viewProj;  // the pass's own view-projection (shadow cascades); G-buffer passes use the camera's
     uint instance;  // index into the instance buffer
@@ -73,6 +75,7 @@ VITRINE_PUSH_BEGIN(SceneDrawPush)
     uint flags;
     uint pad;
 VITRINE_PUSH_END(draw)
+#endif
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuTexRef) == 48);

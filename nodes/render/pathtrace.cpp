@@ -1,0 +1,230 @@
+// render.pathtrace: progressive path-traced reference of the scene camera (shaders/render/pathtrace.comp).
+#include "shaders/render/pathtrace.h"
+#include "core/accel/gpu_bvh.hpp"
+#include "core/gpu/context.hpp"
+#include "core/gpu/vk_check.hpp"
+#include "core/graph/registry.hpp"
+#include "core/scene/gpu_scene.hpp"
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <string>
+
+namespace vitrine {
+namespace {
+
+using gpu_types::PathtracePush;
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "render.pathtrace";
+    s.doc = "Path-traced ground truth of the scene camera: the same layered materials and BRDF as gbuffer.layered + "
+            "lighting.deferred, the sun as a directional light (next-event estimation), the sky cube map as an "
+            "environment light (importance sampled through sky.env_cdf, MIS with BRDF sampling), emissive surfaces, "
+            "Russian roulette. Accumulates across frames through its own @prev outputs and restarts when the camera or "
+            "the scene moves; `spp` samples per pixel per frame make one frame a reference. HDR radiance in cd/m², "
+            "like lighting.color.";
+    auto tex = [](const char* name, const char* doc, bool optional = false) {
+        return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
+    };
+    s.inputs = {
+        {"scene",
+         PortKind::Scene,
+         {},
+         false,
+         Usage::Sampled,
+         "The scene to trace (its BVH is built or loaded on first use)"},
+        {"camera",
+         PortKind::Camera,
+         {},
+         false,
+         Usage::Sampled,
+         "The frame's camera (unjittered; the tracer jitters itself)"},
+        tex("sky", "A sky node's cube map (radiance of the environment, without the sun disk: sun_in_cubemap false)"),
+        tex("sky_sh", "A sky node's `sh`: sun illuminance (texel 9, lux) and direction (texel 10)"),
+        tex("env_cdf", "sky.env_cdf of the same cube map (without it the sky is found by BRDF sampling only)", true),
+        tex("history", "This node's color@prev (without it nothing accumulates across frames)", true),
+        tex("history_stats", "This node's stats@prev", true),
+    };
+    OutputPort color;
+    color.name = "color";
+    color.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    color.size = SizeRule::frame();
+    color.usage = Usage::StorageReadWrite; // refined by each of the frame's dispatches
+    color.doc = "Mean radiance (cd/m², rgb) of all samples since the last restart; a = 1";
+    OutputPort stats = color;
+    stats.name = "stats";
+    stats.doc = "x: samples per pixel since the restart; y: mean luminance; z: sum of squared deviations of the "
+                "samples' luminance; w: standard error of the mean luminance (cd/m²)";
+    s.outputs = {color, stats};
+    s.params = {
+        {"spp",
+         ParamType::Int,
+         16,
+         1.0,
+         1024.0,
+         {},
+         "Samples per pixel per frame (for more, accumulate frames with a still camera)"},
+        {"max_bounces",
+         ParamType::Int,
+         8,
+         1.0,
+         64.0,
+         {},
+         "Surfaces that reflect light along a path (1: direct light only; Russian roulette ends most paths sooner)"},
+        {"sun_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         100.0,
+         {},
+         "Multiplier of the sky model's sun illuminance (as lighting.deferred)"},
+        {"sky_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         100.0,
+         {},
+         "Multiplier of the sky cube map's radiance (0: sun and emitters only)"},
+        {"emissive_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         1e6,
+         {},
+         "Multiplier of emissive surfaces (as lighting.deferred)"},
+        {"antialias",
+         ParamType::Bool,
+         true,
+         {},
+         {},
+         {},
+         "Jitter camera rays over the pixel (off: through pixel centres)"},
+        {"seed",
+         ParamType::Int,
+         0,
+         0.0,
+         2147483647.0,
+         {},
+         "Random sequence (independent estimates for noise measurements)"},
+    };
+    return s;
+}
+
+class Pathtrace final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        mScene = ctx.objectAs<SceneObject>("scene");
+        mCamera = ctx.objectAs<CameraObject>("camera");
+        if (ctx.hasInput("history") != ctx.hasInput("history_stats"))
+            ctx.failParam("spp",
+                          "connect both history (this node's color@prev) and history_stats (stats@prev), or neither");
+        size_t textures = std::max<size_t>(1, mScene->scene().textures.size());
+        mPipeline =
+            ctx.computePipeline("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 3);
+    }
+
+    void execute(ExecuteContext& ctx) override {
+        GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
+        GpuBvh& bvh = mScene->bvh(ctx.gpu());
+        if (!mGeometrySet) createGeometrySet(ctx.gpu(), gpu);
+
+        const Params& p = ctx.params();
+        const CameraFrame& cam = mCamera->current;
+        bool moved =
+            cam.viewProjNoJitter != mLastViewProj || mScene->pose.instanceWorld != mScene->previousPose.instanceWorld;
+        bool reset = !ctx.hasInput("history") || !ctx.inputValid("history") || moved;
+        mLastViewProj = cam.viewProjNoJitter;
+
+        PathtracePush push{};
+        push.invViewProj = glm::inverse(cam.viewProjNoJitter);
+        push.cameraPos = glm::vec4(cam.state.position, 0.0f);
+        push.scales = {p.getFloat("sun_scale"), p.getFloat("sky_scale"), p.getFloat("emissive_scale"), 0.0f};
+        uint32_t flags = (reset ? PATHTRACE_RESET : 0u) | (ctx.hasInput("env_cdf") ? PATHTRACE_ENV_CDF : 0u) |
+                         (p.getBool("antialias") ? PATHTRACE_ANTIALIAS : 0u);
+        const uint32_t seed = static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu;
+        const uint32_t spp = static_cast<uint32_t>(p.getInt("spp"));
+        const ImageDesc& out = ctx.output("color").desc();
+        std::array<VkDescriptorSetLayout, 3> layouts = {bvh.setLayout(), gpu.setLayout(), mGeometryLayout};
+        std::array<VkDescriptorSet, 3> sets = {bvh.set(), gpu.set(), mGeometrySet};
+        for (uint32_t done = 0, chunk = 0; done < spp; ++chunk) {
+            const uint32_t count = std::min(PATHTRACE_SAMPLES_PER_DISPATCH, spp - done);
+            push.counts = {count, static_cast<uint32_t>(p.getInt("max_bounces")),
+                           (ctx.frameIndex() * 0x9E3779B9u + chunk * 0x632BE5ABu) ^ seed,
+                           flags | (done > 0 ? PATHTRACE_CONTINUE : 0u)};
+            if (done > 0) ctx.computeBarrier();
+            ctx.dispatchWithSets(mPipeline, &push, sizeof(push), out.width, out.height, layouts, sets);
+            done += count;
+        }
+    }
+
+    void releaseGpu() override {
+        if (!mContext) return;
+        VkDevice device = mContext->device();
+        VkDescriptorPool pool = mPool;
+        VkDescriptorSetLayout layout = mGeometryLayout;
+        mContext->destroyLater([device, pool, layout] {
+            vkDestroyDescriptorPool(device, pool, nullptr);
+            vkDestroyDescriptorSetLayout(device, layout, nullptr);
+        });
+        mPool = VK_NULL_HANDLE;
+        mGeometryLayout = VK_NULL_HANDLE;
+        mGeometrySet = VK_NULL_HANDLE;
+        mContext = nullptr;
+    }
+    ~Pathtrace() override { releaseGpu(); }
+
+private:
+    // Set 3 of the shader (shaders/pathtrace/surface.glsl): the scene's vertex and index buffers.
+    void createGeometrySet(Context& context, const GpuScene& gpu) {
+        mContext = &context;
+        VkDevice device = context.device();
+        VkDescriptorSetLayoutBinding b[2] = {
+            {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+            {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+        };
+        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+        li.bindingCount = 2;
+        li.pBindings = b;
+        VK_CHECK(vkCreateDescriptorSetLayout(device, &li, nullptr, &mGeometryLayout));
+        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2};
+        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        pi.maxSets = 1;
+        pi.poolSizeCount = 1;
+        pi.pPoolSizes = &size;
+        VK_CHECK(vkCreateDescriptorPool(device, &pi, nullptr, &mPool));
+        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        ai.descriptorPool = mPool;
+        ai.descriptorSetCount = 1;
+        ai.pSetLayouts = &mGeometryLayout;
+        VK_CHECK(vkAllocateDescriptorSets(device, &ai, &mGeometrySet));
+        VkDescriptorBufferInfo infos[2] = {{gpu.vertexBuffer().buffer(), 0, VK_WHOLE_SIZE},
+                                           {gpu.indexBuffer().buffer(), 0, VK_WHOLE_SIZE}};
+        VkWriteDescriptorSet writes[2];
+        for (uint32_t i = 0; i < 2; ++i) {
+            writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+            writes[i].dstSet = mGeometrySet;
+            writes[i].dstBinding = i;
+            writes[i].descriptorCount = 1;
+            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            writes[i].pBufferInfo = &infos[i];
+        }
+        vkUpdateDescriptorSets(device, 2, writes, 0, nullptr);
+        context.setName(reinterpret_cast<uint64_t>(mGeometrySet), VK_OBJECT_TYPE_DESCRIPTOR_SET, "pathtrace.geometry");
+    }
+
+    std::shared_ptr<SceneObject> mScene;
+    std::shared_ptr<CameraObject> mCamera;
+    PipelineId mPipeline = 0;
+    glm::mat4 mLastViewProj{0.0f};
+    Context* mContext = nullptr;
+    VkDescriptorSetLayout mGeometryLayout = VK_NULL_HANDLE;
+    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    VkDescriptorSet mGeometrySet = VK_NULL_HANDLE;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Pathtrace>(); });
+
+} // namespace
+} // namespace vitrine

@@ -1,0 +1,116 @@
+// A ray hit turned into a shading point for the path tracer (render.pathtrace) and bake.lightmap:
+// position, geometric and shading normals (normal map applied), and the layered material evaluated by
+// the same evaluateLayers() as gbuffer.layered, at LOD 0 (no ray cones: the top mip, so no Toksvig).
+//
+// Include after #version with VITRINE_SCENE_SET, VITRINE_SCENE_TEXTURES and VITRINE_BVH_SET defined, and
+// VITRINE_GEOMETRY_SET: the set holding the scene's vertex buffer (binding 0, scene::Vertex as 18 floats)
+// and index buffer (binding 1), GpuScene::vertexBuffer()/indexBuffer().
+#ifndef PATHTRACE_SURFACE_GLSL
+#define PATHTRACE_SURFACE_GLSL
+#extension GL_GOOGLE_include_directive : require
+#define VITRINE_SCENE_DIVERGENT_TEXTURES
+#define VITRINE_SCENE_NO_DRAW_PUSH
+#include "accel/bvh.glsl"
+#include "common/brdf.glsl"
+#include "scene/scene.glsl"
+
+layout(set = VITRINE_GEOMETRY_SET, binding = 0, std430) readonly buffer SceneVertices { float sceneVertices[]; };
+layout(set = VITRINE_GEOMETRY_SET, binding = 1, std430) readonly buffer SceneIndices { uint sceneIndices[]; };
+
+const uint kVertexFloats = 18u; // position 3, normal 3, tangent 4, uv0 2, uv1 2, colour 4
+
+struct PathSurface {
+    vec3 position;
+    vec3 geometricNormal; // faces the ray's origin
+    vec3 normal;          // shading normal (normal map), on the same side as geometricNormal
+    vec3 baseColor;       // layers x vertex colour
+    float metallic;
+    float roughness;
+    float cavity;
+    vec3 emissive; // cd/m^2, before the node's emissive scale
+};
+
+vec3 vertexVec3(uint v, uint offset) {
+    uint b = v * kVertexFloats + offset;
+    return vec3(sceneVertices[b], sceneVertices[b + 1u], sceneVertices[b + 2u]);
+}
+vec4 vertexVec4(uint v, uint offset) {
+    uint b = v * kVertexFloats + offset;
+    return vec4(sceneVertices[b], sceneVertices[b + 1u], sceneVertices[b + 2u], sceneVertices[b + 3u]);
+}
+vec2 vertexVec2(uint v, uint offset) {
+    uint b = v * kVertexFloats + offset;
+    return vec2(sceneVertices[b], sceneVertices[b + 1u]);
+}
+
+// Whether the rasteriser would cull what the ray hit: the back of a triangle whose material is single sided
+// (gbuffer.layered culls those; the BVH reports both sides). The front is counter-clockwise in world space.
+bool pathCulled(BvhHit hit, vec3 direction) {
+    GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
+    if (materials[ref.material].info.w != 0u) return false;
+    GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];
+    uint base = prim.firstIndex + 3u * ref.triangle;
+    mat3 world = mat3(instances[hit.instance].world);
+    vec3 p0 = world * vertexVec3(sceneIndices[base] + prim.vertexOffset, 0u);
+    vec3 p1 = world * vertexVec3(sceneIndices[base + 1u] + prim.vertexOffset, 0u);
+    vec3 p2 = world * vertexVec3(sceneIndices[base + 2u] + prim.vertexOffset, 0u);
+    return dot(cross(p1 - p0, p2 - p0), direction) > 0.0;
+}
+
+PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
+    GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
+    GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];
+    uint i0 = sceneIndices[prim.firstIndex + 3u * ref.triangle] + prim.vertexOffset;
+    uint i1 = sceneIndices[prim.firstIndex + 3u * ref.triangle + 1u] + prim.vertexOffset;
+    uint i2 = sceneIndices[prim.firstIndex + 3u * ref.triangle + 2u] + prim.vertexOffset;
+    vec3 bary = vec3(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics);
+    GpuInstance inst = instances[hit.instance];
+    mat3 world = mat3(inst.world);
+    mat3 normalMatrix = mat3(inst.normalMatrix);
+
+    PathSurface s;
+    s.position = origin + hit.t * direction;
+    vec3 p0 = vertexVec3(i0, 0u), p1 = vertexVec3(i1, 0u), p2 = vertexVec3(i2, 0u);
+    vec3 ng = normalize(normalMatrix * cross(p1 - p0, p2 - p0));
+    bool backFace = dot(ng, direction) > 0.0;
+    if (backFace) ng = -ng;
+    s.geometricNormal = ng;
+
+    vec3 n = normalMatrix * (bary.x * vertexVec3(i0, 3u) + bary.y * vertexVec3(i1, 3u) + bary.z * vertexVec3(i2, 3u));
+    vec4 tangent = bary.x * vertexVec4(i0, 6u) + bary.y * vertexVec4(i1, 6u) + bary.z * vertexVec4(i2, 6u);
+    vec2 uv0 = bary.x * vertexVec2(i0, 10u) + bary.y * vertexVec2(i1, 10u) + bary.z * vertexVec2(i2, 10u);
+    vec2 uv1 = bary.x * vertexVec2(i0, 12u) + bary.y * vertexVec2(i1, 12u) + bary.z * vertexVec2(i2, 12u);
+    vec4 color = bary.x * vertexVec4(i0, 14u) + bary.y * vertexVec4(i1, 14u) + bary.z * vertexVec4(i2, 14u);
+
+    GpuMaterial m = materials[ref.material];
+    UvGradients lod0;
+    lod0.uv0 = vec4(0.0);
+    lod0.uv1 = vec4(0.0);
+    LayeredSurface l = evaluateLayers(m, uv0, uv1, lod0);
+
+    // The G-buffer's tangent frame and normal mapping (gbuffer/layered.frag), flipped for back faces.
+    n = dot(n, n) > 1e-20 ? normalize(n) : ng;
+    vec3 t = world * tangent.xyz;
+    t = t - n * dot(n, t);
+    t = dot(t, t) > 1e-12 ? normalize(t) : vec3(1.0, 0.0, 0.0);
+    vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
+    float len = length(l.normal);
+    vec3 nts = len > 1e-6 ? l.normal / len : vec3(0.0, 0.0, 1.0);
+    vec3 N = normalize(t * nts.x + b * nts.y + n * nts.z);
+    if (backFace) N = -N;
+    // A shading normal that faces away from the viewer (interpolation or a steep normal map) would
+    // see no light at all; bend it back to the visible side.
+    float NoV = dot(N, -direction);
+    if (NoV < 0.01) N = normalize(N - direction * (0.01 - NoV));
+    s.normal = N;
+
+    s.baseColor = l.albedo.rgb * color.rgb;
+    s.metallic = clamp(l.metallic, 0.0, 1.0);
+    s.roughness = roughnessFromShininess(clamp(l.shininess, 0.0, 1.0));
+    s.cavity = clamp(l.cavity, 0.0, 1.0);
+    s.emissive = m.emissive.rgb;
+    if (m.emissiveRef.info.x >= 0) s.emissive *= sampleRef(m.emissiveRef, uv0, uv1, lod0).rgb;
+    return s;
+}
+
+#endif

@@ -1,0 +1,362 @@
+// render.pathtrace against closed-form answers and against lighting.deferred. Scenes are built in code,
+// written as .glb and loaded through scene.gltf, so the whole path (glTF, GPU scene, BVH, layered
+// materials, sky nodes, sky.env_cdf) is what is measured. Skies are uniform (sky.hdri of a constant
+// image: no sun, cube map C everywhere) unless the sun is the subject.
+//
+// Closed forms used, with the shared BRDF (common/brdf.glsl: Lambert + GGX/Smith/Schlick, F0 = 0.04 for
+// dielectrics, the base colour for metals). At shininess 1 (GGX alpha 0.002) the specular lobe is a
+// mirror: its directional albedo under a uniform sky is Schlick's F(NoV) (G2/G1 differs from 1 by less
+// than 1e-5 at the angles used). So a convex object under a uniform sky C, with no occlusion, has
+//     L = C (diffuseAlbedo + F(NoV))
+// and a mirror metal sphere seen from its centre reflects every ray back through the centre at normal
+// incidence, so with emission Le and F0 = a the radiance after N bounces is the geometric series
+//     L = Le (1 + a + ... + a^N).
+#include "tests/gpu/lighting_scene.hpp"
+
+#include "core/image/io.hpp"
+#include "core/shading/brdf.hpp"
+#include "shaders/sky/sky.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+using namespace lighting;
+
+class PathTrace : public GpuTest {};
+
+// A uniform sky of radiance c (no sun in it) as sky.hdri over an equirect .exr written next to glb.
+json uniformSky(const std::filesystem::path& glb, double c) {
+    Image sky(32, 16);
+    for (int y = 0; y < sky.height; ++y)
+        for (int x = 0; x < sky.width; ++x) {
+            float* p = sky.at(x, y);
+            p[0] = p[1] = p[2] = p[3] = 1.0f;
+        }
+    const auto file = glb.parent_path() / (glb.stem().string() + "_sky.exr");
+    writeExr(file, sky, ExrPixelType::Float);
+    return {{"type", "sky.hdri"}, {"params", {{"path", file.string()}, {"intensity", c}, {"size", 16}}}};
+}
+
+json pathtraceNode(json params, bool history = false) {
+    json in = {{"scene", "scene.scene"},
+               {"camera", "scene.camera"},
+               {"sky", "sky.cubemap"},
+               {"sky_sh", "sky.sh"},
+               {"env_cdf", "env_cdf.cdf"}};
+    if (history) {
+        in["history"] = "pt.color@prev";
+        in["history_stats"] = "pt.stats@prev";
+    }
+    return {{"type", "render.pathtrace"}, {"in", in}, {"params", params}};
+}
+
+json traceGraph(const std::filesystem::path& glb, json sky, json ptParams, int w, int h, int frames = 1,
+                bool history = false) {
+    json nodes = {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}}}}},
+                  {"sky", sky},
+                  {"env_cdf", {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}}},
+                  {"pt", pathtraceNode(ptParams, history)}};
+    json g = graph(nodes, {{"color", "pt.color"}, {"stats", "pt.stats"}}, w, h);
+    g["frame"]["frames"] = frames;
+    g["frame"]["write"] = json::array({frames - 1});
+    return g;
+}
+
+double schlick(double f0, double cosine) {
+    return f0 + (1.0 - f0) * std::pow(1.0 - cosine, 5.0);
+}
+
+// Directional albedo of the shared BRDF (core/shading, the CPU mirror of brdf.glsl) for a view at NoV:
+// the integral of brdfCosine over the hemisphere, midpoint rule in (cos theta, phi), 256 x 256 cells.
+double directionalAlbedo(double NoV, glm::vec3 base, float metallic, float roughness) {
+    const int nu = 256, nphi = 256;
+    const glm::vec3 n(0, 0, 1), v(static_cast<float>(std::sqrt(1.0 - NoV * NoV)), 0.0f, static_cast<float>(NoV));
+    double sum = 0.0;
+    for (int i = 0; i < nu; ++i) {
+        double u = (i + 0.5) / nu, r = std::sqrt(1.0 - u * u);
+        for (int j = 0; j < nphi; ++j) {
+            double phi = 2.0 * kPi * (j + 0.5) / nphi;
+            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                        static_cast<float>(u));
+            sum += shading::brdfCosine(n, v, l, base, metallic, roughness).g;
+        }
+    }
+    return sum * (1.0 / nu) * (2.0 * kPi / nphi);
+}
+
+// White furnace: a white sphere alone under a uniform sky C. A white mirror metal returns C, a white
+// smooth dielectric C (1 + F(NoV)) at every pixel (see the top of the file), and a white rough metal
+// (roughness 0.65) C times the BRDF's directional albedo at NoV (single-scattering GGX loses energy; the
+// CPU integrates core/shading's brdfCosine over the hemisphere): any error in the BRDF's
+// sampling weights, the environment's pdf or the MIS weights shows as a departure from these. Bounds: the
+// mean over the sphere's pixels within 1 %, each pixel within 25 % (64 samples per pixel), and at least
+// 85 % of pixels within two of their own estimated standard errors (stats.w) of the exact value.
+TEST_F(PathTrace, WhiteFurnaceSphereReturnsTheEnvironment) {
+    const int W = 48, H = 48;
+    const double C = 100.0, radius = 1.0;
+    struct Case {
+        const char* name;
+        float metallic, shininess;
+    };
+    for (const Case& c : {Case{"white_mirror_metal", 1.0f, 1.0f}, Case{"white_smooth_dielectric", 0.0f, 1.0f},
+                          Case{"white_rough_metal", 1.0f, 0.35f}}) {
+        SCOPED_TRACE(c.name);
+        SceneBuilder b(std::string("furnace_") + c.name);
+        b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(static_cast<float>(radius), 96, 48),
+                                                     b.material(c.name, glm::vec3(1.0f), c.metallic, c.shininess))));
+        b.camera({0.0f, 0.5f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+        auto glb = b.write();
+        auto out = runGraph(traceGraph(glb, uniformSky(glb, C), {{"spp", 64}, {"antialias", false}}, W, H));
+        const Image& img = out.at("color");
+        Pinhole cam(b.s, W, H);
+        // The rough lobe's albedo at 65 values of NoV in [0.2, 1], interpolated linearly (smooth in NoV).
+        std::vector<double> albedo;
+        if (c.shininess < 1.0f)
+            for (int i = 0; i <= 64; ++i)
+                albedo.push_back(
+                    directionalAlbedo(0.2 + 0.8 * i / 64.0, glm::vec3(1.0f), c.metallic, 1.0f - c.shininess));
+        auto roughAlbedo = [&](double NoV) {
+            double f = std::clamp((NoV - 0.2) / 0.8 * 64.0, 0.0, 63.999);
+            int i = static_cast<int>(f);
+            return albedo[i] + (albedo[i + 1] - albedo[i]) * (f - i);
+        };
+        double sumRatio = 0.0, worst = 0.0, background = 0.0;
+        int n = 0, within2 = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                double t = hitSphere(cam.position, d, glm::dvec3(0.0), radius);
+                if (t < 0.0) {
+                    background = std::max(background, relErr(rgb(img, x, y), glm::dvec3(C)));
+                    continue;
+                }
+                glm::dvec3 nrm = glm::normalize(cam.position + t * d);
+                double NoV = glm::dot(nrm, -d);
+                if (NoV < 0.2) continue; // tessellated silhouette
+                double expected = c.shininess < 1.0f  ? C * roughAlbedo(NoV)
+                                  : c.metallic > 0.5f ? C
+                                                      : C * (1.0 + schlick(0.04, NoV));
+                glm::dvec3 got = rgb(img, x, y);
+                double ratio = (got.r + got.g + got.b) / (3.0 * expected);
+                double se = out.at("stats").at(x, y)[3];
+                sumRatio += ratio;
+                worst = std::max(worst, std::abs(ratio - 1.0));
+                within2 += std::abs(got.g - expected) <= 2.0 * se + 1e-4 * expected ? 1 : 0;
+                ++n;
+            }
+        double mean = sumRatio / n;
+        std::printf(
+            "furnace %s: %d pixels, mean ratio %.5f, worst pixel %.3f, within 2 standard errors %.3f, background "
+            "error %.2g\n",
+            c.name, n, mean, worst, double(within2) / n, background);
+        ASSERT_GT(n, 500);
+        EXPECT_LT(std::abs(mean - 1.0), 0.01);
+        EXPECT_LT(worst, 0.25);
+        EXPECT_GT(double(within2) / n, 0.85); // the per-pixel error estimate is honest (~95 % for a normal error)
+        EXPECT_LT(background, 1e-3);
+    }
+}
+
+// Energy after N bounces: the camera at the centre of a closed emissive mirror sphere (F0 = a). Each path
+// bounces radially, so L = Le (1 + a + ... + a^N) exactly; N = 1, 3, 10 checks max_bounces, and N = 10
+// runs Russian roulette from the third surface (unbiased: the mean holds). Bound 1 % on the mean over
+// the image (a uniform sky outside must not leak in: the sphere is closed). The sphere is double sided; made
+// single sided, the camera inside sees the sky through its culled back faces.
+TEST_F(PathTrace, ClosedEmissiveMirrorSphereSumsTheGeometricSeries) {
+    const int W = 24, H = 24;
+    const double a = 0.7, Le = 5.0;
+    SceneBuilder b("closed_sphere");
+    uint32_t material = b.material("mirror", glm::vec3(static_cast<float>(a)), 1.0f, 1.0f);
+    b.s.materials[material].emissiveFactor = glm::vec3(1.0f);
+    b.s.materials[material].emissiveStrength = static_cast<float>(Le);
+    b.s.materials[material].doubleSided = true; // seen from inside: a single-sided sphere is culled, as raster does
+    b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(4.0f, 64, 32), material)));
+    b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, 1.0f);
+    auto glb = b.write();
+    for (int bounces : {1, 3, 10}) {
+        SCOPED_TRACE(bounces);
+        auto out = runGraph(traceGraph(glb, uniformSky(glb, 1000.0), {{"spp", 32}, {"max_bounces", bounces}}, W, H));
+        const Image& img = out.at("color");
+        double sum = 0.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x)
+                sum += rgb(img, x, y).g;
+        double mean = sum / (W * H);
+        double expected = Le * (1.0 - std::pow(a, bounces + 1)) / (1.0 - a);
+        std::printf("closed sphere, %d bounces: mean %.5f, expected %.5f\n", bounces, mean, expected);
+        EXPECT_LT(std::abs(mean / expected - 1.0), 0.01);
+    }
+    // Single sided, the sphere is culled from inside (as gbuffer.layered culls it): the camera sees the sky.
+    b.s.materials[material].doubleSided = false;
+    b.s.name = "closed_sphere_single_sided";
+    auto single = b.write();
+    auto out = runGraph(traceGraph(single, uniformSky(single, 1000.0), {{"spp", 1}}, W, H));
+    EXPECT_NEAR(rgb(out.at("color"), W / 2, H / 2).g, 1000.0, 1.0)
+        << "back faces of a single-sided material are culled";
+}
+
+// A diffuse plane (base 0.5, smooth dielectric) under a uniform sky C receives E = pi C, so its Lambert
+// term is 0.5 E / pi = 0.5 C, and its mirror-like coat adds F(NoV) C: L = C (0.5 + F(NoV)). Bounds: 2 % on
+// the mean over the plane's pixels, 35 % per pixel at 32 samples, 85 % of pixels within two estimated
+// standard errors.
+TEST_F(PathTrace, DiffusePlaneUnderUniformSkyReceivesPiL) {
+    const int W = 48, H = 32;
+    const double C = 100.0, albedo = 0.5;
+    SceneBuilder b("plane");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(20, 0, 0), glm::vec3(0, 0, 20), glm::vec3(0, 1, 0));
+    b.node("plane", static_cast<int32_t>(
+                        b.mesh("plane", quad, b.material("plane", glm::vec3(static_cast<float>(albedo)), 0.0f, 1.0f))));
+    b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+    auto glb = b.write();
+    auto out = runGraph(traceGraph(glb, uniformSky(glb, C), {{"spp", 32}, {"antialias", false}}, W, H));
+    const Image& img = out.at("color");
+    Pinhole cam(b.s, W, H);
+    double sumRatio = 0.0, worst = 0.0;
+    int n = 0, within2 = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y > -0.1) continue;
+            double expected = C * (albedo + schlick(0.04, -d.y));
+            glm::dvec3 got = rgb(img, x, y);
+            double ratio = (got.r + got.g + got.b) / (3.0 * expected);
+            sumRatio += ratio;
+            worst = std::max(worst, std::abs(ratio - 1.0));
+            within2 += std::abs(got.g - expected) <= 2.0 * out.at("stats").at(x, y)[3] ? 1 : 0;
+            ++n;
+        }
+    double mean = sumRatio / n;
+    std::printf("plane: %d pixels, mean ratio %.5f, worst pixel %.3f, within 2 standard errors %.3f\n", n, mean, worst,
+                double(within2) / n);
+    ASSERT_GT(n, 300);
+    EXPECT_LT(std::abs(mean - 1.0), 0.02);
+    EXPECT_LT(worst, 0.35);
+    EXPECT_GT(double(within2) / n, 0.85);
+}
+
+// Direct light only (max_bounces 1, sky off, sun on): the path tracer's sun next-event estimation against
+// lighting.deferred (sky_ambient 0, no shadow map: the sphere cannot shadow its own lit side) on the
+// lighting tests' sphere, rough dielectric and smooth metal. Rays through pixel centres, so both shade
+// the same points. Bound 2 % per channel at every pixel with NoV >= 0.3 and NoL >= 0.2 (the G-buffer's
+// UNORM8 base colour and RGBA16F octahedral normal account for up to ~1.5 % on the metal).
+TEST_F(PathTrace, DirectSunMatchesDeferredLighting) {
+    const int W = 64, H = 64;
+    const double radius = 1.0, sunScale = 0.03;
+    for (const auto& [name, base, metallic, shininess] :
+         {std::tuple{"rough_dielectric", glm::vec3(0.8f, 0.5f, 0.25f), 0.0f, 0.25f},
+          std::tuple{"smooth_metal", glm::vec3(0.95f, 0.64f, 0.54f), 1.0f, 0.65f}}) {
+        SCOPED_TRACE(name);
+        SceneBuilder b(std::string("pt_sphere_") + name);
+        b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(static_cast<float>(radius), 128, 64),
+                                                     b.material(name, base, metallic, shininess))));
+        b.camera({0.0f, 0.4f, 3.2f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+        b.sun({0.55f, 0.75f, 0.6f});
+        auto glb = b.write();
+        json nodes = baseNodes(glb);
+        nodes["direct"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", sunScale}}, false);
+        nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
+        nodes["pt"] = pathtraceNode(
+            {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
+        auto out = runGraph(graph(nodes, {{"direct", "direct.color"}, {"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
+        const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+        Pinhole cam(b.s, W, H);
+        int n = 0;
+        double worst = 0.0, worstCpu = 0.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                double t = hitSphere(cam.position, d, glm::dvec3(0.0), radius);
+                if (t < 0.0) continue;
+                glm::dvec3 nrm = glm::normalize(cam.position + t * d);
+                if (glm::dot(nrm, -d) < 0.3 || glm::dot(nrm, l) < 0.2) continue;
+                glm::dvec3 pt = rgb(out.at("pt"), x, y), deferred = rgb(out.at("direct"), x, y);
+                double e = relErr(pt, deferred);
+                worst = std::max(worst, e);
+                EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << ": " << pt.r << " vs " << deferred.r;
+                glm::dvec3 cpu = glm::dvec3(shading::shadeDirectional(
+                    glm::vec3(nrm), glm::vec3(-d), glm::vec3(l), base, metallic,
+                    shading::roughnessFromShininess(shininess),
+                    glm::vec3(rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale / kPi)));
+                worstCpu = std::max(worstCpu, relErr(pt, cpu));
+                ++n;
+            }
+        std::printf("direct sun %s: %d pixels, worst relative difference to lighting.deferred %.4f, to the CPU BRDF "
+                    "%.4f\n",
+                    name, n, worst, worstCpu);
+        EXPECT_GT(n, 400);
+    }
+}
+
+// Accumulation through color@prev / stats@prev with a still camera: after 16 frames of 4 samples the
+// count is 64, the estimated standard error is ~1/4 of one frame's (1/sqrt(N)), and the means agree (the
+// rough plane has no closed form; one frame's mean over the plane is within 5 % of 16 frames'). With the camera moving
+// (a glTF animation of the camera node) every frame restarts: the count stays at 4.
+TEST_F(PathTrace, AccumulationConvergesAndRestartsWhenTheCameraMoves) {
+    const int W = 32, H = 24;
+    const double C = 100.0, albedo = 0.5;
+    auto build = [&](bool moving) {
+        SceneBuilder b(moving ? "plane_moving" : "plane_still");
+        std::vector<Tri> quad;
+        addQuad(quad, glm::vec3(0.0f), glm::vec3(20, 0, 0), glm::vec3(0, 0, 20), glm::vec3(0, 1, 0));
+        b.node("plane", static_cast<int32_t>(b.mesh(
+                            "plane", quad, b.material("plane", glm::vec3(static_cast<float>(albedo)), 0.0f, 0.5f))));
+        b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+        if (moving) {
+            scene::Animation anim;
+            anim.name = "dolly";
+            scene::AnimationSampler s;
+            s.times = {0.0f, 10.0f};
+            s.values = {glm::vec4(0.0f, 2.0f, 3.0f, 0.0f), glm::vec4(2.0f, 2.0f, 3.0f, 0.0f)};
+            anim.samplers.push_back(s);
+            anim.channels.push_back(
+                {static_cast<uint32_t>(b.s.nodes.size() - 1), scene::AnimationPath::Translation, 0});
+            b.s.animations.push_back(anim);
+        }
+        return std::pair{b.write(), b.s};
+    };
+    auto [glb, s] = build(false);
+    json sky = uniformSky(glb, C);
+    json params = {{"spp", 4}, {"antialias", false}};
+    auto one = runGraph(traceGraph(glb, sky, params, W, H, 1, true));
+    auto many = runGraph(traceGraph(glb, sky, params, W, H, 16, true));
+    Pinhole cam(s, W, H);
+    double seOne = 0.0, seMany = 0.0, sumOne = 0.0, sumMany = 0.0;
+    int n = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y > -0.1) continue;
+            EXPECT_EQ(one.at("stats").at(x, y)[0], 4.0f);
+            EXPECT_EQ(many.at("stats").at(x, y)[0], 64.0f);
+            seOne += one.at("stats").at(x, y)[3];
+            seMany += many.at("stats").at(x, y)[3];
+            // Grey: the luminance mean of the stats is the colour's green.
+            double mean = many.at("color").at(x, y)[1];
+            EXPECT_NEAR(many.at("stats").at(x, y)[1], mean, 1e-3 * mean);
+            sumOne += one.at("color").at(x, y)[1];
+            sumMany += mean;
+            ++n;
+        }
+    double ratio = seOne / seMany;
+    std::printf("accumulation: %d pixels, mean standard error 1 frame %.4f, 16 frames %.4f (ratio %.3f, 1/sqrt(N) "
+                "predicts 4); mean radiance %.4f vs %.4f\n",
+                n, seOne / n, seMany / n, ratio, sumOne / n, sumMany / n);
+    EXPECT_GT(ratio, 3.4);
+    EXPECT_LT(ratio, 4.6);
+    EXPECT_LT(std::abs(sumOne / sumMany - 1.0), 0.05);
+
+    auto [movingGlb, movingScene] = build(true);
+    auto moving = runGraph(traceGraph(movingGlb, uniformSky(movingGlb, C), params, W, H, 3, true));
+    auto still = runGraph(traceGraph(glb, sky, params, W, H, 3, true));
+    EXPECT_EQ(moving.at("stats").at(W / 2, H - 2)[0], 4.0f) << "a moving camera restarts the accumulation";
+    EXPECT_EQ(still.at("stats").at(W / 2, H - 2)[0], 12.0f);
+}
+
+} // namespace
+} // namespace vitrine::test
