@@ -108,7 +108,8 @@ TEST_F(GltfErrors, NumbersTooLargeAndNestingTooDeep) {
 }
 
 // Found by fuzz_gltf: a camera animated over 1e29 s made the number of 30 Hz path samples a float beyond size_t
-// (undefined behaviour, then an endless loop). Times must be finite and a camera path at most 10^6 samples.
+// (undefined behaviour, then an endless loop). Times must be finite (readAccessor) and a camera path at most 10^6
+// samples.
 TEST_F(GltfErrors, CameraAnimationTimesOutOfRange) {
     auto withLastTime = [&](float t) {
         std::vector<uint8_t> buffer = mBuffer;
