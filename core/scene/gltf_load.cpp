@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 
@@ -17,6 +18,8 @@ namespace vitrine::scene::gltf {
 namespace {
 
 constexpr float kCameraSampleRate = 30.0f; // Hz, for camera nodes moved by arbitrary animations
+// At most this many samples per camera path (9 h 15 min at 30 Hz): a longer animation is a broken file, not a shot.
+constexpr float kMaxCameraSamples = 1.0e6f;
 
 std::string role(const LoadContext& ctx, const Json& obj, const std::string& e) {
     const Json* extras = member(obj, "extras");
@@ -118,7 +121,7 @@ AnimationSampler readSampler(const LoadContext& ctx, const tinygltf::AnimationSa
         ctx.fail(e + ".output", std::to_string(output.count) + " elements; expected " +
                                     std::to_string(input.count * per) + " (input count" + (per == 3 ? " × 3)" : ")"));
     }
-    out.times = input.data;
+    out.times = input.data; // finite: readAccessor refuses NaN and infinities
     for (size_t i = 1; i < out.times.size(); ++i) {
         if (out.times[i] < out.times[i - 1]) ctx.fail(e + ".input", "times decrease at key " + std::to_string(i));
     }
@@ -181,7 +184,7 @@ void splitWorld(const glm::mat4& world, glm::vec3& position, glm::quat& orientat
 }
 
 // A path for a camera node of any file: one key when still, 30 Hz samples while animations move it.
-CameraPath pathForCameraNode(const Scene& scene, uint32_t node) {
+CameraPath pathForCameraNode(const LoadContext& ctx, const Scene& scene, uint32_t node) {
     CameraPath path;
     path.name = scene.nodes[node].name.empty() ? "camera" + std::to_string(node) : scene.nodes[node].name;
     path.camera = static_cast<uint32_t>(scene.nodes[node].camera);
@@ -201,7 +204,16 @@ CameraPath pathForCameraNode(const Scene& scene, uint32_t node) {
         path.loop = path.loop || a.loop;
         moving = true;
     }
-    size_t count = moving ? static_cast<size_t>(std::ceil((end - start) * kCameraSampleRate)) + 1 : 1;
+    // Checked before the cast: a float beyond size_t is undefined behaviour, and a huge count exhausts memory.
+    const float samples = std::ceil((end - start) * kCameraSampleRate);
+    if (moving && !(samples <= kMaxCameraSamples)) {
+        char span[32];
+        std::snprintf(span, sizeof span, "%g", static_cast<double>(end - start));
+        ctx.fail("camera node '" + path.name + "'",
+                 std::string("its animations span ") + span + " s; a camera path is sampled at 30 Hz, at most " +
+                     std::to_string(static_cast<int>(kMaxCameraSamples)) + " samples (expected times in seconds)");
+    }
+    size_t count = moving ? static_cast<size_t>(samples) + 1 : 1;
     float yfov = scene.cameras[path.camera].yfov;
     for (size_t k = 0; k < count; ++k) {
         CameraKey key;
@@ -398,7 +410,7 @@ void loadNodesAndScene(LoadContext& ctx) {
     size_t exported = scene.cameraPaths.size();
     for (size_t n = 0; n < scene.nodes.size(); ++n) {
         if (scene.nodes[n].camera < 0) continue;
-        CameraPath path = pathForCameraNode(scene, static_cast<uint32_t>(n));
+        CameraPath path = pathForCameraNode(ctx, scene, static_cast<uint32_t>(n));
         // A path exportGlb() wrote under this node's name already is this camera's (a re-import).
         auto end = scene.cameraPaths.begin() + static_cast<std::ptrdiff_t>(exported);
         if (std::any_of(scene.cameraPaths.begin(), end, [&](const CameraPath& p) { return p.name == path.name; }))

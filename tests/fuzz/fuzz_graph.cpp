@@ -7,9 +7,9 @@
 #include <cstdint>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    static const std::filesystem::path scratch = vitrine::fuzz::scratchDirectory("vitrine-fuzz-graph");
+    static const vitrine::fuzz::Scratch scratch("vitrine-fuzz-graph");
     try {
-        vitrine::fuzz::loadGraphInput(data, size, scratch);
+        vitrine::fuzz::loadGraphInput(data, size, scratch.dir);
     } catch (const vitrine::UserError&) {
         // Rejected with a message for the user: what malformed input should get.
     }

@@ -28,4 +28,16 @@ void loadGltfInput(const uint8_t* data, size_t size, const std::filesystem::path
 // A directory for one process's scratch files (created; under /dev/shm when there is one, else $TMPDIR or /tmp).
 std::filesystem::path scratchDirectory(const char* name);
 
+// scratchDirectory(), removed with its files when the process ends normally (a fuzzer's time is up).
+struct Scratch {
+    explicit Scratch(const char* name) : dir(scratchDirectory(name)) {}
+    ~Scratch() {
+        std::error_code ec;
+        std::filesystem::remove_all(dir, ec);
+    }
+    Scratch(const Scratch&) = delete;
+    Scratch& operator=(const Scratch&) = delete;
+    std::filesystem::path dir;
+};
+
 } // namespace vitrine::fuzz

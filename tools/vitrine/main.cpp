@@ -14,7 +14,8 @@ const char* kUsage = R"(usage: vitrine COMMAND [options]
 commands:
   run GRAPH [--set K=V]... [--out DIR] [--frames N] [--exr half|float|none] [--overwrite]
       Render GRAPH headless; writes each output of the chosen frames as PNG (through the
-      OCIO display transform) and all outputs of a frame as one multi-layer EXR.
+      OCIO display transform) and all outputs of a frame as one multi-layer EXR. --frames N is
+      frame.frames (and frame.write = [N-1]) before validation; later --set frame.* override it.
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
   nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
                                     JSON on stdout (or in FILE).
@@ -44,7 +45,8 @@ common options:
   --quiet / --verbose   Less / more output on stderr
 
 exit status: 0 done, 1 the input is wrong (message on stderr), 2 internal failure (or Vulkan
-validation messages with --validate), 3 `golden check` found images beyond tolerance.
+validation messages with --validate), 3 `golden check` found images beyond tolerance, 130 `run`
+stopped by Ctrl-C / SIGTERM after finishing (and writing) the frame it was rendering.
 )";
 
 } // namespace

@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <limits>
+
 namespace vitrine::scene {
 namespace {
 
@@ -102,6 +105,30 @@ TEST_F(GltfErrors, NumbersTooLargeAndNestingTooDeep) {
     expectUserError([&] { loadGltf(mDir / "big.gltf"); }, {"big.gltf: JSON line 2, column 11", "'1e999' is too large"});
     test::writeText(mDir / "deep.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '['));
     expectUserError([&] { loadGltf(mDir / "deep.gltf"); }, {"deep.gltf: JSON line 1, column", "nesting deeper than"});
+}
+
+// Found by fuzz_gltf: a camera animated over 1e29 s made the number of 30 Hz path samples a float beyond size_t
+// (undefined behaviour, then an endless loop). Times must be finite (readAccessor) and a camera path at most 10^6
+// samples.
+TEST_F(GltfErrors, CameraAnimationTimesOutOfRange) {
+    auto withLastTime = [&](float t) {
+        std::vector<uint8_t> buffer = mBuffer;
+        std::memcpy(buffer.data() + 140 + 4, &t, 4); // bufferViews[4]: the sampler's two key times
+        Json doc = mDoc;
+        doc["animations"][0]["channels"][0]["target"]["node"] = 1; // move the camera node "cam"
+        doc["accessors"][4].erase("max");
+        doc["buffers"][0] = {{"byteLength", buffer.size()}};
+        return test::makeGlb(doc.dump(), buffer);
+    };
+    test::writeBytes(mDir / "long.glb", withLastTime(1e29f));
+    expectUserError([&] { loadGltf(mDir / "long.glb"); }, {"long.glb", "camera node 'cam'", "at most 1000000 samples"});
+    test::writeBytes(mDir / "nan.glb", withLastTime(std::numeric_limits<float>::quiet_NaN()));
+    expectUserError([&] { loadGltf(mDir / "nan.glb"); }, {"nan.glb", "animations[0].samplers[0].input", "not a finite"});
+    // Nine hours of camera animation is still a path; ten hours (1.08 million samples) is not.
+    test::writeBytes(mDir / "nine_hours.glb", withLastTime(9 * 3600.0f));
+    EXPECT_NO_THROW(loadGltf(mDir / "nine_hours.glb"));
+    test::writeBytes(mDir / "ten_hours.glb", withLastTime(10 * 3600.0f));
+    expectUserError([&] { loadGltf(mDir / "ten_hours.glb"); }, {"ten_hours.glb", "span 36000 s"});
 }
 
 TEST_F(GltfErrors, MissingBufferFile) {
