@@ -11,29 +11,6 @@
 
 namespace vitrine::bake {
 
-namespace {
-
-void transition(VkCommandBuffer cmd, const GpuImage& image, VkImageLayout from, VkImageLayout to,
-                VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
-                VkAccessFlags2 dstAccess) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = srcStage;
-    b.srcAccessMask = srcAccess;
-    b.dstStageMask = dstStage;
-    b.dstAccessMask = dstAccess;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image.image();
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
-}
-
-} // namespace
-
 LightmapTexels rasterizeLightmapTexels(Context& ctx, ShaderCompiler& shaders, GpuScene& gpu,
                                        const scene::Scene& scene, const LightmapAtlas& atlas) {
     if (atlas.width == 0 || atlas.height == 0) throw InternalError("rasterizeLightmapTexels: empty atlas");
@@ -61,7 +38,7 @@ LightmapTexels rasterizeLightmapTexels(Context& ctx, ShaderCompiler& shaders, Gp
 
     ctx.immediate([&](VkCommandBuffer cmd) {
         for (const GpuImage* image : {&position, &normal})
-            transition(cmd, *image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            imageBarrier(cmd, image->image(), 0, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                        VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                        VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
         VkClearValue zero{};
@@ -85,7 +62,7 @@ LightmapTexels rasterizeLightmapTexels(Context& ctx, ShaderCompiler& shaders, Gp
         }
         endRendering(cmd);
         for (const GpuImage* image : {&position, &normal})
-            transition(cmd, *image, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            imageBarrier(cmd, image->image(), 0, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
                        VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     });

@@ -27,4 +27,10 @@ GpuBuffer uploadBuffer(Context& ctx, const void* data, size_t bytes, VkBufferUsa
 GpuBuffer recordUpload(Context& ctx, VkCommandBuffer cmd, const GpuImage& image, const Image& pixels,
                        uint32_t layer = 0);
 
+// Records one image memory barrier over mips [baseMip, baseMip + mips) of layer 0 (colour aspect). For code that
+// works outside the render graph (uploads, bakes); graph passes get their barriers from the executor.
+void imageBarrier(VkCommandBuffer cmd, VkImage image, uint32_t baseMip, uint32_t mips, VkImageLayout from, VkImageLayout to,
+                  VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
+                  VkAccessFlags2 dstAccess);
+
 } // namespace vitrine
