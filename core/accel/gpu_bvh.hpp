@@ -7,6 +7,7 @@
 // index its shader gives VITRINE_BVH_SET (1 by default, beside the scene's set 0).
 
 #include "core/accel/scene_bvh.hpp"
+#include "core/gpu/buffer_set.hpp"
 #include "core/gpu/resources.hpp"
 
 #include <string>
@@ -28,20 +29,16 @@ public:
     // submissions.
     void update(const scene::ScenePose& pose);
 
-    VkDescriptorSetLayout setLayout() const { return mSetLayout; }
-    VkDescriptorSet set() const { return mSet; }
+    VkDescriptorSetLayout setLayout() const { return mSet.layout(); }
+    VkDescriptorSet set() const { return mSet.set(); }
     uint64_t bytes() const { return mBytes; } // device memory of all five buffers
     double uploadMs() const { return mUploadMs; }
 
 private:
-    void release();
-
     Context& mCtx;
     const accel::SceneBvh& mBvh;
     GpuBuffer mNodes, mTriangles, mRefs, mPrimitives, mTop;
-    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
-    VkDescriptorSet mSet = VK_NULL_HANDLE;
+    StorageBufferSet mSet;
     uint64_t mBytes = 0;
     double mUploadMs = 0.0;
 };

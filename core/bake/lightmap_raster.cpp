@@ -52,7 +52,7 @@ LightmapTexels rasterizeLightmapTexels(Context& ctx, ShaderCompiler& shaders, Gp
             const int32_t region = atlas.regionOfInstance.at(draw.instance);
             if (region < 0 || !scene.primitives[draw.primitive].lightmapUvs) continue;
             gpu_types::SceneDrawPush push{};
-            push.viewProj[0] = atlas.regions[region].scaleOffset;
+            push.lightmap = atlas.regions[region].scaleOffset;
             push.instance = draw.instance;
             push.material = draw.material;
             push.pad = static_cast<uint32_t>(region);

@@ -5,19 +5,54 @@
 
 namespace vitrine::bake {
 
+namespace {
+float luminanceOf(glm::vec3 c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+} // namespace
+
 void filterLightmap(LightmapTexels& t, const LightmapFilterOptions& o) {
     // The B3-spline kernel of the à-trous transform, separable weights 1/16, 4/16, 6/16, 4/16, 1/16.
     static constexpr float kKernel[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
     const float inv2Sigma2 = 1.0f / (2.0f * o.positionSigma * o.positionSigma);
+    const bool guided = t.variance.size() == t.irradiance.size() && o.luminanceSigma > 0.0f;
     std::vector<glm::vec3> next(t.irradiance.size());
+    std::vector<float> variance = guided ? t.variance : std::vector<float>{};
+    std::vector<float> nextVariance(variance.size());
     for (int it = 0, step = 1; it < o.iterations; ++it, step *= 2) {
+        const float reach = 6.0f * float(step) * o.texelSize, reach2 = reach * reach;
+        // The noise estimate of a texel from few samples is itself noisy (0 where every sample happened to
+        // agree): the luminance test uses its 3x3 mean over the region, as SVGF does.
+        std::vector<float> blurred;
+        if (guided) {
+            blurred.assign(variance.size(), 0.0f);
+            for (uint32_t y = 0; y < t.height; ++y)
+                for (uint32_t x = 0; x < t.width; ++x) {
+                    const size_t c = t.index(x, y);
+                    if (t.region[c] < 0) continue;
+                    float sum = 0.0f;
+                    int n = 0;
+                    for (int j = -1; j <= 1; ++j)
+                        for (int i = -1; i <= 1; ++i) {
+                            const int sx = int(x) + i, sy = int(y) + j;
+                            if (sx < 0 || sy < 0 || sx >= int(t.width) || sy >= int(t.height)) continue;
+                            const size_t s = t.index(uint32_t(sx), uint32_t(sy));
+                            if (t.region[s] != t.region[c]) continue;
+                            sum += variance[s];
+                            ++n;
+                        }
+                    blurred[c] = sum / float(n);
+                }
+        }
         for (uint32_t y = 0; y < t.height; ++y)
             for (uint32_t x = 0; x < t.width; ++x) {
                 const size_t c = t.index(x, y);
                 next[c] = t.irradiance[c];
+                if (guided) nextVariance[c] = variance[c];
                 if (t.region[c] < 0) continue;
+                const float lc = luminanceOf(t.irradiance[c]);
+                // The deviation a difference of two texels may have from noise alone.
+                const float noise = guided ? o.luminanceSigma * std::sqrt(2.0f * std::max(blurred[c], 0.0f)) : 0.0f;
                 glm::vec3 sum(0.0f);
-                float weight = 0.0f;
+                float weight = 0.0f, weight2Variance = 0.0f;
                 for (int j = -2; j <= 2; ++j)
                     for (int i = -2; i <= 2; ++i) {
                         const int sx = int(x) + i * step, sy = int(y) + j * step;
@@ -25,15 +60,25 @@ void filterLightmap(LightmapTexels& t, const LightmapFilterOptions& o) {
                         const size_t s = t.index(uint32_t(sx), uint32_t(sy));
                         if (t.region[s] != t.region[c]) continue;
                         const glm::vec3 d = t.position[s] - t.position[c];
-                        const float wp = std::exp(-glm::dot(d, d) * inv2Sigma2);
+                        if (o.texelSize > 0.0f && glm::dot(d, d) > reach2) continue;
+                        const float plane = glm::dot(d, t.normal[c]);
+                        const float wp = std::exp(-plane * plane * inv2Sigma2);
                         const float wn = std::pow(std::max(glm::dot(t.normal[s], t.normal[c]), 0.0f), o.normalPower);
-                        const float w = kKernel[i + 2] * kKernel[j + 2] * wp * wn;
+                        float wl = 1.0f;
+                        if (guided) {
+                            const float dl = std::abs(luminanceOf(t.irradiance[s]) - lc);
+                            wl = std::exp(-dl / (noise + 1e-6f * (lc + 1.0f)));
+                        }
+                        const float w = kKernel[i + 2] * kKernel[j + 2] * wp * wn * wl;
                         sum += w * t.irradiance[s];
                         weight += w;
+                        if (guided) weight2Variance += w * w * variance[s];
                     }
                 next[c] = sum / weight; // the centre's own weight is > 0, so weight > 0
+                if (guided) nextVariance[c] = weight2Variance / (weight * weight);
             }
         t.irradiance.swap(next);
+        if (guided) variance.swap(nextVariance);
     }
 }
 
@@ -64,25 +109,6 @@ void dilateLightmap(LightmapTexels& t, int radius) {
             }
         }
     t.irradiance.swap(value); // dilated texels keep region -1: coverage stays what was rasterised
-}
-
-uint32_t packRgb9e5(glm::vec3 rgb) {
-    constexpr int kN = 9, kB = 15;
-    constexpr float kMax = 511.0f / 512.0f * 65536.0f; // (2^N - 1) / 2^N * 2^(Emax - B)
-    auto clampChannel = [&](float v) { return std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, kMax); };
-    const float r = clampChannel(rgb.r), g = clampChannel(rgb.g), b = clampChannel(rgb.b);
-    const float maxC = std::max(r, std::max(g, b));
-    int expPrime = (maxC > 0.0f ? std::max(-kB - 1, int(std::floor(std::log2(maxC)))) : -kB - 1) + 1 + kB;
-    const float maxS = std::floor(maxC / std::ldexp(1.0f, expPrime - kB - kN) + 0.5f);
-    const int expShared = maxS < float(1 << kN) ? expPrime : expPrime + 1;
-    const float scale = std::ldexp(1.0f, expShared - kB - kN);
-    auto mantissa = [&](float v) { return uint32_t(std::floor(v / scale + 0.5f)) & 0x1ffu; };
-    return mantissa(r) | (mantissa(g) << 9) | (mantissa(b) << 18) | (uint32_t(expShared) << 27);
-}
-
-glm::vec3 unpackRgb9e5(uint32_t p) {
-    const float scale = std::ldexp(1.0f, int(p >> 27) - 15 - 9);
-    return glm::vec3(float(p & 0x1ffu), float((p >> 9) & 0x1ffu), float((p >> 18) & 0x1ffu)) * scale;
 }
 
 } // namespace vitrine::bake

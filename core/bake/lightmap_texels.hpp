@@ -8,6 +8,8 @@
 //   - shared-exponent packing to E5B9G9R9 (VK_FORMAT_E5B9G9R9_UFLOAT_PACK32, 4 bytes a texel), the compact
 //     HDR format the lightmap is cached and sampled in.
 
+#include "core/image/rgb9e5.hpp"
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -23,14 +25,25 @@ struct LightmapTexels {
     std::vector<glm::vec3> position;   // world space, metres
     std::vector<glm::vec3> normal;     // unit
     std::vector<int32_t> region;
+    // Variance of each texel's estimate of the mean luminance of its irradiance (from the bake's samples);
+    // empty when unknown. With it, the filter also stops at differences the noise cannot explain.
+    std::vector<float> variance;
 
     size_t index(uint32_t x, uint32_t y) const { return size_t(y) * width + x; }
 };
 
 struct LightmapFilterOptions {
     int iterations = 3;            // à-trous steps 1, 2, 4 ... texels
-    float positionSigma = 0.25f;   // metres: texels farther apart than this barely mix
+    float positionSigma = 0.25f;   // metres off the centre texel's tangent plane: texels farther than this barely mix
     float normalPower = 32.0f;     // weight = max(dot(n, n'), 0)^normalPower
+    // With LightmapTexels::variance: taps whose luminance differs from the centre's by more than
+    // luminanceSigma standard deviations of the difference (as the filter has reduced them) barely mix, so
+    // real gradients (contact shadows, the edge of a sunlit patch) survive while noise is smoothed
+    // [Schied et al. 2017, SVGF].
+    float luminanceSigma = 3.0f;
+    // World size of a texel (m); > 0: a tap farther from the centre than 6 x step x texelSize (a neighbour in
+    // the atlas but not on the surface: across a chart seam) is left out. 0: no such limit.
+    float texelSize = 0.0f;
 };
 
 // Edge-aware smoothing of `irradiance` over covered texels of the same region.
@@ -40,9 +53,8 @@ void filterLightmap(LightmapTexels& texels, const LightmapFilterOptions& options
 // texel (Chebyshev rings, the nearest ring wins, ties averaged). Texels farther away stay as they are.
 void dilateLightmap(LightmapTexels& texels, int radius);
 
-// E5B9G9R9 as the Vulkan specification defines it (shared exponent, bias 15, 9-bit mantissas, no sign):
-// negative and NaN inputs become 0, values above the maximum (65408) clamp.
-uint32_t packRgb9e5(glm::vec3 rgb);
-glm::vec3 unpackRgb9e5(uint32_t packed);
+// E5B9G9R9 packing (core/image/rgb9e5.hpp), the format the lightmap is cached and sampled in.
+using vitrine::packRgb9e5;
+using vitrine::unpackRgb9e5;
 
 } // namespace vitrine::bake

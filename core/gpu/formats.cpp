@@ -19,6 +19,7 @@ const std::vector<FormatInfo>& allFormats() {
         {"rg32f", VK_FORMAT_R32G32_SFLOAT, 8, 2, false, false},
         {"rgba32f", VK_FORMAT_R32G32B32A32_SFLOAT, 16, 4, false, false},
         {"r11g11b10f", VK_FORMAT_B10G11R11_UFLOAT_PACK32, 4, 3, false, false},
+        {"rgb9e5", VK_FORMAT_E5B9G9R9_UFLOAT_PACK32, 4, 3, false, false},
         {"d32f", VK_FORMAT_D32_SFLOAT, 4, 1, true, false},
     };
     return kFormats;

@@ -3,6 +3,7 @@
 #include "core/base/error.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/formats.hpp"
+#include "core/image/rgb9e5.hpp"
 
 #include <glm/gtc/packing.hpp>
 
@@ -66,6 +67,11 @@ std::vector<uint8_t> packPixels(const Image& image, VkFormat format) {
             std::memcpy(dst, &v, 4);
             break;
         }
+        case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: {
+            uint32_t v = packRgb9e5(glm::vec3(p[0], p[1], p[2]));
+            std::memcpy(dst, &v, 4);
+            break;
+        }
         default: throw InternalError("packPixels: unsupported format " + formatName(format));
         }
     }
@@ -114,6 +120,15 @@ Image unpackPixels(const void* data, uint32_t width, uint32_t height, VkFormat f
             uint32_t v;
             std::memcpy(&v, src, 4);
             glm::vec3 c = glm::unpackF2x11_1x10(v);
+            p[0] = c.x;
+            p[1] = c.y;
+            p[2] = c.z;
+            break;
+        }
+        case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: {
+            uint32_t v;
+            std::memcpy(&v, src, 4);
+            glm::vec3 c = unpackRgb9e5(v);
             p[0] = c.x;
             p[1] = c.y;
             p[2] = c.z;

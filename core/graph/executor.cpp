@@ -116,6 +116,15 @@ public:
         vkCmdPipelineBarrier2(mCmd, &dep);
     }
 
+    void splitSubmission() override {
+        VK_CHECK(vkEndCommandBuffer(mCmd));
+        mEx.mCtx.waitSerial(mEx.mCtx.submit(mCmd));
+        VK_CHECK(vkResetCommandBuffer(mCmd, 0));
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        VK_CHECK(vkBeginCommandBuffer(mCmd, &begin));
+    }
+
     void dispatchWithSets(PipelineId id, const void* push, uint32_t pushSize, uint32_t width, uint32_t height,
                           std::span<const VkDescriptorSetLayout> layouts, std::span<const VkDescriptorSet> sets) override {
         record(id, push, pushSize, width, height, 1, layouts, sets);

@@ -122,6 +122,12 @@ public:
     // over several dispatches (render.pathtrace splits its samples so no invocation runs long).
     virtual void computeBarrier() = 0;
 
+    // Ends the frame's command buffer here, submits it and waits for the GPU, then goes on recording into a
+    // fresh one (cmd() stays the same handle; bindings are gone). For long work done once (bakes), so that it
+    // can show progress and read results back mid-frame; everything recorded before, this pass's inputs
+    // included, has run when it returns. Never for per-frame work: it stalls the frame.
+    virtual void splitSubmission() = 0;
+
     // Records a copy of `pixels` into mip 0 / `layer` of an output whose port usage is TransferDst.
     virtual void upload(const std::string& port, const Image& pixels, uint32_t layer = 0) = 0;
 

@@ -40,6 +40,9 @@ struct InputPort {
     bool optional = false;
     Usage usage = Usage::Sampled;
     std::string doc;
+    // The node also copies this input to the host (after ExecuteContext::splitSubmission, with readImage): its
+    // image gets VK_IMAGE_USAGE_TRANSFER_SRC_BIT.
+    bool readBack = false;
 };
 
 struct OutputPort {

@@ -62,6 +62,14 @@ GpuBvh& SceneObject::bvh(Context& ctx) {
     return *mGpuBvh;
 }
 
+const StorageBufferSet& GpuScene::geometrySet() {
+    if (!mGeometrySet) {
+        const VkBuffer buffers[2] = {mVertices.buffer(), mIndices.buffer()};
+        mGeometrySet = StorageBufferSet(mCtx, buffers, VK_SHADER_STAGE_COMPUTE_BIT, mScene.name + ".geometry");
+    }
+    return mGeometrySet;
+}
+
 GpuScene& SceneObject::gpu() const {
     if (!mGpu) throw InternalError("the scene '" + mScene->name + "' was used on the GPU before its node uploaded it");
     return *mGpu;

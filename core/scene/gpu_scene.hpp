@@ -6,6 +6,7 @@
 // frame and then, every frame, poses the animated nodes and the camera and writes them to per-frame
 // buffers. Raster nodes bind GpuScene::set() (layout: shaders/scene/scene.glsl) and draw through it.
 
+#include "core/gpu/buffer_set.hpp"
 #include "core/gpu/resources.hpp"
 #include "core/graph/node.hpp"
 #include "core/scene/scene.hpp"
@@ -90,6 +91,9 @@ public:
     // (GpuBvhPrimitive, shaders/accel/bvh.h).
     const GpuBuffer& vertexBuffer() const { return mVertices; }
     const GpuBuffer& indexBuffer() const { return mIndices; }
+    // Both as one descriptor set (binding 0 vertices, 1 indices; compute stage), made on first use: the
+    // VITRINE_GEOMETRY_SET of shaders/pathtrace/surface.glsl.
+    const StorageBufferSet& geometrySet();
     // Binds the vertex and index buffers. Then drawIndexed(cmd, draw) per draw.
     void bindGeometry(VkCommandBuffer cmd) const;
     void drawIndexed(VkCommandBuffer cmd, const GpuDraw& draw) const;
@@ -103,6 +107,7 @@ private:
     Context& mCtx;
     const scene::Scene& mScene;
     GpuBuffer mVertices, mIndices, mMaterials, mLayers, mInstances, mCamera;
+    StorageBufferSet mGeometrySet;
     std::vector<GpuImage> mTextures;       // one per scene texture
     std::vector<VkSampler> mSamplers;      // one per scene texture
     GpuImage mFallback;                    // bound when the scene has no textures

@@ -1,6 +1,7 @@
 // lighting.deferred: sun (GGX + Lambert, cascaded shadows) and sky ambient over the G-buffer.
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
+#include "nodes/bake/baked_lighting.hpp"
 #include "nodes/shadow/cascades.hpp"
 #include "shaders/lighting/deferred.h"
 
@@ -11,8 +12,10 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "lighting.deferred";
     s.doc = "Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance (GGX, Smith, Schlick) + Lambert for the sun "
-            "with PCF-filtered cascaded shadows and cavity; diffuse ambient from the sky's SH irradiance and indirect "
-            "specular from the sky (stand-ins until lightmaps and IBL), emissive added. Outputs HDR radiance (cd/m²).";
+            "with PCF-filtered cascaded shadows and cavity; indirect diffuse from the G-buffer's baked lightmap or "
+            "bake.lightmap's irradiance volume (the sky's SH irradiance scaled by sky_ambient where there is "
+            "neither); indirect specular from the volume's SH radiance (else the sky), until IBL; emissive added. "
+            "Outputs HDR radiance (cd/m²).";
     auto tex = [](const char* name, const char* doc, bool optional = false) {
         return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
     };
@@ -20,13 +23,15 @@ NodeSchema schema() {
         tex("normal", "G-buffer: octahedral normal, view depth, shininess"),
         tex("base_color", "G-buffer: base colour, metallic"),
         tex("material", "G-buffer: alpha, clothness, vertex AO, cavity"),
-        tex("emissive", "G-buffer: lightmap / emissive"),
+        tex("emissive", "G-buffer: emissive + baked diffuse (a = 1 where lightmapped)"),
         tex("depth", "G-buffer hardware depth (reverse Z)"),
         tex("shadow_map", "shadow.directional's atlas (without it the sun is unshadowed)", true),
         {"cascades", PortKind::Buffer, {}, true, Usage::Sampled, "shadow.directional's cascades"},
         tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
         tex("sky", "A sky node's cubemap (background and mirror reflections)"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
+        tex("volume", "bake.lightmap's irradiance volume (diffuse and specular stand-in for what has no lightmap)", true),
+        {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's `layout` (with `volume`)"},
     };
     OutputPort color;
     color.name = "color";
@@ -38,8 +43,8 @@ NodeSchema schema() {
     s.outputs = {color, spec};
     s.params = {
         {"sky_ambient", ParamType::Float, 0.15, 0.0, 1.0, {},
-         "Fraction of the open sky's ambient that reaches interior surfaces (a stand-in for occlusion until lightmaps "
-         "and probes exist)"},
+         "Fraction of the open sky's ambient that reaches surfaces with neither a lightmap nor the irradiance volume "
+         "(a stand-in for occlusion)"},
         {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows (off: the sun reaches everything)"},
         {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
         {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of the emissive channel"},
@@ -54,6 +59,9 @@ public:
         if (ctx.hasInput("cascades")) mCascades = ctx.objectAs<ShadowCascadesObject>("cascades");
         if (ctx.hasInput("shadow_map") != ctx.hasInput("cascades"))
             ctx.failParam("shadows", "connect both shadow_map and cascades of a shadow.directional node, or neither");
+        if (ctx.hasInput("volume") != ctx.hasInput("baked"))
+            ctx.failParam("sky_ambient", "connect both volume and baked (bake.lightmap's volume and layout), or neither");
+        if (ctx.hasInput("baked")) mBaked = ctx.objectAs<BakedLightingObject>("baked");
         mPipeline = ctx.computePipeline("lighting/deferred.comp");
     }
 
@@ -67,6 +75,10 @@ public:
         u.params = {p.getFloat("sky_ambient"), shadows ? 1.0f : 0.0f, p.getFloat("sun_scale"), p.getFloat("emissive_scale")};
         if (mCascades) u.shadow = mCascades->data;
         else u.shadow.params = {1.0f, 1.0f, 0.0f, 0.0f};
+        if (mBaked) {
+            u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
+            u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
+        }
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("color").desc();
         ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
@@ -75,6 +87,7 @@ public:
 private:
     std::shared_ptr<CameraObject> mCamera;
     std::shared_ptr<ShadowCascadesObject> mCascades;
+    std::shared_ptr<BakedLightingObject> mBaked;
     PipelineId mPipeline = 0;
 };
 

@@ -2,7 +2,6 @@
 #include "shaders/render/pathtrace.h"
 #include "core/accel/gpu_bvh.hpp"
 #include "core/gpu/context.hpp"
-#include "core/gpu/vk_check.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
 
@@ -128,7 +127,7 @@ public:
     void execute(ExecuteContext& ctx) override {
         GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
         GpuBvh& bvh = mScene->bvh(ctx.gpu());
-        if (!mGeometrySet) createGeometrySet(ctx.gpu(), gpu);
+        const StorageBufferSet& geometry = gpu.geometrySet();
 
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
@@ -146,8 +145,8 @@ public:
         const uint32_t seed = static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu;
         const uint32_t spp = static_cast<uint32_t>(p.getInt("spp"));
         const ImageDesc& out = ctx.output("color").desc();
-        std::array<VkDescriptorSetLayout, 3> layouts = {bvh.setLayout(), gpu.setLayout(), mGeometryLayout};
-        std::array<VkDescriptorSet, 3> sets = {bvh.set(), gpu.set(), mGeometrySet};
+        std::array<VkDescriptorSetLayout, 3> layouts = {bvh.setLayout(), gpu.setLayout(), geometry.layout()};
+        std::array<VkDescriptorSet, 3> sets = {bvh.set(), gpu.set(), geometry.set()};
         for (uint32_t done = 0, chunk = 0; done < spp; ++chunk) {
             const uint32_t count = std::min(PATHTRACE_SAMPLES_PER_DISPATCH, spp - done);
             push.counts = {count, static_cast<uint32_t>(p.getInt("max_bounces")),
@@ -159,69 +158,11 @@ public:
         }
     }
 
-    void releaseGpu() override {
-        if (!mContext) return;
-        VkDevice device = mContext->device();
-        VkDescriptorPool pool = mPool;
-        VkDescriptorSetLayout layout = mGeometryLayout;
-        mContext->destroyLater([device, pool, layout] {
-            vkDestroyDescriptorPool(device, pool, nullptr);
-            vkDestroyDescriptorSetLayout(device, layout, nullptr);
-        });
-        mPool = VK_NULL_HANDLE;
-        mGeometryLayout = VK_NULL_HANDLE;
-        mGeometrySet = VK_NULL_HANDLE;
-        mContext = nullptr;
-    }
-    ~Pathtrace() override { releaseGpu(); }
-
 private:
-    // Set 3 of the shader (shaders/pathtrace/surface.glsl): the scene's vertex and index buffers.
-    void createGeometrySet(Context& context, const GpuScene& gpu) {
-        mContext = &context;
-        VkDevice device = context.device();
-        VkDescriptorSetLayoutBinding b[2] = {
-            {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-            {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-        };
-        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-        li.bindingCount = 2;
-        li.pBindings = b;
-        VK_CHECK(vkCreateDescriptorSetLayout(device, &li, nullptr, &mGeometryLayout));
-        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2};
-        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-        pi.maxSets = 1;
-        pi.poolSizeCount = 1;
-        pi.pPoolSizes = &size;
-        VK_CHECK(vkCreateDescriptorPool(device, &pi, nullptr, &mPool));
-        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-        ai.descriptorPool = mPool;
-        ai.descriptorSetCount = 1;
-        ai.pSetLayouts = &mGeometryLayout;
-        VK_CHECK(vkAllocateDescriptorSets(device, &ai, &mGeometrySet));
-        VkDescriptorBufferInfo infos[2] = {{gpu.vertexBuffer().buffer(), 0, VK_WHOLE_SIZE},
-                                           {gpu.indexBuffer().buffer(), 0, VK_WHOLE_SIZE}};
-        VkWriteDescriptorSet writes[2];
-        for (uint32_t i = 0; i < 2; ++i) {
-            writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-            writes[i].dstSet = mGeometrySet;
-            writes[i].dstBinding = i;
-            writes[i].descriptorCount = 1;
-            writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-            writes[i].pBufferInfo = &infos[i];
-        }
-        vkUpdateDescriptorSets(device, 2, writes, 0, nullptr);
-        context.setName(reinterpret_cast<uint64_t>(mGeometrySet), VK_OBJECT_TYPE_DESCRIPTOR_SET, "pathtrace.geometry");
-    }
-
     std::shared_ptr<SceneObject> mScene;
     std::shared_ptr<CameraObject> mCamera;
     PipelineId mPipeline = 0;
     glm::mat4 mLastViewProj{0.0f};
-    Context* mContext = nullptr;
-    VkDescriptorSetLayout mGeometryLayout = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
-    VkDescriptorSet mGeometrySet = VK_NULL_HANDLE;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Pathtrace>(); });

@@ -19,9 +19,15 @@ layout(location = 0) out vec4 outNormal;   // octahedral normal xy, linear view 
 layout(location = 1) out vec4 outBase;     // base colour rgb, metallic
 layout(location = 2) out vec4 outMaterial; // base colour alpha, clothness (reserved), vertex AO, cavity
 layout(location = 3) out vec2 outVelocity; // pixels, current minus previous position
-layout(location = 4) out vec3 outEmissive; // lightmap or emissive radiance
+layout(location = 4) out vec4 outEmissive; // rgb: emissive + baked diffuse radiance; a: 1 where lightmapped
+
+#ifdef VITRINE_GBUFFER_LIGHTMAP
+// bake.lightmap's irradiance atlas (lux); draw.lightmap maps uv1 into this instance's region.
+layout(set = 1, binding = 0) uniform sampler2D lightmapAtlas;
+#endif
 
 #define FLAG_TOKSVIG 1u
+#define FLAG_LIGHTMAP 2u
 
 void main() {
     UvGradients grads = uvGradients(vUv0, vUv1);
@@ -52,9 +58,23 @@ void main() {
     vec3 emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) emissive *= sampleRef(m.emissiveRef, vUv0, vUv1, grads).rgb;
 
+    vec3 baseColor = s.albedo.rgb * vColor.rgb;
+    float metallic = clamp(s.metallic, 0.0, 1.0);
+    float cavity = clamp(s.cavity, 0.0, 1.0);
+    float lightmapped = 0.0;
+#ifdef VITRINE_GBUFFER_LIGHTMAP
+    if ((draw.flags & FLAG_LIGHTMAP) != 0u) {
+        // The baked diffuse (MUSEUM_SPEC §3): irradiance x Lambert, darkened by the cavity map the texels are
+        // too coarse to see. lighting.deferred adds it instead of its ambient stand-ins.
+        vec3 irradiance = textureLod(lightmapAtlas, vUv1 * draw.lightmap.xy + draw.lightmap.zw, 0.0).rgb;
+        emissive += diffuseAlbedo(baseColor, metallic) * irradiance / kPi * cavity;
+        lightmapped = 1.0;
+    }
+#endif
+
     outNormal = vec4(octEncode(N), vViewDepth, shininess);
-    outBase = vec4(s.albedo.rgb * vColor.rgb, clamp(s.metallic, 0.0, 1.0));
-    outMaterial = vec4(coverage, 0.0, vColor.a, clamp(s.cavity, 0.0, 1.0));
+    outBase = vec4(baseColor, metallic);
+    outMaterial = vec4(coverage, 0.0, vColor.a, cavity);
     outVelocity = velocity;
-    outEmissive = emissive;
+    outEmissive = vec4(emissive, lightmapped);
 }

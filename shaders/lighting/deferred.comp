@@ -4,10 +4,16 @@
 #include "common/brdf.glsl"
 #include "common/octahedral.glsl"
 #include "common/sh.glsl"
+#include "bake/irradiance_volume.glsl"
 
-// Deferred sun + sky lighting (MUSEUM_SPEC §1, §3): Cook-Torrance GGX/Smith/Schlick + Lambert for the
-// sun with cascaded PCF shadows; diffuse ambient from the sky's SH irradiance; indirect specular from
-// the sky (stand-in until IBL); cavity and vertex AO on the ambient terms; emissive added.
+// Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance GGX/Smith/Schlick + Lambert for the sun with
+// cascaded PCF shadows, then the indirect light:
+//   - lightmapped pixels (G-buffer emissive a = 1) carry their baked diffuse in the emissive channel;
+//   - others take diffuse from bake.lightmap's irradiance volume when it is connected;
+//   - without either, the open sky's SH irradiance scaled by `sky_ambient` stands in;
+// indirect specular: the volume's SH radiance along the mirror direction where there is a volume (the room's
+// own light, until IBL probes), else the sky blurred towards its SH by roughness. Cavity and vertex AO
+// darken the ambient terms; emissive is added.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_normal;
 layout(binding = 1) uniform sampler2D in_base_color;
@@ -20,6 +26,7 @@ layout(binding = 7) uniform samplerCube in_sky;
 layout(binding = 8) writeonly uniform image2D out_color;
 layout(binding = 9) writeonly uniform image2D out_specular_indirect;
 layout(binding = 10) uniform Uniforms { DeferredUniforms u; };
+layout(binding = 11) uniform sampler2D in_volume;
 
 const float kHalfMax = 60000.0; // keep the RGBA16F output finite (sun glints on mirrors)
 
@@ -78,7 +85,9 @@ void main() {
     vec4 g0 = texelFetch(in_normal, p, 0);
     vec4 g1 = texelFetch(in_base_color, p, 0);
     vec4 g2 = texelFetch(in_material, p, 0);
-    vec3 emissive = texelFetch(in_emissive, p, 0).rgb;
+    vec4 emissiveLm = texelFetch(in_emissive, p, 0);
+    vec3 emissive = emissiveLm.rgb;
+    bool lightmapped = emissiveLm.a > 0.5;
     vec3 n = octDecode(g0.xy);
     float viewDepth = g0.z;
     float roughness = roughnessFromShininess(g0.w);
@@ -96,13 +105,19 @@ void main() {
     float visibility = u.params.y > 0.5 ? sunVisibility(world, n, viewDepth) : 1.0;
     vec3 direct = shadeDirectional(n, v, l, baseColor, metallic, roughness, sunE / kPi) * visibility * cavity;
 
-    // Ambient from the sky: SH irradiance (diffuse) and the sky along the mirror direction blurred
-    // towards the SH radiance with roughness (specular), both scaled by the stand-in occlusion.
+    // Indirect light: baked (lightmap in the emissive channel, or the irradiance volume), else the sky's SH
+    // irradiance and the sky along the mirror direction blurred towards its SH radiance with roughness, both
+    // scaled by the stand-in occlusion.
     float NoV = clamp(dot(n, v), 1e-4, 1.0);
-    float occlusion = u.params.x * vertexAo * cavity;
-    vec3 diffuse = diffuseAlbedo(baseColor, metallic) * max(shIrradiance(sh, n), vec3(0.0)) / kPi * occlusion;
     vec3 r = reflect(-v, n);
-    vec3 skyR = mix(textureLod(in_sky, r, 0.0).rgb, max(shRadiance(sh, r), vec3(0.0)), clamp(roughness * 2.0, 0.0, 1.0));
+    vec3 volume[9];
+    bool baked = volumeSh(in_volume, u.volumeOrigin, u.volumeCounts.xyz, world, n, volume);
+    float occlusion = baked ? vertexAo * cavity : u.params.x * vertexAo * cavity;
+    vec3 diffuse = vec3(0.0);
+    if (!lightmapped)
+        diffuse = diffuseAlbedo(baseColor, metallic) * max(shIrradiance(baked ? volume : sh, n), vec3(0.0)) / kPi * occlusion;
+    vec3 skyR = baked ? max(shRadiance(volume, r), vec3(0.0))
+                      : mix(textureLod(in_sky, r, 0.0).rgb, max(shRadiance(sh, r), vec3(0.0)), clamp(roughness * 2.0, 0.0, 1.0));
     // Karis' analytic fit of the split-sum environment BRDF (mobile approximation).
     vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
     vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);

@@ -12,11 +12,13 @@ struct DeferredUniforms {
     mat4 invViewProj;  // jittered, as the G-buffer was rasterised
     vec4 cameraPos;    // world
     vec4 params;       // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
+    vec4 volumeOrigin; // bake.lightmap's irradiance volume: xyz probe (0, 0, 0), w spacing (m)
+    uvec4 volumeCounts; // xyz probes per axis (0: no volume connected)
     ShadowCascades shadow;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(DeferredUniforms) == 64 + 32 + sizeof(ShadowCascades));
+static_assert(sizeof(DeferredUniforms) == 64 + 64 + sizeof(ShadowCascades));
 }
 #endif
 #endif

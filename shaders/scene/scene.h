@@ -74,6 +74,7 @@ VITRINE_PUSH_BEGIN(SceneDrawPush)
     uint material;  // index into the material buffer
     uint flags;
     uint pad;
+    vec4 lightmap;  // where the instance's lightmap lies in the atlas: atlas uv = uv1 * xy + zw
 VITRINE_PUSH_END(draw)
 #endif
 
@@ -83,7 +84,7 @@ static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
 static_assert(sizeof(GpuMaterial) == 32 + 48);
 static_assert(sizeof(GpuInstance) == 192);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
-static_assert(sizeof(SceneDrawPush) == 80);
+static_assert(sizeof(SceneDrawPush) == 96);
 }
 #endif
 #endif

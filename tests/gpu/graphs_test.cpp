@@ -4,6 +4,8 @@
 // the source tree when the test binary starts, so a new graph is covered without touching this file.
 #include "tests/gpu/gpu_test.hpp"
 
+#include "core/graph/loader.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -27,7 +29,13 @@ class ShippedGraph : public GpuTest, public ::testing::WithParamInterface<std::s
 
 TEST_P(ShippedGraph, ValidatesAndRunsAtPreviewSize) {
     const fs::path file = fs::path(VITRINE_SOURCE_DIR) / "graphs" / GetParam();
-    const auto outputs = runGraphFile(file.string(), {"frame.width=64", "frame.height=36"});
+    std::vector<std::string> sets = {"frame.width=64", "frame.height=36"};
+    // Bakes at preview quality too (the shipped quality is measured by the golden and bake tests).
+    for (const auto& [id, node] : loadGraphDocument(file)["nodes"].items())
+        if (node.value("type", "") == "bake.lightmap")
+            for (const char* p : {".params.samples=2", ".params.texels_per_meter=1", ".params.probe_spacing=10"})
+                sets.push_back(id + p);
+    const auto outputs = runGraphFile(file.string(), sets);
     ASSERT_FALSE(outputs.empty()) << file;
     for (const auto& [name, image] : outputs) {
         EXPECT_EQ(image.width, 64) << name;

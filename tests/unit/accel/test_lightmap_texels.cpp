@@ -1,6 +1,6 @@
 // CPU passes over a baked lightmap (core/bake/lightmap_texels): E5B9G9R9 packing against values worked out by
 // hand from the Vulkan specification's shared-exponent algorithm, dilation into gutters, and the edge-aware
-// filter (constants preserved, noise reduced, no mixing across regions, creases or distant surfaces).
+// filter (constants preserved, noise reduced, no mixing across regions, creases, parallel surfaces or chart seams).
 #include "core/bake/lightmap_texels.hpp"
 
 #include <gtest/gtest.h>
@@ -105,7 +105,7 @@ TEST(LightmapTexels, FilterKeepsConstantsAndReducesNoise) {
 
 TEST(LightmapTexels, FilterDoesNotMixRegionsCreasesOrDistantSurfaces) {
     // Left half and right half of a 16x8 atlas, 1 and 10.
-    for (int kind = 0; kind < 3; ++kind) {
+    for (int kind = 0; kind < 4; ++kind) {
         LightmapTexels t = flat(16, 8);
         for (uint32_t y = 0; y < 8; ++y)
             for (uint32_t x = 0; x < 16; ++x) {
@@ -115,8 +115,11 @@ TEST(LightmapTexels, FilterDoesNotMixRegionsCreasesOrDistantSurfaces) {
                 t.region[i] = (kind == 0 && right) ? 1 : 0;           // 0: two regions
                 if (kind == 1 && right) t.normal[i] = glm::vec3(1, 0, 0); // 1: a 90-degree crease
                 if (kind == 2 && right) t.position[i].y += 5.0f;      // 2: a parallel surface 5 m away
+                if (kind == 3 && right) t.position[i].x += 10.0f;     // 3: the same plane 10 m on (a chart seam)
             }
-        filterLightmap(t);
+        LightmapFilterOptions options;
+        options.texelSize = 0.05f;
+        filterLightmap(t, options);
         for (uint32_t y = 0; y < 8; ++y)
             for (uint32_t x = 0; x < 16; ++x)
                 ASSERT_NEAR(t.irradiance[t.index(x, y)].x, x >= 8 ? 10.0f : 1.0f, 1e-3f)

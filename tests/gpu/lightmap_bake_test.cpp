@@ -1,0 +1,313 @@
+// bake.lightmap against answers it does not compute itself:
+//   - a floor beside a long wall under a uniform sky with a black wall: every floor point sees the sky except
+//     the wall, E(d) = pi C (1 - F(d)), with F(d) = (1 - d / sqrt(d^2 + h^2)) / 2 the view factor from a point
+//     at distance d to an infinitely long wall of height h;
+//   - the same floor, black, with a sunlit white wall and no sky: the wall is a uniform Lambert emitter of
+//     radiance a E_sun cos(theta) / pi, so E(d) = a E_sun cos(theta) F(d) (the texel's own direct sun is left
+//     to the frame, and a black floor returns nothing to the wall);
+//   - the museum: no NaN or Inf anywhere, no black texel where the sun reaches the surface (the CPU BVH says
+//     which), gutters dilated; a second run loads the cache instead of baking; a damaged cache file is baked
+//     again;
+//   - the museum frame with lightmaps against the path-traced reference: where the light falls (the mean
+//     luminance of each block of an 8 x 4 grid over the image, in log units) is nearer the reference's than
+//     without them.
+#include "tests/gpu/lighting_scene.hpp"
+
+#include "core/accel/scene_bvh.hpp"
+#include "core/accel/traverse.hpp"
+#include "core/bake/lightmap_atlas.hpp"
+#include "core/bake/lightmap_raster.hpp"
+#include "core/graph/loader.hpp"
+#include "core/image/io.hpp"
+#include "core/scene/gltf.hpp"
+#include "core/scene/gpu_scene.hpp"
+#include "core/scene/museum.hpp"
+#include "core/shader/compiler.hpp"
+#include "shaders/sky/sky.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <cstdlib>
+#include <functional>
+#include <optional>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+using namespace lighting;
+namespace fs = std::filesystem;
+
+class LightmapBake : public GpuTest {};
+
+// Sets an environment variable for a scope (the bake cache's folder).
+class ScopedEnv {
+public:
+    ScopedEnv(const char* name, const std::string& value) : mName(name) {
+        if (const char* old = std::getenv(name)) mOld = old;
+        setenv(name, value.c_str(), 1);
+    }
+    ~ScopedEnv() {
+        if (mOld) setenv(mName, mOld->c_str(), 1);
+        else unsetenv(mName);
+    }
+
+private:
+    const char* mName;
+    std::optional<std::string> mOld;
+};
+
+constexpr float kFloor = 8.0f;     // the floor spans x in [0, 8], z in [-4, 4]
+constexpr float kWallHeight = 2.0f; // the wall's face is the plane x = 0, y in [0, 2], z in [-100, 100]
+constexpr float kTexelsPerMeter = 4.0f;
+
+// A lightmapped floor (uv1 = (x / 8, (z + 4) / 8)) beside a long wall without lightmap UVs.
+fs::path floorAndWall(const std::string& name, glm::vec3 floorBase, float floorMetallic, glm::vec3 wallBase,
+                      float wallMetallic, glm::vec3 toSun) {
+    SceneBuilder b(name);
+    std::vector<Tri> floor;
+    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
+    for (Tri& t : floor)
+        for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
+    const uint32_t floorMesh = b.mesh("floor", floor, b.material("floor", floorBase, floorMetallic, 0.0f));
+    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
+    b.node("floor", static_cast<int32_t>(floorMesh));
+    const uint32_t wall = b.mesh("wall", boxTris({0.1f, kWallHeight / 2, 100.0f}), b.material("wall", wallBase, wallMetallic, 0.0f));
+    b.node("wall", static_cast<int32_t>(wall), {-0.1f, kWallHeight / 2, 0.0f});
+    b.camera({4.0f, 3.0f, 6.0f}, {4.0f, 0.0f, 0.0f}, 0.9f);
+    b.sun(toSun);
+    return b.write();
+}
+
+json uniformSky(const fs::path& glb, double c) {
+    Image sky(32, 16);
+    for (float& v : sky.pixels) v = 1.0f;
+    const auto file = glb.parent_path() / (glb.stem().string() + "_sky.exr");
+    writeExr(file, sky, ExrPixelType::Float);
+    return {{"type", "sky.hdri"}, {"params", {{"path", file.string()}, {"intensity", c}, {"size", 16}}}};
+}
+
+json bakeGraph(const fs::path& glb, json sky, json params) {
+    params["texels_per_meter"] = kTexelsPerMeter;
+    params["probe_spacing"] = 100.0;
+    params["probe_rays"] = 16;
+    params["cache"] = false; // always this build's integrator, never an earlier build's file
+    json nodes = {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}}}}},
+                  {"sky", sky},
+                  {"bake", {{"type", "bake.lightmap"},
+                            {"in", {{"scene", "scene.scene"}, {"sky", "sky.cubemap"}, {"sky_sh", "sky.sh"}}},
+                            {"params", params}}}};
+    return graph(nodes, {{"lightmap", "bake.lightmap"}, {"volume", "bake.volume"}, {"sh", "sky.sh"}}, 16, 16);
+}
+
+// The floor's region in the atlas the node planned (the same plan, from the same loaded scene).
+bake::LightmapRegion floorRegion(const fs::path& glb) {
+    const scene::Scene s = scene::loadGltf(glb);
+    bake::LightmapAtlasOptions o;
+    o.texelsPerMeter = kTexelsPerMeter;
+    const bake::LightmapAtlas atlas = bake::planLightmapAtlas(s, o);
+    EXPECT_EQ(atlas.regions.size(), 1u);
+    return atlas.regions.at(0);
+}
+
+double viewFactorToWall(double d) { return 0.5 * (1.0 - d / std::sqrt(d * d + kWallHeight * kWallHeight)); }
+
+// Mean baked irradiance (red) of each texel column of the floor's region against expected(d), d the
+// distance of the column's texel centres from the wall, for d in [0.5, dMax] m: each column within
+// `tolerance`, their sum within `totalTolerance`.
+void expectProfile(const Image& lightmap, const bake::LightmapRegion& r, const std::function<double(double)>& expected,
+                   double tolerance, double totalTolerance, double dMax = kFloor - 0.5) {
+    double worst = 0.0, total = 0.0, totalExpected = 0.0;
+    int columns = 0;
+    for (uint32_t i = 0; i < r.size; ++i) {
+        // Texel centre -> uv1 through the region's scale and offset -> x = 8 u.
+        const double atlasU = (r.x + i + 0.5) / lightmap.width;
+        const double d = (atlasU - r.scaleOffset.z) / r.scaleOffset.x * kFloor;
+        if (d < 0.5 || d > dMax) continue;
+        double sum = 0.0;
+        for (uint32_t j = 0; j < r.size; ++j) sum += lightmap.at(int(r.x + i), int(r.y + j))[0];
+        const double mean = sum / r.size, want = expected(d);
+        const double e = std::abs(mean / want - 1.0);
+        worst = std::max(worst, e);
+        EXPECT_LT(e, tolerance) << "d = " << d << " m: baked " << mean << " lux, expected " << want;
+        total += mean;
+        totalExpected += want;
+        ++columns;
+    }
+    const double totalError = std::abs(total / totalExpected - 1.0);
+    std::printf("  %d columns, worst relative error %.4f, of the sum %.4f\n", columns, worst, totalError);
+    EXPECT_LT(totalError, totalTolerance);
+    EXPECT_GE(columns, 10);
+}
+
+TEST_F(LightmapBake, SkyLightBesideABlackWallFollowsTheViewFactor) {
+    const double C = 1000.0;
+    const fs::path glb = floorAndWall("bake_sky_wall", glm::vec3(0.5f), 0.0f, glm::vec3(0.0f), 1.0f, {0.3f, 1.0f, 0.2f});
+    const bake::LightmapRegion r = floorRegion(glb);
+    // Raw with many samples (the integrator), then the node's defaults: few samples and the filter, which
+    // must remove the noise without flattening the contact gradient near the wall.
+    for (auto [samples, iterations, tolerance, totalTolerance] :
+         {std::tuple{256, 0, 0.02, 0.01}, std::tuple{16, 4, 0.05, 0.03}}) {
+        SCOPED_TRACE("filter iterations " + std::to_string(iterations));
+        auto out = runGraph(bakeGraph(glb, uniformSky(glb, C),
+                                      {{"samples", samples}, {"sun_scale", 0.0}, {"filter_iterations", iterations}}));
+        std::printf("sky beside a black wall, %d samples, filter %d:\n", samples, iterations);
+        expectProfile(out.at("lightmap"), r, [&](double d) { return kPi * C * (1.0 - viewFactorToWall(d)); }, tolerance,
+                      totalTolerance);
+        // The gutter ring around the region holds its border's values (dilation): nothing black.
+        const Image& lm = out.at("lightmap");
+        for (uint32_t i = 0; i < r.size; ++i) {
+            EXPECT_GT(lm.at(int(r.x + i), int(r.y) - 1)[0], 0.3 * kPi * C) << "gutter above column " << i;
+            EXPECT_GT(lm.at(int(r.x + i), int(r.y + r.size))[0], 0.3 * kPi * C) << "gutter below column " << i;
+        }
+    }
+}
+
+TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
+    const glm::vec3 wallBase(0.5f);
+    const fs::path glb = floorAndWall("bake_sun_wall", glm::vec3(0.0f), 1.0f, wallBase, 0.0f, {1.0f, 1.0f, 0.3f});
+    const bake::LightmapRegion r = floorRegion(glb);
+    json sky = {{"type", "sky.procedural"}, {"in", {{"scene", "scene.scene"}}}, {"params", {{"size", 16}, {"sun_in_cubemap", false}}}};
+    auto out = runGraph(bakeGraph(glb, sky, {{"samples", 1024}, {"sky_scale", 0.0}, {"filter_iterations", 0}}));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
+    const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    // The bake's albedo-only material: diffuse albedo + F0 (0.5 + 0.04 for a white-ish dielectric).
+    const double albedo = wallBase.r + 0.04;
+    const double cosine = glm::dot(toSun, glm::dvec3(1, 0, 0));
+    ASSERT_GT(cosine, 0.3);
+    std::printf("sun off a white wall (E_sun %.0f lux, cos %.3f):\n", sunE.r, cosine);
+    // Few paths find the wall far from it (F = 0.11 at 3 m): columns to 3 m, each within 6 %, their sum 2 %.
+    expectProfile(out.at("lightmap"), r, [&](double d) { return albedo * sunE.r * cosine * viewFactorToWall(d); }, 0.06,
+                  0.02, 3.0);
+}
+
+// Builds the museum as scene.museum does with these params, and its lightmap texels as the bake saw them.
+struct MuseumTexels {
+    scene::Scene scene;
+    bake::LightmapAtlas atlas;
+    bake::LightmapTexels texels;
+};
+
+TEST_F(LightmapBake, MuseumBakeIsFiniteLitWhereTheSunIsAndCached) {
+    const float tpm = 2.0f;
+    json nodes = {{"scene", {{"type", "scene.museum"}, {"params", {{"texture_size", 64}, {"camera", "static"}}}}},
+                  {"sky", {{"type", "sky.procedural"}, {"in", {{"scene", "scene.scene"}}}, {"params", {{"size", 16}, {"sun_in_cubemap", false}}}}},
+                  {"bake", {{"type", "bake.lightmap"},
+                            {"in", {{"scene", "scene.scene"}, {"sky", "sky.cubemap"}, {"sky_sh", "sky.sh"}}},
+                            {"params", {{"samples", 4}, {"texels_per_meter", tpm}, {"probe_spacing", 6.0}, {"probe_rays", 16}}}}}};
+    const json g = graph(nodes, {{"lightmap", "bake.lightmap"}, {"volume", "bake.volume"}, {"sh", "sky.sh"}}, 16, 16);
+
+    // A cache of its own, so the first run bakes.
+    const fs::path cacheDir = fs::path(VITRINE_TEST_OUT) / "museum_bake_cache";
+    fs::remove_all(cacheDir);
+    ScopedEnv env("VITRINE_CACHE_DIR", cacheDir.string());
+    auto first = runGraph(g);
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(cacheDir / "bake" / "lightmap")) files.push_back(e.path());
+    ASSERT_EQ(files.size(), 1u) << "the bake is stored once";
+    const auto stamp = fs::last_write_time(files[0]);
+
+    // Every texel and probe finite.
+    for (const char* name : {"lightmap", "volume"})
+        for (float v : first.at(name).pixels) ASSERT_TRUE(std::isfinite(v)) << name;
+
+    // The texels the bake integrated, and the sun's visibility at each from the CPU BVH.
+    scene::MuseumOptions mo;
+    mo.textureSize = 64;
+    const scene::Scene s = scene::buildMuseum(mo);
+    bake::LightmapAtlasOptions ao;
+    ao.texelsPerMeter = tpm;
+    const bake::LightmapAtlas atlas = bake::planLightmapAtlas(s, ao);
+    ASSERT_EQ(first.at("lightmap").width, int(atlas.width));
+    ShaderCompiler shaders;
+    GpuScene gpuScene(gpu(), shaders, s);
+    const scene::ScenePose pose = s.evaluate(0.0);
+    gpuScene.update(pose, pose, CameraFrame{});
+    const bake::LightmapTexels t = bake::rasterizeLightmapTexels(gpu(), shaders, gpuScene, s, atlas);
+    const accel::SceneBvh bvh = accel::SceneBvh::build(s);
+    const auto top = bvh.topLevel(pose);
+    const glm::vec3 toSun = glm::normalize(glm::vec3(rgb(first.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0)));
+    size_t covered = 0, sunlit = 0, blackSunlit = 0;
+    for (uint32_t y = 0; y < t.height; ++y)
+        for (uint32_t x = 0; x < t.width; ++x) {
+            const size_t i = t.index(x, y);
+            if (t.region[i] < 0) continue;
+            ++covered;
+            if (glm::dot(t.normal[i], toSun) < 0.2f) continue;
+            accel::Ray ray;
+            ray.origin = t.position[i] + t.normal[i] * 1e-3f;
+            ray.direction = toSun;
+            if (accel::traceAny(bvh.arrays(), top, ray)) continue;
+            ++sunlit;
+            const float* e = first.at("lightmap").at(int(x), int(y));
+            if (!(e[0] + e[1] + e[2] > 0.0f)) ++blackSunlit;
+        }
+    std::printf("museum bake: %zu covered texels, %zu sunlit, %zu of them black\n", covered, sunlit, blackSunlit);
+    EXPECT_GT(sunlit, 500u);
+    EXPECT_LE(blackSunlit, sunlit / 200) << "more than 0.5 % of the sunlit texels are black";
+
+    // A second run loads the bake: the file is not rewritten and the result is the same.
+    auto second = runGraph(g);
+    EXPECT_EQ(fs::last_write_time(files[0]), stamp) << "the second run baked again";
+    EXPECT_EQ(second.at("lightmap").pixels, first.at("lightmap").pixels);
+    EXPECT_EQ(second.at("volume").pixels, first.at("volume").pixels);
+
+    // A damaged file is not used: the bake runs again (same seeds, same result) and replaces it.
+    fs::resize_file(files[0], fs::file_size(files[0]) / 2);
+    auto third = runGraph(g);
+    EXPECT_EQ(third.at("lightmap").pixels, first.at("lightmap").pixels);
+    EXPECT_GT(fs::file_size(files[0]), 0u);
+    EXPECT_NE(fs::last_write_time(files[0]), stamp);
+}
+
+// Mean luminance of each block of a bx x by grid over the image.
+std::vector<double> blockMeans(const Image& img, int bx, int by) {
+    std::vector<double> means(size_t(bx) * by, 0.0);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.at(x, y);
+            means[size_t(y * by / img.height) * bx + x * bx / img.width] += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        }
+    for (double& m : means) m /= double(img.width / bx) * (img.height / by);
+    return means;
+}
+
+// Mean |log(a / b)| over the blocks: 0 when the light is distributed alike, log 2 when off by a factor 2.
+double logBlockError(const Image& a, const Image& b) {
+    const std::vector<double> ma = blockMeans(a, 8, 4), mb = blockMeans(b, 8, 4);
+    double sum = 0.0;
+    for (size_t i = 0; i < ma.size(); ++i) sum += std::abs(std::log(std::max(ma[i], 1e-6) / std::max(mb[i], 1e-6)));
+    return sum / double(ma.size());
+}
+
+TEST_F(LightmapBake, MuseumLightIsDistributedMoreLikeTheReference) {
+    const fs::path root = fs::path(VITRINE_SOURCE_DIR) / "graphs";
+    // The static shot (the walkthrough's camera moves, so the reference would restart every frame), HDR.
+    const std::vector<std::string> common = {"frame.width=64", "frame.height=36", "scene.params.camera=static",
+                                             "scene.params.texture_size=64"};
+    auto hdr = [&](const std::string& file, std::vector<std::string> sets, const std::string& output) {
+        sets.insert(sets.begin(), common.begin(), common.end());
+        sets.push_back("outputs.hdr=" + output);
+        return runGraphFile((root / file).string(), sets).at("hdr");
+    };
+    const Image gi = hdr("museum.json", {"bake.params.samples=8", "bake.params.texels_per_meter=2"}, "lighting.color");
+    const Image noGi = hdr("variants/museum_no_gi.json", {}, "lighting.color");
+    const Image reference = hdr("variants/museum_reference.json", {"pathtrace.params.spp=64"}, "pathtrace.color");
+    const double eGi = logBlockError(gi, reference), eNoGi = logBlockError(noGi, reference);
+    {
+        const auto a = blockMeans(gi, 8, 4), b = blockMeans(noGi, 8, 4), r = blockMeans(reference, 8, 4);
+        for (int y = 0; y < 4; ++y) {
+            for (int x = 0; x < 8; ++x) std::printf(" %5.2f/%5.2f", a[y * 8 + x] / r[y * 8 + x], b[y * 8 + x] / r[y * 8 + x]);
+            std::printf("\n");
+        }
+    }
+    std::printf("mean |log luminance ratio| to the reference over 8x4 blocks: lightmaps %.4f, without %.4f\n", eGi,
+                eNoGi);
+    EXPECT_LT(eGi, 0.8 * eNoGi) << "the lightmaps must bring the light's distribution nearer the reference";
+    EXPECT_LT(eGi, std::log(1.5)) << "within a factor 1.5 of the reference on average";
+}
+
+} // namespace
+} // namespace vitrine::test
