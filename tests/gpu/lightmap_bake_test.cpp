@@ -5,6 +5,9 @@
 //   - the same floor, black, with a sunlit white wall and no sky: the wall is a uniform Lambert emitter of
 //     radiance a E_sun cos(theta) / pi, so E(d) = a E_sun cos(theta) F(d) (the texel's own direct sun is left
 //     to the frame, and a black floor returns nothing to the wall);
+//   - the floor of a closed box whose walls all emit Le and reflect with albedo rho: radiance is the same
+//     everywhere, Le (1 + rho + ... + rho^n) after n reflections, so E = pi Le sum rho^k (bounces and Russian
+//     roulette, the emissive path);
 //   - the museum: no NaN or Inf anywhere, no black texel where the sun reaches the surface (the CPU BVH says
 //     which), gutters dilated; a second run loads the cache instead of baking; a damaged cache file is baked
 //     again;
@@ -183,6 +186,55 @@ TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
                   0.02, 3.0);
 }
 
+TEST_F(LightmapBake, ClosedEmissiveBoxFollowsTheGeometricSeries) {
+    const float Le = 100.0f, base = 0.5f;
+    SceneBuilder b("bake_emissive_box");
+    const uint32_t material = b.material("glow", glm::vec3(base), 0.0f, 0.0f);
+    b.s.materials[material].emissiveFactor = glm::vec3(1.0f);
+    b.s.materials[material].emissiveStrength = Le;
+    // Five walls facing inwards, and the floor (y = -1) lightmapped on its own.
+    const glm::vec3 half(2.0f, 1.0f, 2.0f);
+    std::vector<Tri> walls, floor;
+    for (int axis = 0; axis < 3; ++axis)
+        for (float sign : {-1.0f, 1.0f}) {
+            glm::vec3 n(0.0f), u(0.0f), v(0.0f);
+            n[axis] = -sign;
+            u[(axis + 1) % 3] = half[(axis + 1) % 3];
+            v[(axis + 2) % 3] = half[(axis + 2) % 3];
+            addQuad(axis == 1 && sign < 0.0f ? floor : walls, sign * half[axis] * glm::vec3(axis == 0, axis == 1, axis == 2), u, v, n);
+        }
+    for (Tri& t : floor)
+        for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->uv1 = {(v->position.x + half.x) / 4.0f, (v->position.z + half.z) / 4.0f};
+    const uint32_t floorMesh = b.mesh("floor", floor, material);
+    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
+    b.node("floor", static_cast<int32_t>(floorMesh));
+    b.node("walls", static_cast<int32_t>(b.mesh("walls", walls, material)));
+    b.camera({0.0f, 0.0f, 0.0f}, {0.0f, -1.0f, 1.0f}, 0.9f);
+    b.sun({0.3f, 1.0f, 0.2f});
+    const fs::path glb = b.write();
+    const bake::LightmapRegion r = floorRegion(glb);
+    const double rho = base + 0.04; // the bake's albedo-only material: diffuse + F0
+    for (int bounces : {1, 4}) {
+        auto out = runGraph(bakeGraph(glb, uniformSky(glb, 1000.0),
+                                      {{"samples", 64}, {"max_bounces", bounces}, {"sun_scale", 0.0}, {"sky_scale", 0.0}}));
+        double series = 0.0;
+        for (int k = 0; k <= bounces; ++k) series += std::pow(rho, k);
+        const double expected = kPi * Le * series;
+        double sum = 0.0, worst = 0.0;
+        for (uint32_t j = 0; j < r.size; ++j)
+            for (uint32_t i = 0; i < r.size; ++i) {
+                const double e = out.at("lightmap").at(int(r.x + i), int(r.y + j))[0];
+                sum += e;
+                worst = std::max(worst, std::abs(e / expected - 1.0));
+            }
+        const double mean = sum / (double(r.size) * r.size);
+        std::printf("emissive box, %d bounces: mean %.1f lux, expected %.1f (worst texel %.3f off)\n", bounces, mean,
+                    expected, worst);
+        EXPECT_NEAR(mean / expected, 1.0, 0.01) << bounces << " bounces";
+        EXPECT_LT(worst, 0.1);
+    }
+}
+
 // Builds the museum as scene.museum does with these params, and its lightmap texels as the bake saw them.
 struct MuseumTexels {
     scene::Scene scene;
@@ -260,6 +312,15 @@ TEST_F(LightmapBake, MuseumBakeIsFiniteLitWhereTheSunIsAndCached) {
     EXPECT_EQ(third.at("lightmap").pixels, first.at("lightmap").pixels);
     EXPECT_GT(fs::file_size(files[0]), 0u);
     EXPECT_NE(fs::last_write_time(files[0]), stamp);
+
+    // Another sky is other lighting: baked anew under another key, with another result.
+    json hazy = g;
+    hazy["nodes"]["sky"]["params"]["turbidity"] = 6.0;
+    auto fourth = runGraph(hazy);
+    size_t stored = 0;
+    for (const auto& e : fs::directory_iterator(cacheDir / "bake" / "lightmap")) stored += e.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(stored, 2u) << "a changed sky must not reuse the bake of the first";
+    EXPECT_NE(fourth.at("lightmap").pixels, first.at("lightmap").pixels);
 }
 
 // Mean luminance of each block of a bx x by grid over the image.
