@@ -1,6 +1,7 @@
 // lighting.deferred: sun (GGX + Lambert, cascaded shadows) and sky ambient over the G-buffer.
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
+#include "nodes/lighting/punctual_lights.hpp"
 #include "nodes/shadow/cascades.hpp"
 #include "shaders/lighting/deferred.h"
 
@@ -11,7 +12,7 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "lighting.deferred";
     s.doc = "Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance (GGX, Smith, Schlick) + Lambert for the sun "
-            "with PCF-filtered cascaded shadows and cavity; diffuse ambient from the sky's SH irradiance and indirect "
+            "with PCF-filtered cascaded shadows and cavity, the scene's point and spot lights unshadowed; diffuse ambient from the sky's SH irradiance and indirect "
             "specular from the sky (stand-ins until lightmaps and IBL), emissive added. Outputs HDR radiance (cd/m²).";
     auto tex = [](const char* name, const char* doc, bool optional = false) {
         return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
@@ -27,6 +28,8 @@ NodeSchema schema() {
         tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
         tex("sky", "A sky node's cubemap (background and mirror reflections)"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
+        {"scene", PortKind::Scene, {}, true, Usage::Sampled,
+         "The scene, for its KHR_lights_punctual point and spot lights (unshadowed); without it only the sun"},
     };
     OutputPort color;
     color.name = "color";
@@ -51,6 +54,10 @@ class Deferred final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         mCamera = ctx.objectAs<CameraObject>("camera");
+        if (ctx.hasInput("scene")) {
+            mScene = ctx.objectAs<SceneObject>("scene");
+            warnLightCount(mScene->scene(), "lighting.deferred");
+        }
         if (ctx.hasInput("cascades")) mCascades = ctx.objectAs<ShadowCascadesObject>("cascades");
         if (ctx.hasInput("shadow_map") != ctx.hasInput("cascades"))
             ctx.failParam("shadows", "connect both shadow_map and cascades of a shadow.directional node, or neither");
@@ -67,6 +74,7 @@ public:
         u.params = {p.getFloat("sky_ambient"), shadows ? 1.0f : 0.0f, p.getFloat("sun_scale"), p.getFloat("emissive_scale")};
         if (mCascades) u.shadow = mCascades->data;
         else u.shadow.params = {1.0f, 1.0f, 0.0f, 0.0f};
+        if (mScene) u.lights = packPunctualLights(*mScene);
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("color").desc();
         ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
@@ -75,6 +83,7 @@ public:
 private:
     std::shared_ptr<CameraObject> mCamera;
     std::shared_ptr<ShadowCascadesObject> mCascades;
+    std::shared_ptr<SceneObject> mScene;
     PipelineId mPipeline = 0;
 };
 

@@ -4,6 +4,7 @@
 #include "scene/scene.glsl"
 #include "common/brdf.glsl"
 #include "common/octahedral.glsl"
+#include "gbuffer/unlit.glsl"
 
 // The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
 layout(location = 0) in vec3 vNormal;
@@ -57,4 +58,5 @@ void main() {
     outMaterial = vec4(coverage, 0.0, vColor.a, clamp(s.cavity, 0.0, 1.0));
     outVelocity = velocity;
     outEmissive = emissive;
+    applyUnlit(m, outBase, outMaterial, outEmissive);
 }

@@ -2,6 +2,7 @@
 #define LIGHTING_DEFERRED_H
 #include "../common/shared.h"
 #include "../shadow/cascades.h"
+#include "lights.h"
 
 #ifdef __cplusplus
 namespace vitrine::gpu_types {
@@ -13,10 +14,11 @@ struct DeferredUniforms {
     vec4 cameraPos;    // world
     vec4 params;       // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
     ShadowCascades shadow;
+    PunctualLights lights; // the scene's point and spot lights (none without a scene input)
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(DeferredUniforms) == 64 + 32 + sizeof(ShadowCascades));
+static_assert(sizeof(DeferredUniforms) == 64 + 32 + sizeof(ShadowCascades) + sizeof(PunctualLights));
 }
 #endif
 #endif
