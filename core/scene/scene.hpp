@@ -59,7 +59,7 @@ struct Vertex {
     // TEXCOORD_1, or (0, 0).
     glm::vec2 uv1{0.0f};
     // rgb: linear vertex colour (glTF COLOR_0, multiplies base colour). a: vertex ambient occlusion,
-    // 1 = unoccluded (glTF attribute _AO). COLOR_0's own alpha is not kept: vitrine has no translucency.
+    // 1 = unoccluded (glTF attribute _AO). COLOR_0's own alpha is not kept: coverage comes from the material only.
     glm::vec4 color{1.0f};
 };
 static_assert(sizeof(Vertex) == 72, "Vertex must stay tightly packed: the GPU side mirrors it");

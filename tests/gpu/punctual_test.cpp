@@ -68,7 +68,10 @@ TEST_F(Punctual, PointAndSpotLightsAndUnlitMatchCpu) {
     nodes["lighting"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", 0.0}}, false);
     nodes["lighting"]["in"]["scene"] = "scene.scene";
     nodes["no_lights"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", 0.0}}, false);
-    auto out = runGraph(graph(nodes, {{"lit", "lighting.color"}, {"dark", "no_lights.color"}}, W, H));
+    auto out = runGraph(graph(
+        nodes,
+        {{"lit", "lighting.color"}, {"dark", "no_lights.color"}, {"base", "gbuffer.base_color"}, {"mat", "gbuffer.material"}},
+        W, H));
 
     Pinhole cam(b.s, W, H);
     int wallPixels = 0, unlitPixels = 0, spotPixels = 0, beyondRange = 0;
@@ -85,6 +88,9 @@ TEST_F(Punctual, PointAndSpotLightsAndUnlitMatchCpu) {
                 double e = relErr(got, glm::dvec3(unlitColor));
                 worstUnlit = std::max(worstUnlit, e);
                 EXPECT_LT(e, 0.016) << "unlit pixel " << x << "," << y << ": " << got.r << " vs " << unlitColor.r;
+                // No light term may add to it, whatever scales with base colour or cavity (lightmaps too): both zero.
+                EXPECT_EQ(rgb(out.at("base"), x, y), glm::dvec3(0.0)) << "unlit base colour, " << x << "," << y;
+                EXPECT_EQ(out.at("mat").at(x, y)[3], 0.0f) << "unlit cavity, " << x << "," << y;
                 ++unlitPixels;
                 continue;
             }
