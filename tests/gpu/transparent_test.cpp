@@ -311,5 +311,66 @@ TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
     EXPECT_GT(brightest, 2.0 * darkest); // the lights and the shadow make the quad far from uniform
 }
 
+// A closed double-sided BLEND box (alpha 0.5) seen face on, lit by a point light just in front of it: its far face
+// (seen from inside, a back face) is drawn before its near face, so out = a L_near + (1 − a)(a L_far + (1 − a) bg),
+// the two radiances by core/shading's BRDF and the inverse square law (the far face is three times further from the
+// lamp). Drawing the faces in index order would swap them.
+TEST_F(Transparent, ClosedDoubleSidedBoxBlendsItsFarFaceFirst) {
+    const int W = 64, H = 64;
+    const glm::vec3 color(0.3f, 0.6f, 0.9f);
+    const float alpha = 0.5f, shininess = 0.4f, intensity = 3.0f;
+    const glm::dvec3 lamp(0.0, 0.0, 1.0);
+    SceneBuilder b("blend_box");
+    std::vector<Tri> wall;
+    addQuad(wall, glm::vec3(0, 0, -2), glm::vec3(4, 0, 0), glm::vec3(0, 4, 0), glm::vec3(0, 0, 1));
+    uint32_t wm = b.material("wall", {0.5f, 0.5f, 0.5f}, 0.0f, 0.3f);
+    b.s.materials[wm].unlit = true;
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, wm)));
+    uint32_t m = b.material("box", color, 0.0f, shininess);
+    blend(b, m, alpha).doubleSided = true;
+    b.node("box", static_cast<int32_t>(b.mesh("box", boxTris(glm::vec3(0.5f)), m)));
+    scene::PunctualLight light;
+    light.intensity = intensity;
+    b.node("lamp", -1, glm::vec3(lamp));
+    light.node = static_cast<uint32_t>(b.s.nodes.size() - 1);
+    b.s.lights = {light};
+    b.camera({0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+    json params = {{"sky_ambient", 0.0}, {"sun_scale", 0.0}};
+    auto out = runGraph(
+        graph(pipeline(b.write(), params, params), {{"out", "transparent.color"}, {"bg", "lighting.color"}}, W, H));
+    Pinhole cam(b.s, W, H);
+    auto lit = [&](glm::dvec3 p, glm::dvec3 d) {
+        glm::dvec3 l = lamp - p;
+        double dist2 = glm::dot(l, l);
+        return glm::dvec3(shading::brdfCosine(glm::vec3(0, 0, 1), glm::vec3(-d), glm::vec3(glm::normalize(l)), color,
+                                              0.0f, shading::roughnessFromShininess(shininess))) *
+               (intensity / dist2);
+    };
+    int n = 0;
+    double worst = 0.0, contrast = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            // Through the near face (z = 0.5) and out of the far one (z = -0.5), away from the side faces.
+            if (!hitsQuad(cam.position, d, 0.5, 0.0, 0.5, 0.05) || !hitsQuad(cam.position, d, -0.5, 0.0, 0.5, 0.05))
+                continue;
+            glm::dvec3 pn = cam.position + (0.5 - cam.position.z) / d.z * d;
+            glm::dvec3 pf = cam.position + (-0.5 - cam.position.z) / d.z * d;
+            glm::dvec3 ln = lit(pn, d), lf = lit(pf, d);
+            glm::dvec3 expected =
+                double(alpha) * ln + (1.0 - alpha) * (double(alpha) * lf + (1.0 - alpha) * rgb(out.at("bg"), x, y));
+            double e = relErr(rgb(out.at("out"), x, y), expected);
+            worst = std::max(worst, e);
+            contrast = std::max(contrast, ln.g / lf.g);
+            EXPECT_LT(e, 0.01) << "pixel " << x << "," << y << ": " << rgb(out.at("out"), x, y).g << " vs "
+                               << expected.g;
+            ++n;
+        }
+    std::printf("closed box: %d pixels through both faces, max relative error %.2g (near face up to %.1fx the far)\n",
+                n, worst, contrast);
+    EXPECT_GE(n, 200);
+    EXPECT_GT(contrast, 3.0);
+}
+
 } // namespace
 } // namespace vitrine::test
