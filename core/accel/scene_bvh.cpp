@@ -14,6 +14,9 @@ void gather(const scene::Scene& scene, uint32_t mesh, const glm::mat4& world, bo
     const scene::Mesh& m = scene.meshes[mesh];
     for (uint32_t p = m.firstPrimitive; p < m.firstPrimitive + m.primitiveCount; ++p) {
         const scene::Primitive& prim = scene.primitives[p];
+        // Transparent primitives (alpha blend, glass) are left out: the tracers know no transmission, and an
+        // opaque pane would shut whatever it covers in a box.
+        if (scene.materials[prim.material].transparent()) continue;
         for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
             glm::vec3 v[3];
             for (uint32_t k = 0; k < 3; ++k) {

@@ -245,6 +245,8 @@ Context::Context(const ContextOptions& options)
     features.features.fragmentStoresAndAtomics = supported.fragmentStoresAndAtomics;
     features.features.shaderInt64 = supported.shaderInt64;
     features.features.depthClamp = supported.depthClamp;
+    features.features.dualSrcBlend = supported.dualSrcBlend;
+    mDualSourceBlend = supported.dualSrcBlend;
 
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -61,6 +61,8 @@ public:
     VkQueue queue() const { return mQueue; }
     uint32_t queueFamily() const { return mQueueFamily; }
     const VkPhysicalDeviceProperties& properties() const { return mProperties; }
+    // The dualSrcBlend feature is enabled (forward.transparent tints what lies behind glass with it).
+    bool dualSourceBlend() const { return mDualSourceBlend; }
     const DeviceInfo& deviceInfo() const { return mDeviceInfo; }
     Allocator& allocator() { return *mAllocator; }
     bool validationEnabled() const { return mValidation; }
@@ -102,6 +104,7 @@ private:
     void pollFences();
 
     bool mValidation = false;
+    bool mDualSourceBlend = false;
     bool mPrintValidation = true;
     VkInstance mInstance = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT mMessenger = VK_NULL_HANDLE;

@@ -53,7 +53,10 @@ RasterPipeline::RasterPipeline(Context& ctx, const RasterPipelineDesc& desc) : m
     ds.depthWriteEnable = desc.depthWrite;
     ds.depthCompareOp = desc.depthCompare;
     std::vector<VkPipelineColorBlendAttachmentState> blends(desc.colorFormats.size());
-    for (auto& b : blends) b.colorWriteMask = 0xf;
+    for (auto& b : blends) {
+        if (desc.blend) b = *desc.blend;
+        b.colorWriteMask = 0xf;
+    }
     VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     cb.attachmentCount = static_cast<uint32_t>(blends.size());
     cb.pAttachments = blends.data();

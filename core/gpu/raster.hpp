@@ -32,6 +32,9 @@ struct RasterPipelineDesc {
     VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL; // reverse Z
     bool depthBias = false;  // dynamic state: set with vkCmdSetDepthBias
     bool depthClamp = false; // needs the depthClamp feature (shadow pancaking)
+    // Blending of every colour attachment (none: written as is). Dual-source factors need the dualSrcBlend
+    // feature (Context::dualSourceBlend()).
+    std::optional<VkPipelineColorBlendAttachmentState> blend;
 };
 
 // A graphics pipeline and its layout. Viewport and scissor are dynamic. Move-only; destruction is

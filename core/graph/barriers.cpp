@@ -70,7 +70,10 @@ std::optional<ImageBarrier> requireAccess(ImageSyncState& s, uint32_t image, con
         // Not even the writer's own stage sees the write in a later pass without a barrier.
         s.visibleStages = VK_PIPELINE_STAGE_2_NONE;
     } else {
-        // A layout transition is itself a write that the barrier makes visible to this stage.
+        // A layout transition is itself a write that the barrier makes visible to this stage. It happens before
+        // use.stage, so a later read in another stage waits for use.stage too: that chains it after the transition
+        // (a depth map written by fragment tests, transitioned for a compute read, then sampled by a fragment shader).
+        s.writeStage |= use.stage;
         s.readStages = use.stage;
         s.visibleStages = use.stage;
     }

@@ -9,8 +9,10 @@
 // (generated when absent, see tangents.hpp), TEXCOORD_0/1, COLOR_0 (rgb), `_AO` (vertex AO), the
 // metallic-roughness material with all its textures, samplers, the node hierarchy, cameras, node
 // animations (objects and cameras), KHR_texture_transform, KHR_materials_emissive_strength,
-// KHR_lights_punctual (the first directional light becomes the sun), KHR_mesh_quantization and
-// VITRINE_material_layers (VITRINE_material_layers.md). Skins, morph targets and point/line primitives
+// KHR_lights_punctual (the first directional light becomes the sun; point and spot lights are kept with their
+// nodes), KHR_materials_unlit, KHR_materials_transmission (the factor; its texture is ignored with a warning),
+// KHR_materials_ior, KHR_mesh_quantization and VITRINE_material_layers (VITRINE_material_layers.md). Any other
+// extension in extensionsRequired is refused by name. Skins, morph targets and point/line primitives
 // are ignored with a warning. Embedded (data: URI, GLB) and external buffers and images both work.
 //
 // How glTF maps onto the scene model:

@@ -25,6 +25,9 @@ inline constexpr const char* kTextureTransform = "KHR_texture_transform";
 inline constexpr const char* kEmissiveStrength = "KHR_materials_emissive_strength";
 inline constexpr const char* kLightsPunctual = "KHR_lights_punctual";
 inline constexpr const char* kMeshQuantization = "KHR_mesh_quantization";
+inline constexpr const char* kUnlit = "KHR_materials_unlit";
+inline constexpr const char* kTransmission = "KHR_materials_transmission";
+inline constexpr const char* kIor = "KHR_materials_ior";
 // Our key inside `extras` for what glTF has no place for (physical camera, rooms, camera paths).
 inline constexpr const char* kExtrasKey = "vitrine";
 

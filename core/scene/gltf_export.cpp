@@ -257,6 +257,9 @@ Json Exporter::material(const Material& m) const {
     if (m.alphaMode != AlphaMode::Opaque) j["alphaMode"] = m.alphaMode == AlphaMode::Mask ? "MASK" : "BLEND";
     if (m.alphaCutoff != 0.5f) j["alphaCutoff"] = m.alphaCutoff;
     if (m.doubleSided) j["doubleSided"] = true;
+    if (m.unlit) j["extensions"][gltf::kUnlit] = Json::object();
+    if (m.transmission != 0.0f) j["extensions"][gltf::kTransmission] = {{"transmissionFactor", m.transmission}};
+    if (m.ior != 1.5f) j["extensions"][gltf::kIor] = {{"ior", m.ior}};
 
     auto scalar = [](const ScalarParam& p) {
         Json s = {{"factor", p.factor}, {"atZero", p.atZero}, {"channel", p.channel}};
@@ -323,8 +326,28 @@ void Exporter::cameras() {
 }
 
 void Exporter::nodesAndScene() {
-    for (const Node& n : mScene.nodes) {
+    // KHR_lights_punctual: the sun is light 0 when there is one, the point and spot lights follow.
+    std::vector<int> lightOf(mScene.nodes.size(), -1);
+    Json lights = Json::array();
+    if (mScene.hasSun) {
+        const Sun& sun = mScene.sun;
+        lights.push_back({{"name", "sun"}, {"type", "directional"}, {"color", vec(sun.color)}, {"intensity", sun.illuminance}});
+    }
+    for (const PunctualLight& l : mScene.lights) {
+        if (lightOf[l.node] >= 0) throw UserError("scene '" + mScene.name + "': node " + std::to_string(l.node) +
+                                                  " carries two lights; glTF allows one per node");
+        lightOf[l.node] = static_cast<int>(lights.size());
+        Json j = {{"type", l.type == LightType::Spot ? "spot" : "point"}, {"color", vec(l.color)}, {"intensity", l.intensity}};
+        if (!l.name.empty()) j["name"] = l.name;
+        if (l.range > 0.0f) j["range"] = l.range;
+        if (l.type == LightType::Spot) j["spot"] = {{"innerConeAngle", l.innerConeAngle}, {"outerConeAngle", l.outerConeAngle}};
+        lights.push_back(j);
+    }
+    if (!lights.empty()) mDoc["extensions"][gltf::kLightsPunctual]["lights"] = lights;
+    for (size_t i = 0; i < mScene.nodes.size(); ++i) {
+        const Node& n = mScene.nodes[i];
         Json j = Json::object();
+        if (lightOf[i] >= 0) j["extensions"][gltf::kLightsPunctual] = {{"light", lightOf[i]}};
         if (!n.name.empty()) j["name"] = n.name;
         if (n.local.translation != glm::vec3(0.0f)) j["translation"] = vec(n.local.translation);
         if (n.local.rotation != glm::quat(1, 0, 0, 0)) j["rotation"] = vec(n.local.rotation);
@@ -368,8 +391,6 @@ void Exporter::nodesAndScene() {
         j["extras"][gltf::kExtrasKey]["role"] = "sun";
         roots.push_back(mDoc["nodes"].size());
         mDoc["nodes"].push_back(j);
-        mDoc["extensions"][gltf::kLightsPunctual]["lights"] = Json::array(
-            {{{"name", "sun"}, {"type", "directional"}, {"color", vec(sun.color)}, {"intensity", sun.illuminance}}});
         ours["sun"] = {{"toSun", vec(sun.toSun)},
                        {"color", vec(sun.color)},
                        {"illuminance", sun.illuminance},
@@ -476,7 +497,16 @@ std::vector<uint8_t> Exporter::run() {
     transforms = text.find(gltf::kTextureTransform) != std::string::npos;
     if (transforms) used.push_back(gltf::kTextureTransform);
     if (strength) used.push_back(gltf::kEmissiveStrength);
-    if (mScene.hasSun) used.push_back(gltf::kLightsPunctual);
+    if (mScene.hasSun || !mScene.lights.empty()) used.push_back(gltf::kLightsPunctual);
+    bool unlit = false, transmission = false, ior = false;
+    for (const Material& m : mScene.materials) {
+        unlit = unlit || m.unlit;
+        transmission = transmission || m.transmission != 0.0f;
+        ior = ior || m.ior != 1.5f;
+    }
+    if (unlit) used.push_back(gltf::kUnlit);
+    if (transmission) used.push_back(gltf::kTransmission);
+    if (ior) used.push_back(gltf::kIor);
     mDoc["extensionsUsed"] = used;
     while (mBin.size() % 4)
         mBin.push_back(0);

@@ -253,30 +253,57 @@ void readSceneExtras(LoadContext& ctx, const Json& sceneJson, const std::string&
     }
 }
 
-// The first directional KHR_lights_punctual light, when the file has no exact sun in our extras.
-void readSunLight(LoadContext& ctx, const std::vector<int32_t>& remap) {
+// KHR_lights_punctual: the first directional light becomes the sun (when the file has no exact sun in our
+// extras), point and spot lights are kept with their nodes; other directional lights are ignored with a warning.
+void readLights(LoadContext& ctx, const std::vector<int32_t>& remap) {
     const Json* ext = member(ctx.doc, "extensions");
     const Json* lights = ext ? member(*ext, kLightsPunctual) : nullptr;
     const Json* list = lights ? member(*lights, "lights") : nullptr;
     const Json* nodes = member(ctx.doc, "nodes");
-    if (!list || !nodes || ctx.scene->hasSun) return;
+    if (!list || !nodes) return;
+    Scene& scene = *ctx.scene;
     for (size_t i = 0; i < nodes->size(); ++i) {
         const Json* next = member((*nodes)[i], "extensions");
         const Json* light = next ? member(*next, kLightsPunctual) : nullptr;
         if (!light || remap[i] < 0) continue;
         const Json& l = (*list)[(*light)["light"].get<size_t>()];
         std::string le = "extensions.KHR_lights_punctual.lights[" + (*light)["light"].dump() + "]";
-        if (string(ctx, l, "type", "", le) != "directional") {
-            ctx.warn(le, "only directional lights are used (as the sun); ignored");
+        if (!l.is_object()) ctx.fail(le, "expected a JSON object");
+        std::string type = string(ctx, l, "type", "", le);
+        glm::vec3 color = glm::vec3(numbers(ctx, l, "color", 3, glm::vec4(1.0f), le));
+        float intensity = static_cast<float>(number(ctx, l, "intensity", 1.0, le));
+        if (!(intensity >= 0.0f)) ctx.fail(le + ".intensity", "expected a number >= 0");
+        if (type == "directional") {
+            if (scene.hasSun) {
+                ctx.warn(le, "only one directional light is used (the sun); ignored");
+                continue;
+            }
+            glm::mat4 world = scene.evaluate(0.0).nodeWorld[remap[i]];
+            scene.hasSun = true;
+            scene.sun.toSun = glm::normalize(glm::vec3(world * glm::vec4(0, 0, 1, 0))); // lights shine down -Z
+            scene.sun.color = color;
+            scene.sun.illuminance = intensity;
             continue;
         }
-        Scene& scene = *ctx.scene;
-        glm::mat4 world = scene.evaluate(0.0).nodeWorld[remap[i]];
-        scene.hasSun = true;
-        scene.sun.toSun = glm::normalize(glm::vec3(world * glm::vec4(0, 0, 1, 0))); // lights shine down -Z
-        scene.sun.color = glm::vec3(numbers(ctx, l, "color", 3, glm::vec4(1.0f), le));
-        scene.sun.illuminance = static_cast<float>(number(ctx, l, "intensity", 1.0, le));
-        return;
+        if (type != "point" && type != "spot") ctx.fail(le + ".type", "'" + type + "'; expected directional, point or spot");
+        PunctualLight p;
+        p.name = string(ctx, l, "name", "", le);
+        p.type = type == "spot" ? LightType::Spot : LightType::Point;
+        p.color = color;
+        p.intensity = intensity;
+        p.range = static_cast<float>(number(ctx, l, "range", 0.0, le));
+        if (!(p.range >= 0.0f)) ctx.fail(le + ".range", "expected a number > 0");
+        if (p.type == LightType::Spot) {
+            const Json* spot = object(ctx, l, "spot", le);
+            std::string se = le + ".spot";
+            p.innerConeAngle = spot ? static_cast<float>(number(ctx, *spot, "innerConeAngle", 0.0, se)) : 0.0f;
+            p.outerConeAngle = spot ? static_cast<float>(number(ctx, *spot, "outerConeAngle", 0.7853981634, se))
+                                    : 0.7853981634f;
+            if (!(p.innerConeAngle >= 0.0f && p.innerConeAngle < p.outerConeAngle && p.outerConeAngle <= 1.5707964f))
+                ctx.fail(se, "expected 0 <= innerConeAngle < outerConeAngle <= pi/2");
+        }
+        p.node = static_cast<uint32_t>(remap[i]);
+        scene.lights.push_back(p);
     }
 }
 
@@ -401,7 +428,7 @@ void loadNodesAndScene(LoadContext& ctx) {
         readSceneExtras(ctx, sceneJson, e);
     }
     scene.finalize();
-    readSunLight(ctx, remap);
+    readLights(ctx, remap);
 
     for (const auto& [index, path] : exportedPaths) {
         scene.cameraPaths.push_back(

@@ -259,6 +259,22 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
                 static_cast<float>(number(ctx, *s, "emissiveStrength", 1.0, e + ".extensions." + kEmissiveStrength));
         }
     }
+    if (extensions) {
+        if (object(ctx, *extensions, kUnlit, e + ".extensions")) out.unlit = true;
+        if (const Json* t = object(ctx, *extensions, kTransmission, e + ".extensions")) {
+            std::string te = e + ".extensions." + kTransmission;
+            out.transmission = static_cast<float>(number(ctx, *t, "transmissionFactor", 0.0, te));
+            if (!(out.transmission >= 0.0f && out.transmission <= 1.0f))
+                ctx.fail(te + ".transmissionFactor", "expected a number in [0, 1]");
+            if (member(*t, "transmissionTexture")) ctx.warn(te + ".transmissionTexture", "not read; the factor is used");
+        }
+        if (const Json* i = object(ctx, *extensions, kIor, e + ".extensions")) {
+            std::string ie = e + ".extensions." + kIor;
+            out.ior = static_cast<float>(number(ctx, *i, "ior", 1.5, ie));
+            if (!(out.ior == 0.0f || (out.ior >= 1.0f && out.ior <= 10.0f)))
+                ctx.fail(ie + ".ior", "expected 0 or a number in [1, 10]");
+        }
+    }
     std::string mode = string(ctx, m, "alphaMode", "OPAQUE", e);
     if (mode == "OPAQUE")
         out.alphaMode = AlphaMode::Opaque;

@@ -123,6 +123,8 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
                       static_cast<uint32_t>(m.alphaMode), m.doubleSided ? 1u : 0u};
             g.emissive = glm::vec4(m.emissiveFactor * m.emissiveStrength, m.alphaCutoff);
             g.emissiveRef = texRef(m.emissiveTexture);
+            float r = m.ior == 0.0f ? 1.0f : (m.ior - 1.0f) / (m.ior + 1.0f); // KHR_materials_ior: 0 means F0 = 1
+            g.optics = {m.transmission, r * r, m.unlit ? 1.0f : 0.0f, 0.0f};
             materials.push_back(g);
             for (size_t li = 0; li < m.layers.size(); ++li) {
                 const scene::MaterialLayer& l = m.layers[li];
@@ -153,7 +155,10 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
         for (uint32_t i = 0; i < scene.instances.size(); ++i) {
             const scene::Mesh& mesh = scene.meshes[scene.instances[i].mesh];
             for (uint32_t p = mesh.firstPrimitive; p < mesh.firstPrimitive + mesh.primitiveCount; ++p)
-                mDraws.push_back({i, p, scene.primitives[p].material});
+            {
+                uint32_t material = scene.primitives[p].material;
+                (scene.materials[material].transparent() ? mTransparentDraws : mDraws).push_back({i, p, material});
+            }
         }
         // Grouped by material, then instance: fewer state changes, and a stable order.
         std::stable_sort(mDraws.begin(), mDraws.end(), [](const GpuDraw& a, const GpuDraw& b) { return a.material < b.material; });

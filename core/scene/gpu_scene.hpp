@@ -79,7 +79,10 @@ public:
     VkDescriptorSetLayout setLayout() const { return mSetLayout; }
     VkDescriptorSet set() const { return mSet; }
     uint32_t textureCount() const { return static_cast<uint32_t>(mTextures.size()); }
+    // Opaque and alpha-masked draws (the G-buffer, shadow maps); transparent ones (Material::transparent():
+    // alpha BLEND or transmission) are apart, for forward.transparent.
     const std::vector<GpuDraw>& draws() const { return mDraws; }
+    const std::vector<GpuDraw>& transparentDraws() const { return mTransparentDraws; }
     const GpuSceneStats& stats() const { return mStats; }
     const GpuImage& texture(uint32_t index) const { return mTextures.at(index); }
 
@@ -115,6 +118,7 @@ private:
     VkDescriptorPool mPool = VK_NULL_HANDLE;
     VkDescriptorSet mSet = VK_NULL_HANDLE;
     std::vector<GpuDraw> mDraws;
+    std::vector<GpuDraw> mTransparentDraws;
     GpuSceneStats mStats;
     float mAnisotropy = -1.0f;
 };

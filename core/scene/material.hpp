@@ -153,6 +153,15 @@ struct Material {
     AlphaMode alphaMode = AlphaMode::Opaque;
     float alphaCutoff = 0.5f;
     bool doubleSided = false;
+    // KHR_materials_unlit: the base colour (× vertex colour) is the radiance, through the emissive path.
+    bool unlit = false;
+    // KHR_materials_transmission's transmissionFactor (its texture is not read): the fraction of the dielectric
+    // base that lets light through, drawn by forward.transparent as thin glass (tinted by the base colour).
+    float transmission = 0.0f;
+    float ior = 1.5f; // KHR_materials_ior: the dielectric reflectance at normal incidence is ((ior − 1)/(ior + 1))²
+
+    // Drawn by the transparent pass (alpha blending or transmission), not into the G-buffer.
+    bool transparent() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }
 
     bool operator==(const Material&) const = default;
 };

@@ -59,7 +59,7 @@ struct Vertex {
     // TEXCOORD_1, or (0, 0).
     glm::vec2 uv1{0.0f};
     // rgb: linear vertex colour (glTF COLOR_0, multiplies base colour). a: vertex ambient occlusion,
-    // 1 = unoccluded (glTF attribute _AO). COLOR_0's own alpha is not kept: vitrine has no translucency.
+    // 1 = unoccluded (glTF attribute _AO). COLOR_0's own alpha is not kept: coverage comes from the material only.
     glm::vec4 color{1.0f};
 };
 static_assert(sizeof(Vertex) == 72, "Vertex must stay tightly packed: the GPU side mirrors it");
@@ -185,6 +185,21 @@ struct Sun {
     float angularDiameter = 0.00931f;  // radians (0.53°): shadow penumbra
 };
 
+enum class LightType : uint8_t { Point, Spot };
+
+// A KHR_lights_punctual point or spot light, placed by its node (a spot shines down the node's −Z). Unshadowed;
+// the sun (Scene::sun) stays the one shadowed light.
+struct PunctualLight {
+    std::string name;
+    LightType type = LightType::Point;
+    glm::vec3 color{1.0f};      // linear
+    float intensity = 1.0f;     // candela (lm/sr): the illuminance at distance d facing it is intensity / d²
+    float range = 0.0f;         // metres; 0 = infinite (glTF's windowing (1 − (d/range)⁴)² beyond)
+    float innerConeAngle = 0.0f;           // radians, spot only
+    float outerConeAngle = 0.7853981634f;  // radians, spot only (glTF's default π/4)
+    uint32_t node = 0;
+};
+
 // A named box of space; the probe placement gives each a cubemap with this influence volume.
 struct Room {
     std::string name;
@@ -218,6 +233,7 @@ struct Scene {
 
     Sun sun;
     bool hasSun = false;
+    std::vector<PunctualLight> lights;
     std::vector<Room> rooms;
     Aabb bounds; // world, at rest, set by finalize()
 

@@ -49,6 +49,12 @@ void hashMaterial(Hasher& h, const Material& m) {
     h.value(m.alphaMode);
     h.value(m.alphaCutoff);
     h.value(m.doubleSided);
+    // Hashed only when set, so that the keys of scenes without them (bake caches) did not change.
+    if (m.unlit || m.transmission != 0.0f || m.ior != 1.5f) {
+        h.value(m.unlit);
+        h.value(m.transmission);
+        h.value(m.ior);
+    }
 }
 
 void hashCamera(Hasher& h, const Camera& c) {
@@ -149,6 +155,17 @@ uint64_t Scene::contentHash() const {
     }
     h.value(hasSun);
     if (hasSun) h.value(sun);
+    if (!lights.empty()) {
+        h.value(lights.size());
+        for (const PunctualLight& l : lights) {
+            h.string(l.name);
+            h.value(l.type);
+            h.value(l.color);
+            for (float v : {l.intensity, l.range, l.innerConeAngle, l.outerConeAngle})
+                h.value(v);
+            h.value(l.node);
+        }
+    }
     h.value(rooms.size());
     for (const Room& r : rooms) {
         h.string(r.name);
@@ -247,6 +264,8 @@ void Scene::validate() const {
     }
     for (uint32_t r : roots)
         c.index("roots", r, nodes.size(), "nodes");
+    for (size_t i = 0; i < lights.size(); ++i)
+        c.index("lights[" + std::to_string(i) + "].node", lights[i].node, nodes.size(), "nodes");
     for (size_t i = 0; i < cameraPaths.size(); ++i) {
         const CameraPath& p = cameraPaths[i];
         std::string e = "cameraPaths[" + std::to_string(i) + "] '" + p.name + "'";

@@ -40,16 +40,19 @@ glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic) {
     return baseColor * (1.0f - metallic);
 }
 
-glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {
+glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness) {
     float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
     if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
     glm::vec3 h = glm::normalize(v + l);
     float NoH = std::clamp(glm::dot(n, h), 0.0f, 1.0f);
     float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
     float alpha = ggxAlpha(roughness);
-    glm::vec3 spec =
-        ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(specularF0(baseColor, metallic), VoH);
-    return (diffuseAlbedo(baseColor, metallic) * lambertDiffuse() + spec) * NoL;
+    glm::vec3 spec = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+    return (diffuseColor * lambertDiffuse() + spec) * NoL;
+}
+
+glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {
+    return brdfCosineF0(n, v, l, diffuseAlbedo(baseColor, metallic), specularF0(baseColor, metallic), roughness);
 }
 
 glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,

@@ -19,6 +19,8 @@ inline float lambertDiffuse() {
 }
 glm::vec3 specularF0(glm::vec3 baseColor, float metallic);
 glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic);
+// brdfCosine with the diffuse colour and F0 given apart (shaders/common/brdf.glsl).
+glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness);
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness);
 // intensity = E / pi, E the light's illuminance (lux) on a surface facing it.
 glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,

@@ -2,6 +2,7 @@
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "nodes/bake/baked_lighting.hpp"
+#include "nodes/lighting/punctual_lights.hpp"
 #include "nodes/shadow/cascades.hpp"
 #include "shaders/lighting/deferred.h"
 
@@ -12,10 +13,10 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "lighting.deferred";
     s.doc = "Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance (GGX, Smith, Schlick) + Lambert for the sun "
-            "with PCF-filtered cascaded shadows and cavity; indirect diffuse from the G-buffer's baked lightmap or "
-            "bake.lightmap's irradiance volume (the sky's SH irradiance scaled by sky_ambient where there is "
-            "neither); indirect specular from the volume's SH radiance (else the sky), until IBL; emissive added. "
-            "Outputs HDR radiance (cd/m²).";
+            "with PCF-filtered cascaded shadows and cavity, the scene's point and spot lights unshadowed; indirect "
+            "diffuse from the G-buffer's baked lightmap or bake.lightmap's irradiance volume (the sky's SH irradiance "
+            "scaled by sky_ambient where there is neither); indirect specular from the volume's SH radiance (else the "
+            "sky), until IBL; emissive added. Outputs HDR radiance (cd/m²).";
     auto tex = [](const char* name, const char* doc, bool optional = false) {
         return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
     };
@@ -32,6 +33,8 @@ NodeSchema schema() {
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
         tex("volume", "bake.lightmap's irradiance volume (diffuse and specular stand-in for what has no lightmap)", true),
         {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's `layout` (with `volume`)"},
+        {"scene", PortKind::Scene, {}, true, Usage::Sampled,
+         "The scene, for its KHR_lights_punctual point and spot lights (unshadowed); without it only the sun"},
     };
     OutputPort color;
     color.name = "color";
@@ -47,7 +50,7 @@ NodeSchema schema() {
          "(a stand-in for occlusion)"},
         {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows (off: the sun reaches everything)"},
         {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
-        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of the emissive channel"},
+        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of the emissive channel where it is emission alone (lightmapped pixels carry emission and baked light together and are left as baked)"},
     };
     return s;
 }
@@ -56,6 +59,10 @@ class Deferred final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         mCamera = ctx.objectAs<CameraObject>("camera");
+        if (ctx.hasInput("scene")) {
+            mScene = ctx.objectAs<SceneObject>("scene");
+            warnLightCount(mScene->scene(), "lighting.deferred");
+        }
         if (ctx.hasInput("cascades")) mCascades = ctx.objectAs<ShadowCascadesObject>("cascades");
         if (ctx.hasInput("shadow_map") != ctx.hasInput("cascades"))
             ctx.failParam("shadows", "connect both shadow_map and cascades of a shadow.directional node, or neither");
@@ -79,6 +86,7 @@ public:
             u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
             u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
         }
+        if (mScene) u.lights = packPunctualLights(*mScene);
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("color").desc();
         ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
@@ -88,6 +96,7 @@ private:
     std::shared_ptr<CameraObject> mCamera;
     std::shared_ptr<ShadowCascadesObject> mCascades;
     std::shared_ptr<BakedLightingObject> mBaked;
+    std::shared_ptr<SceneObject> mScene;
     PipelineId mPipeline = 0;
 };
 

@@ -11,7 +11,7 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "scene.gltf";
     s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
-            "KHR_texture_transform, KHR_materials_emissive_strength.";
+            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, KHR_lights_punctual.";
     s.pass = PassKind::Transfer;
     s.params = {{"path", ParamType::Path, "", {}, {}, {}, "The .gltf or .glb file (relative to the graph file)"}};
     addSceneNodeSchema(s);

@@ -60,15 +60,21 @@ vec3 ggxSpecular(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f
 
 // The full BRDF times the cosine, f(l, v) NoL, for unit vectors n (surface), v (to the eye),
 // l (to the light). Zero when l or v is below the surface.
-vec3 brdfCosine(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+// The same with the diffuse colour and F0 given apart (a dielectric's F0 from its IOR; transmission
+// taking part of the diffuse): brdfCosine is brdfCosineF0 of diffuseAlbedo() and specularF0().
+vec3 brdfCosineF0(vec3 n, vec3 v, vec3 l, vec3 diffuseColor, vec3 f0, float roughness) {
     float NoL = dot(n, l);
     float NoV = dot(n, v);
     if (NoL <= 0.0 || NoV <= 0.0) return vec3(0.0);
     vec3 h = normalize(v + l);
     float NoH = clamp(dot(n, h), 0.0, 1.0);
     float VoH = clamp(dot(v, h), 0.0, 1.0);
-    vec3 spec = ggxSpecular(NoV, NoL, NoH, VoH, ggxAlpha(roughness), specularF0(baseColor, metallic));
-    return (diffuseAlbedo(baseColor, metallic) * lambertDiffuse() + spec) * NoL;
+    vec3 spec = ggxSpecular(NoV, NoL, NoH, VoH, ggxAlpha(roughness), f0);
+    return (diffuseColor * lambertDiffuse() + spec) * NoL;
+}
+
+vec3 brdfCosine(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
+    return brdfCosineF0(n, v, l, diffuseAlbedo(baseColor, metallic), specularF0(baseColor, metallic), roughness);
 }
 
 // Outgoing radiance (cd/m^2) from one directional light of intensity I = E / pi (see the top

@@ -4,6 +4,7 @@
 #include "scene/scene.glsl"
 #include "common/brdf.glsl"
 #include "common/octahedral.glsl"
+#include "gbuffer/unlit.glsl"
 
 // The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
 layout(location = 0) in vec3 vNormal;
@@ -76,5 +77,6 @@ void main() {
     outBase = vec4(baseColor, metallic);
     outMaterial = vec4(coverage, 0.0, vColor.a, cavity);
     outVelocity = velocity;
+    applyUnlit(m, outBase, outMaterial, emissive);
     outEmissive = vec4(emissive, lightmapped);
 }

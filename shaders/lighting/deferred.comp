@@ -4,10 +4,12 @@
 #include "common/brdf.glsl"
 #include "common/octahedral.glsl"
 #include "common/sh.glsl"
+#include "lighting/ambient.glsl"
+#include "lighting/sun_shadow.glsl"
 #include "bake/irradiance_volume.glsl"
 
 // Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance GGX/Smith/Schlick + Lambert for the sun with
-// cascaded PCF shadows, then the indirect light:
+// cascaded PCF shadows and unshadowed point and spot lights, then the indirect light:
 //   - lightmapped pixels (G-buffer emissive a = 1) carry their baked diffuse in the emissive channel;
 //   - others take diffuse from bake.lightmap's irradiance volume when it is connected;
 //   - without either, the open sky's SH irradiance scaled by `sky_ambient` stands in;
@@ -27,41 +29,8 @@ layout(binding = 8) writeonly uniform image2D out_color;
 layout(binding = 9) writeonly uniform image2D out_specular_indirect;
 layout(binding = 10) uniform Uniforms { DeferredUniforms u; };
 layout(binding = 11) uniform sampler2D in_volume;
-
-const float kHalfMax = 60000.0; // keep the RGBA16F output finite (sun glints on mirrors)
-
-float shadowTap(ivec2 texel, float depth) {
-    ivec2 size = textureSize(in_shadow_map, 0);
-    texel = clamp(texel, ivec2(0), size - 1);
-    return depth <= texelFetch(in_shadow_map, texel, 0).r ? 1.0 : 0.0;
-}
-
-// Bilinear-weighted PCF: every tap compares 2x2 texels and interpolates the results; taps on a grid
-// of radius u.shadow.lightDir.w texels around the point.
-float sunVisibility(vec3 p, vec3 n, float viewDepth) {
-    int count = int(u.shadow.params.x);
-    int c = 0;
-    while (c < count - 1 && viewDepth > u.shadow.splits[c]) ++c;
-    if (viewDepth > u.shadow.splits[count - 1]) return 1.0;
-    vec3 offsetP = p + n * u.shadow.params.w * u.shadow.texelWorld[c];
-    vec4 s = u.shadow.worldToShadow[c] * vec4(offsetP, 1.0);
-    float atlas = u.shadow.params.y;
-    vec2 st = s.xy * atlas - 0.5;
-    float depth = s.z;
-    int r = int(ceil(u.shadow.lightDir.w));
-    float sum = 0.0, weight = 0.0;
-    for (int y = -r; y <= r; ++y)
-        for (int x = -r; x <= r; ++x) {
-            vec2 q = st + vec2(x, y);
-            ivec2 base = ivec2(floor(q));
-            vec2 f = q - vec2(base);
-            float a = mix(shadowTap(base, depth), shadowTap(base + ivec2(1, 0), depth), f.x);
-            float b = mix(shadowTap(base + ivec2(0, 1), depth), shadowTap(base + ivec2(1, 1), depth), f.x);
-            sum += mix(a, b, f.y);
-            weight += 1.0;
-        }
-    return sum / weight;
-}
+#define VITRINE_LIGHTS u.lights
+#include "lighting/punctual.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -102,31 +71,24 @@ void main() {
     vec3 l = normalize(texelFetch(in_sky_sh, ivec2(10, 0), 0).xyz);
 
     // Sun: E / pi is the light's intensity in the pi convention of brdf.glsl.
-    float visibility = u.params.y > 0.5 ? sunVisibility(world, n, viewDepth) : 1.0;
+    float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, u.shadow, world, n, viewDepth) : 1.0;
     vec3 direct = shadeDirectional(n, v, l, baseColor, metallic, roughness, sunE / kPi) * visibility * cavity;
 
     // Indirect light: baked (lightmap in the emissive channel, or the irradiance volume), else the sky's SH
-    // irradiance and the sky along the mirror direction blurred towards its SH radiance with roughness, both
-    // scaled by the stand-in occlusion.
-    float NoV = clamp(dot(n, v), 1e-4, 1.0);
-    vec3 r = reflect(-v, n);
+    // irradiance and the sky along the mirror direction, scaled by the stand-in occlusion.
     vec3 volume[9];
     bool baked = volumeSh(in_volume, u.volumeOrigin, u.volumeCounts.xyz, world, n, volume);
     float occlusion = baked ? vertexAo * cavity : u.params.x * vertexAo * cavity;
     vec3 diffuse = vec3(0.0);
-    if (!lightmapped)
-        diffuse = diffuseAlbedo(baseColor, metallic) * max(shIrradiance(baked ? volume : sh, n), vec3(0.0)) / kPi * occlusion;
-    vec3 skyR = baked ? max(shRadiance(volume, r), vec3(0.0))
-                      : mix(textureLod(in_sky, r, 0.0).rgb, max(shRadiance(sh, r), vec3(0.0)), clamp(roughness * 2.0, 0.0, 1.0));
-    // Karis' analytic fit of the split-sum environment BRDF (mobile approximation).
-    vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
-    vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
-    vec4 rr = roughness * c0 + c1;
-    float a004 = min(rr.x * rr.x, exp2(-9.28 * NoV)) * rr.x + rr.y;
-    vec2 ab = vec2(-1.04, 1.04) * a004 + rr.zw;
-    vec3 specular = (specularF0(baseColor, metallic) * ab.x + ab.y) * min(skyR, vec3(kHalfMax)) * occlusion;
+    if (!lightmapped) diffuse = skyDiffuse(baked ? volume : sh, n, diffuseAlbedo(baseColor, metallic)) * occlusion;
+    vec3 f0 = specularF0(baseColor, metallic);
+    vec3 specular = (baked ? volumeSpecular(volume, n, v, f0, roughness) : skySpecular(in_sky, sh, n, v, f0, roughness)) *
+                    occlusion;
+    // KHR_lights_punctual point and spot lights (unshadowed), with the cavity as the sun has it.
+    direct += shadePunctual(world, n, v, diffuseAlbedo(baseColor, metallic), f0, roughness) * cavity;
 
-    vec3 color = direct + diffuse + specular + emissive * u.params.w;
+    // Lightmapped pixels carry emission and baked diffuse together: emissive_scale leaves them as baked.
+    vec3 color = direct + diffuse + specular + emissive * (lightmapped ? 1.0 : u.params.w);
     imageStore(out_color, p, vec4(min(color, vec3(kHalfMax)), 1.0));
     imageStore(out_specular_indirect, p, vec4(min(specular, vec3(kHalfMax)), 1.0));
 }

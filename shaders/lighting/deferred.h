@@ -2,6 +2,7 @@
 #define LIGHTING_DEFERRED_H
 #include "../common/shared.h"
 #include "../shadow/cascades.h"
+#include "lights.h"
 
 #ifdef __cplusplus
 namespace vitrine::gpu_types {
@@ -15,10 +16,11 @@ struct DeferredUniforms {
     vec4 volumeOrigin; // bake.lightmap's irradiance volume: xyz probe (0, 0, 0), w spacing (m)
     uvec4 volumeCounts; // xyz probes per axis (0: no volume connected)
     ShadowCascades shadow;
+    PunctualLights lights; // the scene's point and spot lights (none without a scene input)
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(DeferredUniforms) == 64 + 64 + sizeof(ShadowCascades));
+static_assert(sizeof(DeferredUniforms) == 64 + 64 + sizeof(ShadowCascades) + sizeof(PunctualLights));
 }
 #endif
 #endif

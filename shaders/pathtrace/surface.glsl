@@ -110,6 +110,13 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.cavity = clamp(l.cavity, 0.0, 1.0);
     s.emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) s.emissive *= sampleRef(m.emissiveRef, uv0, uv1, lod0).rgb;
+    // KHR_materials_unlit, as gbuffer/unlit.glsl: the colour is emitted and nothing is reflected (cavity 0).
+    if (m.optics.z > 0.5) {
+        s.emissive = s.baseColor;
+        s.baseColor = vec3(0.0);
+        s.metallic = 0.0;
+        s.cavity = 0.0;
+    }
     return s;
 }
 

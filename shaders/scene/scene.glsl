@@ -128,4 +128,18 @@ LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) 
     return s;
 }
 
+// The shading normal (world) from the interpolated vertex normal and tangent (w: bitangent sign) and a tangent-space
+// normal from evaluateLayers() (not unit length), flipped for back faces: gbuffer.layered's tangent frame, for
+// forward passes.
+vec3 shadingNormal(vec3 vertexNormal, vec4 tangent, vec3 tangentSpaceNormal, bool frontFacing) {
+    vec3 n = normalize(vertexNormal);
+    vec3 t = tangent.xyz - n * dot(n, tangent.xyz);
+    t = dot(t, t) > 1e-12 ? normalize(t) : vec3(1.0, 0.0, 0.0);
+    vec3 b = cross(n, t) * (tangent.w < 0.0 ? -1.0 : 1.0);
+    float len = length(tangentSpaceNormal);
+    vec3 nts = len > 1e-6 ? tangentSpaceNormal / len : vec3(0.0, 0.0, 1.0);
+    vec3 N = normalize(t * nts.x + b * nts.y + n * nts.z);
+    return frontFacing ? N : -N;
+}
+
 #endif

@@ -42,6 +42,7 @@ struct GpuMaterial {
     uvec4 info;    // x: first layer, y: layer count, z: alpha mode (0 opaque, 1 mask, 2 blend), w: double sided
     vec4 emissive; // rgb: factor x strength (linear), a: alpha cutoff
     GpuTexRef emissiveRef;
+    vec4 optics;   // x: transmission, y: dielectric F0 from the IOR, z: unlit (1/0), w: 0
 };
 
 struct GpuInstance {
@@ -81,7 +82,7 @@ VITRINE_PUSH_END(draw)
 #ifdef __cplusplus
 static_assert(sizeof(GpuTexRef) == 48);
 static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
-static_assert(sizeof(GpuMaterial) == 32 + 48);
+static_assert(sizeof(GpuMaterial) == 32 + 48 + 16);
 static_assert(sizeof(GpuInstance) == 192);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
 static_assert(sizeof(SceneDrawPush) == 96);

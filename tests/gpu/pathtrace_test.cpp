@@ -240,6 +240,31 @@ TEST_F(PathTrace, DiffusePlaneUnderUniformSkyReceivesPiL) {
     EXPECT_GT(double(within2) / n, 0.85);
 }
 
+// KHR_materials_unlit: a plane of unlit colour c under a uniform sky C emits c and reflects nothing, so every sample
+// of every pixel is exactly c (the sky's C = 100 would otherwise add about 0.5 C).
+TEST_F(PathTrace, UnlitPlaneEmitsItsColourAndReflectsNothing) {
+    const int W = 32, H = 24;
+    const glm::vec3 color(0.2f, 0.5f, 0.8f);
+    SceneBuilder b("unlit_plane");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(20, 0, 0), glm::vec3(0, 0, 20), glm::vec3(0, 1, 0));
+    uint32_t m = b.material("unlit", color, 0.0f, 0.5f);
+    b.s.materials[m].unlit = true;
+    b.node("plane", static_cast<int32_t>(b.mesh("plane", quad, m)));
+    b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+    auto glb = b.write();
+    auto out = runGraph(traceGraph(glb, uniformSky(glb, 100.0), {{"spp", 4}, {"antialias", false}}, W, H));
+    Pinhole cam(b.s, W, H);
+    int n = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            if (cam.ray(x, y).y > -0.1) continue;
+            EXPECT_LT(relErr(rgb(out.at("color"), x, y), glm::dvec3(color)), 1e-5) << "pixel " << x << "," << y;
+            ++n;
+        }
+    EXPECT_GT(n, 100);
+}
+
 // Direct light only (max_bounces 1, sky off, sun on): the path tracer's sun next-event estimation against
 // lighting.deferred (sky_ambient 0, no shadow map: the sphere cannot shadow its own lit side) on the
 // lighting tests' sphere, rough dielectric and smooth metal. Rays through pixel centres, so both shade

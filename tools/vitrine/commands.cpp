@@ -42,7 +42,7 @@ CompiledGraph compileFromArgs(const Args& args, uint32_t frames = 0) {
         frames = args.getUint("frames", 1);
         if (frames == 0) throw UserError("--frames: expected at least 1");
     }
-    return compileGraph(loadGraph(graphArg(args), setsWithFrames(args, frames, args.has("write-all"))));
+    return compileGraph(loadGraph(graphArg(args), setsWithFrames(args, frames, args.has("write-all"), graphArg(args))));
 }
 
 double median(std::vector<double> v) {
@@ -65,7 +65,9 @@ int runCommand(const Args& args) {
     std::string exrMode = args.get("exr", "half");
     if (exrMode != "half" && exrMode != "float" && exrMode != "none")
         throw UserError("--exr: expected half, float or none, got '" + exrMode + "'");
-    fs::path outDir = args.get("out", (fs::path("out") / fs::path(graphArg(args)).stem()).string());
+    // --scene FILE: out/<FILE's stem> unless --out says otherwise.
+    fs::path stem = fs::path(args.has("scene") ? args.get("scene") : graphArg(args)).stem();
+    fs::path outDir = args.get("out", (fs::path("out") / stem).string());
     OutputDir out(outDir, args.has("overwrite") || args.has("force"));
 
     Context ctx(contextOptions(args));

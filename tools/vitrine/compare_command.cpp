@@ -56,7 +56,7 @@ Input openInput(const std::string& role, const std::string& key, const fs::path&
     Input in{role, key, path, {}, {}, {}, {}};
     const std::string ext = lower(path.extension().string());
     if (ext == ".json") {
-        in.graph = loadGraph(path, setsWithFrames(args, frames));
+        in.graph = loadGraph(path, setsWithFrames(args, frames, false, path.string()));
         in.output = pickOutput(*in.graph, args.get("output"));
     } else if (!isImageFile(path)) {
         throw UserError(path.string() + ": compare " + role + ": " + expected + ", got a '" + ext + "' file");

@@ -16,6 +16,8 @@ commands:
       Render GRAPH headless; writes each output of the chosen frames as PNG (through the
       OCIO display transform) and all outputs of a frame as one multi-layer EXR. --frames N is
       frame.frames (and frame.write = [N-1]) before validation; later --set frame.* override it.
+      --scene FILE (run, bench, compare): the graph's scene node becomes scene.gltf of FILE, e.g.
+      `vitrine run graphs/gltf.json --scene model.glb` (output in out/model/).
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
   nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
                                     JSON on stdout (or in FILE).
@@ -56,7 +58,7 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size"},
+                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene"},
                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);

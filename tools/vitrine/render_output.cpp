@@ -1,11 +1,13 @@
 #include "tools/vitrine/render_output.hpp"
 
 #include "core/base/error.hpp"
+#include "core/graph/loader.hpp"
 #include "core/graph/compiler.hpp"
 #include "core/graph/executor.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <filesystem>
 
 namespace vitrine::cli {
 
@@ -16,8 +18,31 @@ ContextOptions contextOptions(const Args& args) {
     return o;
 }
 
-std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite) {
+std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite, const std::string& graph) {
     std::vector<std::string> sets;
+    if (args.has("scene") && !graph.empty()) {
+        const std::string file = args.get("scene");
+        std::error_code ec;
+        if (file.empty() || !std::filesystem::is_regular_file(file, ec))
+            throw UserError("--scene " + file + ": file not found; expected a .gltf or .glb file");
+        const nlohmann::json doc = loadGraphDocument(graph);
+        std::vector<std::string> ids;
+        if (doc.contains("nodes") && doc["nodes"].is_object())
+            for (const auto& [id, node] : doc["nodes"].items())
+                if (node.is_object() && node.contains("type") && node["type"].is_string() &&
+                    node["type"].get<std::string>().rfind("scene.", 0) == 0)
+                    ids.push_back(id);
+        if (ids.size() != 1) {
+            std::string list;
+            for (const std::string& id : ids)
+                list += (list.empty() ? "" : ", ") + id;
+            throw UserError(graph + ": --scene: expected exactly one scene node (type scene.*) to replace, found " +
+                            std::to_string(ids.size()) + (list.empty() ? "" : " (" + list + ")"));
+        }
+        nlohmann::json node = {{"type", "scene.gltf"},
+                               {"params", {{"path", std::filesystem::absolute(file).lexically_normal().string()}}}};
+        sets.push_back(ids[0] + "=" + node.dump());
+    }
     if (frames > 0) {
         sets.push_back("frame.frames=" + std::to_string(frames));
         if (!keepWrite) sets.push_back("frame.write=[" + std::to_string(frames - 1) + "]");

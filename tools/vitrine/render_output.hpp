@@ -21,7 +21,11 @@ ContextOptions contextOptions(const Args& args);
 // frames > 0 (`--frames`): the command line's frame count is part of the document before validation, so that
 // `--frames 24 --set frame.write=[0,12,23]` names frames the file alone does not have. An explicit --set of frame.*
 // still wins. keepWrite: only frame.frames (`run --write-all` keeps the file's frame.write).
-std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite = false);
+// With `--scene FILE` (and `graph`, the graph file the sets are for), the graph's one scene node (type scene.*) is
+// first replaced by {"type": "scene.gltf", "params": {"path": FILE}} under the same id; UserError when the graph has
+// no scene node or several, or FILE does not exist.
+std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite = false,
+                                        const std::string& graph = {});
 
 // "lavapipe" for Mesa's CPU device (lavapipe / llvmpipe), else "gpu": golden images and their tolerances are kept
 // per device class, because a CPU rasteriser and a GPU round differently.

@@ -31,6 +31,7 @@ struct Materials {
     uint32_t gilded, chrome, brushedSteel, dirtyGold, roughStone, velvet, lacqueredWood, engravedSilver;
     uint32_t brass, bronze, walnut, robotWhite, robotDark, robotEye;
     uint32_t paintings[4];
+    uint32_t glass;
 };
 
 struct Museum {

@@ -1,6 +1,7 @@
 // The exhibits, chosen to span the material space: a mirror sphere behind a thin railing, a gold amphora
 // under a layer of dirt, a brushed-steel ring, a rough stone bust, velvet draped over a table, a lacquered
-// walnut chest, and an engraved silver medallion whose fine normal map aliases.
+// walnut chest, and an engraved silver medallion whose fine normal map aliases. The amphora, the ring and the
+// medallion stand in glass cases.
 
 #include "core/scene/museum/context.hpp"
 #include "core/scene/museum/shapes.hpp"
@@ -22,6 +23,16 @@ void pedestal(MeshBuilder& b, const Museum& m, float height, float half = 0.3f) 
     box(b, {-half - 0.05f, height - 0.06f, -half - 0.05f}, {half + 0.05f, height, half + 0.05f}, 1.0f);
     b.material(m.mat.plasterWhite);
     box(b, {-half, 0.08f, -half}, {half, height - 0.06f, half}, 1.0f);
+}
+
+// A glass case over an exhibit, standing on its pedestal's top (y = base) with a half width `half` and height
+// `height`: a closed box 2 mm above the slab (so its floor never fights the slab's depth), a child of the exhibit's
+// node. No lightmap UVs: glass is transparent.
+void glassCase(Museum& m, uint32_t exhibit, float base, float half, float height) {
+    MeshBuilder b("vitrine");
+    b.material(m.mat.glass);
+    box(b, {-half, base + 0.002f, -half}, {half, base + height, half}, 1.0f);
+    m.place(b, m.scene.nodes[exhibit].name + "_vitrine", Transform{}, false, static_cast<int32_t>(exhibit));
 }
 
 Transform placement(Museum& m, glm::vec3 at, float yaw) {
@@ -101,7 +112,8 @@ void goldAmphora(Museum& m, glm::vec3 at) {
         std::vector<glm::vec2> tube = circleProfile(0.014f, 10);
         sweep(b, path, false, {0, 0, side}, tube, true, true, 2.0f);
     }
-    m.place(b, "exhibit_gold_amphora", placement(m, at, 0.3f));
+    uint32_t node = m.place(b, "exhibit_gold_amphora", placement(m, at, 0.3f));
+    glassCase(m, node, 0.9f, 0.34f, 0.95f);
 }
 
 void brushedRing(Museum& m, glm::vec3 at) {
@@ -115,7 +127,8 @@ void brushedRing(Museum& m, glm::vec3 at) {
     path.pop_back();
     std::vector<glm::vec2> tube = circleProfile(0.06f, 32);
     sweep(b, path, true, {0, 0, 1}, tube, true, true, 1.0f);
-    m.place(b, "exhibit_brushed_ring", placement(m, at, -0.4f));
+    uint32_t node = m.place(b, "exhibit_brushed_ring", placement(m, at, -0.4f));
+    glassCase(m, node, 0.9f, 0.4f, 0.95f);
 }
 
 // A head: an ellipsoid with nose, brow, eye sockets, chin and ears pushed and pulled along its normal.
@@ -239,7 +252,8 @@ void engravedMedallion(Museum& m, glm::vec3 at) {
     for (int k = 0; k < segments; ++k)
         b.quad(front[k], back[k], back[k + 1], front[k + 1]);
     b.transform(glm::mat4(1.0f));
-    m.place(b, "exhibit_engraved_medallion", placement(m, at, -glm::half_pi<float>()));
+    uint32_t node = m.place(b, "exhibit_engraved_medallion", placement(m, at, -glm::half_pi<float>()));
+    glassCase(m, node, 1.0f, 0.28f, 0.75f);
 }
 
 } // namespace

@@ -193,6 +193,11 @@ Materials makeMaterials(Scene& scene, const MuseumTextures& t) {
         std::string name = "painting_" + std::to_string(q);
         m.paintings[q] = add(scene, name.c_str(), {l});
     }
+    // Vitrine glass: thin, clear with a faint green edge tint (KHR_materials_transmission, IOR 1.5), seen from both
+    // sides; drawn by forward.transparent, left out of the G-buffer, the shadow map and the ray-tracing BVH.
+    m.glass = add(scene, "vitrine_glass", {plain("glass", glm::vec3(0.93f, 0.97f, 0.95f), 0.97f, 0.0f)});
+    scene.materials.back().transmission = 1.0f;
+    scene.materials.back().doubleSided = true;
     return m;
 }
 

@@ -194,6 +194,7 @@ inline WorldTriangles worldTriangles(const scene::Scene& s, const scene::ScenePo
         const scene::Mesh& mesh = s.meshes[inst.mesh];
         for (uint32_t p = mesh.firstPrimitive; p < mesh.firstPrimitive + mesh.primitiveCount; ++p) {
             const scene::Primitive& prim = s.primitives[p];
+            if (s.materials[prim.material].transparent()) continue; // glass is not in the BVH
             for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
                 for (uint32_t k = 0; k < 3; ++k)
                     w.v.push_back(transformPoint(

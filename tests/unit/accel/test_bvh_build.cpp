@@ -105,7 +105,7 @@ void checkSceneBvh(const scene::Scene& s, const SceneBvh& bvh) {
         if (inst.dynamic) continue;
         const scene::Mesh& m = s.meshes[inst.mesh];
         for (uint32_t p = m.firstPrimitive; p < m.firstPrimitive + m.primitiveCount; ++p)
-            staticTriangles += s.primitives[p].indexCount / 3;
+            if (!s.materials[s.primitives[p].material].transparent()) staticTriangles += s.primitives[p].indexCount / 3;
     }
     EXPECT_EQ(seen.size(), staticTriangles);
 
@@ -127,7 +127,7 @@ void checkSceneBvh(const scene::Scene& s, const SceneBvh& bvh) {
         }
         size_t expected = 0;
         for (uint32_t p = m.firstPrimitive; p < m.firstPrimitive + m.primitiveCount; ++p)
-            expected += s.primitives[p].indexCount / 3;
+            if (!s.materials[s.primitives[p].material].transparent()) expected += s.primitives[p].indexCount / 3;
         EXPECT_EQ(mine.size(), expected);
     }
 }
@@ -230,6 +230,38 @@ TEST(BvhBuild, TinyInputs) {
         miss.origin = glm::vec3(-5.0f, 0.0f, 1.0f);
         EXPECT_FALSE(traceClosest(bvh.arrays(), bvh.topLevel({}), miss).valid());
     }
+}
+
+// Transparent primitives (alpha BLEND, transmission: glass) are left out: a ray through a pane reaches what is behind.
+TEST(BvhBuild, TransparentPrimitivesAreLeftOut) {
+    IndexedMesh tri;
+    tri.positions = {glm::vec3(0, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)};
+    tri.indices = {0, 1, 2};
+    scene::Scene s;
+    addRootNode(s, "wall", addMesh(s, "wall", tri));
+    uint32_t pane = addMesh(s, "pane", tri);
+    scene::Material glass = s.materials[0];
+    glass.name = "glass";
+    glass.transmission = 1.0f;
+    s.materials.push_back(glass);
+    scene::Material film = s.materials[0];
+    film.name = "film";
+    film.alphaMode = scene::AlphaMode::Blend;
+    s.materials.push_back(film);
+    s.primitives[s.meshes[pane].firstPrimitive].material = 1;
+    addRootNode(s, "pane", pane, transform({0.0f, 0.0f, 0.5f}));
+    uint32_t filmMesh = addMesh(s, "film", tri);
+    s.primitives[s.meshes[filmMesh].firstPrimitive].material = 2;
+    addRootNode(s, "film", filmMesh, transform({0.0f, 0.0f, 0.7f}));
+    s.finalize();
+    SceneBvh bvh = SceneBvh::build(s);
+    checkSceneBvh(s, bvh);
+    EXPECT_EQ(bvh.arrays().triangles.size(), 1u);
+    Ray r;
+    r.origin = glm::vec3(0.1f, 0.1f, 1.0f);
+    Hit h = traceClosest(bvh.arrays(), bvh.topLevel({}), r);
+    ASSERT_TRUE(h.valid());
+    EXPECT_FLOAT_EQ(h.t, 1.0f); // the wall at z = 0, through the glass at 0.5 and the film at 0.7
 }
 
 TEST(BvhBuild, SahBeatsSpatialMedian) {

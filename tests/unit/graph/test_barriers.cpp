@@ -115,6 +115,19 @@ TEST(GraphBarriers, ReadInANewStageMakesTheWriteVisibleThere) {
     EXPECT_EQ(b->dstAccess, kSampledRead);
 }
 
+TEST(GraphBarriers, ReadInANewStageWaitsForAnEarlierReadsLayoutTransition) {
+    ImageSyncState x;
+    requireAccess(x, 0, accessOf(Usage::DepthAttachment, PassKind::Raster)); // a shadow map rendered
+    auto toCompute = requireAccess(x, 0, accessOf(Usage::Sampled, PassKind::Compute));
+    ASSERT_TRUE(toCompute.has_value()); // the transition to SHADER_READ_ONLY, before the compute shader
+    // Sampled by a fragment shader next: the barrier must wait for the compute stage, after which the layout
+    // transition is known complete, not only for the depth write.
+    auto b = requireAccess(x, 0, accessOf(Usage::Sampled, PassKind::Raster));
+    ASSERT_TRUE(b.has_value());
+    EXPECT_EQ(b->srcStage & kCompute, kCompute);
+    EXPECT_EQ(b->dstStage, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
+}
+
 TEST(GraphBarriers, DiscardedImageWaitsForEverythingBefore) {
     // A transient whose memory an earlier resource may have used: the first write starts from
     // UNDEFINED but must wait for all prior commands and their writes.

@@ -5,6 +5,7 @@
 #include "test_util.hpp"
 
 #include <algorithm>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -275,4 +276,90 @@ TEST(GltfLoad, LayerExtension) {
 }
 
 } // namespace
+
+// KHR_lights_punctual point and spot lights, KHR_materials_unlit, _transmission and _ior, as written by hand.
+Json lightsAndGlassDoc() {
+    Json doc = test::readJson(test::dataDir() / "quad.gltf");
+    doc["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"name", "bulb"}, {"type", "point"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 12.0}, {"range", 4.0}});
+    doc["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "spot"}, {"intensity", 30.0}, {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}});
+    doc["nodes"][3]["extensions"]["KHR_lights_punctual"] = {{"light", 1}}; // the group, translated and rotated
+    doc["nodes"][1]["extensions"]["KHR_lights_punctual"] = {{"light", 2}}; // the camera node
+    Json& m = doc["materials"][0];
+    m["extensions"]["KHR_materials_unlit"] = Json::object();
+    m["extensions"]["KHR_materials_transmission"] = {{"transmissionFactor", 0.75}};
+    m["extensions"]["KHR_materials_ior"] = {{"ior", 1.33}};
+    m["alphaMode"] = "BLEND";
+    doc["extensionsRequired"] = {"KHR_lights_punctual", "KHR_materials_unlit", "KHR_materials_transmission",
+                                 "KHR_materials_ior"};
+    return doc;
+}
+
+TEST(GltfLoad, PunctualLightsUnlitTransmissionAndIor) {
+    auto file = test::scratchDir() / "lights.gltf";
+    test::writeText(file, lightsAndGlassDoc().dump());
+    Scene scene = loadGltf(file);
+    ASSERT_TRUE(scene.hasSun); // the directional light is still the sun
+    ASSERT_EQ(scene.lights.size(), 2u);
+    const PunctualLight& point = scene.lights[1].type == LightType::Point ? scene.lights[1] : scene.lights[0];
+    const PunctualLight& spot = scene.lights[1].type == LightType::Spot ? scene.lights[1] : scene.lights[0];
+    EXPECT_EQ(point.type, LightType::Point);
+    EXPECT_EQ(point.name, "bulb");
+    EXPECT_EQ(point.color, glm::vec3(1.0f, 0.5f, 0.25f));
+    EXPECT_EQ(point.intensity, 12.0f);
+    EXPECT_EQ(point.range, 4.0f);
+    EXPECT_EQ(scene.nodes[point.node].name, "group");
+    EXPECT_EQ(spot.type, LightType::Spot);
+    EXPECT_EQ(spot.intensity, 30.0f);
+    EXPECT_EQ(spot.range, 0.0f);
+    EXPECT_EQ(spot.innerConeAngle, 0.25f);
+    EXPECT_EQ(spot.outerConeAngle, 0.5f);
+    EXPECT_EQ(scene.nodes[spot.node].name, "cam");
+    const Material& m = scene.materials[0];
+    EXPECT_TRUE(m.unlit);
+    EXPECT_EQ(m.transmission, 0.75f);
+    EXPECT_EQ(m.ior, 1.33f);
+    EXPECT_EQ(m.alphaMode, AlphaMode::Blend);
+    EXPECT_TRUE(m.transparent());
+
+    // Export and load again: the same scene.
+    auto glb = test::scratchDir() / "lights.glb";
+    exportGlb(scene, glb);
+    Scene back = loadGltf(glb);
+    EXPECT_EQ(back.contentHash(), scene.contentHash());
+    ASSERT_EQ(back.lights.size(), 2u);
+    EXPECT_EQ(back.lights[0].node, scene.lights[0].node);
+    EXPECT_TRUE(back.materials[0].unlit);
+    EXPECT_EQ(back.materials[0].transmission, 0.75f);
+    EXPECT_EQ(back.materials[0].ior, 1.33f);
+}
+
+TEST(GltfLoad, BadPunctualLightsAndGlassAreUserErrors) {
+    struct Case {
+        std::function<void(Json&)> edit;
+        std::vector<std::string> expected;
+    };
+    const Case cases[] = {
+        {[](Json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][1]["type"] = "area"; },
+         {"lights[1].type", "'area'", "expected directional, point or spot"}},
+        {[](Json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["innerConeAngle"] = 0.6; },
+         {"lights[2].spot", "innerConeAngle < outerConeAngle"}},
+        {[](Json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][1]["intensity"] = -1.0; },
+         {"lights[1].intensity", "expected a number >= 0"}},
+        {[](Json& d) { d["materials"][0]["extensions"]["KHR_materials_transmission"]["transmissionFactor"] = 1.5; },
+         {"materials[0].extensions.KHR_materials_transmission.transmissionFactor", "[0, 1]"}},
+        {[](Json& d) { d["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = 0.5; },
+         {"materials[0].extensions.KHR_materials_ior.ior", "[1, 10]"}},
+    };
+    int i = 0;
+    for (const Case& c : cases) {
+        Json doc = lightsAndGlassDoc();
+        c.edit(doc);
+        auto file = test::scratchDir() / ("bad_" + std::to_string(i++) + ".gltf");
+        test::writeText(file, doc.dump());
+        test::expectUserError([&] { loadGltf(file); }, c.expected);
+    }
+}
+
 } // namespace vitrine::scene

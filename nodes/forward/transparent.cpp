@@ -1,0 +1,321 @@
+// forward.transparent: alpha-blended and transmissive (thin glass) primitives drawn over the lit opaque colour,
+// sorted back to front, depth-tested against the G-buffer's depth without writing it, and lit by the same terms
+// as lighting.deferred (shaders/lighting/*.glsl).
+#include "shaders/forward/transparent.h"
+#include "core/base/error.hpp"
+#include "core/gpu/context.hpp"
+#include "core/gpu/raster.hpp"
+#include "core/gpu/vk_check.hpp"
+#include "core/graph/registry.hpp"
+#include "core/scene/gpu_scene.hpp"
+#include "nodes/lighting/punctual_lights.hpp"
+#include "nodes/shadow/cascades.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <memory>
+
+namespace vitrine {
+namespace {
+
+using gpu_types::SceneDrawPush;
+using gpu_types::TransparentUniforms;
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "forward.transparent";
+    s.doc =
+        "Transparent surfaces (glTF alphaMode BLEND, KHR_materials_transmission as thin glass) over the lit opaque "
+        "colour: sorted back to front per primitive, depth-tested against the G-buffer without writing depth, lit by "
+        "lighting.deferred's terms (sun with cascaded shadows, point and spot lights, sky ambient and Fresnel "
+        "reflection, emissive); glass tints what lies behind it (dual-source blending).";
+    s.pass = PassKind::Raster;
+    auto tex = [](const char* name, const char* doc, std::vector<VkFormat> formats = {}) {
+        return InputPort{name, PortKind::Texture, std::move(formats), false, Usage::Sampled, doc};
+    };
+    s.inputs = {
+        {"scene", PortKind::Scene, {}, false, Usage::Sampled, "The scene: its transparent primitives and lights"},
+        tex("color", "The lit opaque colour (lighting.deferred's color, HDR)",
+            {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT}),
+        {"depth",
+         PortKind::Texture,
+         {},
+         false,
+         Usage::DepthAttachment,
+         "The G-buffer's depth (reverse Z): transparent surfaces behind it are hidden; not written"},
+        tex("shadow_map", "shadow.directional's atlas"),
+        {"cascades", PortKind::Buffer, {}, false, Usage::Sampled, "shadow.directional's cascades"},
+        tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
+        tex("sky", "A sky node's cube map (reflections)"),
+        {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera (the sort's eye point)"},
+    };
+    OutputPort color;
+    color.name = "color";
+    color.size = SizeRule::ofInput("color");
+    color.formatFrom = "color";
+    color.usage = Usage::ColorAttachment;
+    color.doc = "HDR radiance: the opaque colour with the transparent surfaces blended over it";
+    s.outputs = {color};
+    s.params = {
+        {"sky_ambient",
+         ParamType::Float,
+         0.15,
+         0.0,
+         1.0,
+         {},
+         "As lighting.deferred's: fraction of the open sky's ambient reaching the surfaces"},
+        {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows (off: the sun reaches everything)"},
+        {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
+        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of emission (and of unlit colours)"},
+        {"sort",
+         ParamType::Enum,
+         "back_to_front",
+         {},
+         {},
+         {"back_to_front", "none"},
+         "Draw order: primitives by the distance of their bounds' centre from the eye, farthest first; or the "
+         "scene's order (for A/B)"},
+    };
+    return s;
+}
+
+// Whether the device filters `format` linearly (lavapipe does not filter RGBA32F: the sky's cube map is then read
+// with the nearest texel, as the executor binds it for lighting.deferred).
+bool linearFilterable(Context& ctx, VkFormat format) {
+    VkFormatProperties props;
+    vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), format, &props);
+    return (props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT) != 0;
+}
+
+// Set 0 of the pipelines (set 1 is the scene's): binding 0 the uniforms, 1-4 the sampled inputs.
+constexpr std::array<const char*, 4> kSampled = {"shadow_map", "sky_sh", "sky", "color"};
+
+class Transparent final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        mScene = ctx.objectAs<SceneObject>("scene");
+        mCamera = ctx.objectAs<CameraObject>("camera");
+        mCascades = ctx.objectAs<ShadowCascadesObject>("cascades");
+        mSort = ctx.params().getString("sort") == "back_to_front";
+        warnLightCount(mScene->scene(), "forward.transparent");
+    }
+
+    void execute(ExecuteContext& ctx) override {
+        GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
+        if (!mCopy) create(ctx, gpu);
+        writeSet(ctx);
+
+        VkCommandBuffer cmd = ctx.cmd();
+        const ImageDesc& size = ctx.output("color").desc();
+        beginRendering(cmd, {size.width, size.height}, {{ctx.output("color").view(), true, {}}},
+                       Attachment{ctx.input("depth").view(), false, {}});
+        VkDescriptorSet sets[2] = {mSet, gpu.set()};
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mCopy.pipeline());
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, mCopy.layout(), 0, 2, sets, 0, nullptr);
+        vkCmdDraw(cmd, 3, 1, 0, 0);
+
+        gpu.bindGeometry(cmd);
+        const auto& materials = mScene->scene().materials;
+        VkPipeline bound = VK_NULL_HANDLE;
+        for (const GpuDraw& d : ordered(gpu)) {
+            // A double-sided primitive is drawn twice, its back faces first: a closed convex pane (a vitrine's
+            // box) then blends in depth order within itself too.
+            bool twoPasses = materials[d.material].doubleSided;
+            for (const RasterPipeline* p : {twoPasses ? &mBackFaces : nullptr, &mFrontFaces}) {
+                if (!p) continue;
+                if (p->pipeline() != bound) {
+                    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, p->pipeline());
+                    bound = p->pipeline();
+                }
+                SceneDrawPush push{};
+                push.instance = d.instance;
+                push.material = d.material;
+                vkCmdPushConstants(cmd, p->layout(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                   sizeof(push), &push);
+                gpu.drawIndexed(cmd, d);
+            }
+        }
+        endRendering(cmd);
+    }
+
+    void releaseGpu() override {
+        mCopy = RasterPipeline();
+        mFrontFaces = RasterPipeline();
+        mBackFaces = RasterPipeline();
+        mUniforms = GpuBuffer();
+        if (mDevice) {
+            VkDevice device = mDevice;
+            VkDescriptorSetLayout layout = std::exchange(mSetLayout, VK_NULL_HANDLE);
+            VkDescriptorPool pool = std::exchange(mPool, VK_NULL_HANDLE);
+            VkSampler linear = std::exchange(mLinear, VK_NULL_HANDLE),
+                      nearest = std::exchange(mNearest, VK_NULL_HANDLE);
+            mContext->destroyLater([device, layout, pool, linear, nearest] {
+                vkDestroyDescriptorSetLayout(device, layout, nullptr);
+                vkDestroyDescriptorPool(device, pool, nullptr);
+                vkDestroySampler(device, linear, nullptr);
+                vkDestroySampler(device, nearest, nullptr);
+            });
+            mDevice = VK_NULL_HANDLE;
+            mSet = VK_NULL_HANDLE;
+        }
+    }
+
+    ~Transparent() override { releaseGpu(); }
+
+private:
+    // This frame's transparent draws: farthest first by the distance from the eye to the centre of each
+    // primitive's world bounds (posed), or the scene's order.
+    std::vector<GpuDraw> ordered(const GpuScene& gpu) const {
+        std::vector<GpuDraw> draws = gpu.transparentDraws();
+        if (!mSort) return draws;
+        const scene::Scene& s = mScene->scene();
+        glm::vec3 eye = mCamera->current.state.position;
+        std::vector<std::pair<float, GpuDraw>> keyed;
+        for (const GpuDraw& d : draws) {
+            const glm::mat4& world = d.instance < mScene->pose.instanceWorld.size()
+                                         ? mScene->pose.instanceWorld[d.instance]
+                                         : s.instances[d.instance].world;
+            glm::vec3 centre = glm::vec3(world * glm::vec4(s.primitives[d.primitive].bounds.center(), 1.0f));
+            keyed.push_back({glm::dot(centre - eye, centre - eye), d});
+        }
+        std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+        for (size_t i = 0; i < keyed.size(); ++i)
+            draws[i] = keyed[i].second;
+        return draws;
+    }
+
+    void writeSet(ExecuteContext& ctx) {
+        const Params& p = ctx.params();
+        TransparentUniforms u{};
+        u.params = {p.getFloat("sky_ambient"), p.getBool("shadows") ? 1.0f : 0.0f, p.getFloat("sun_scale"),
+                    p.getFloat("emissive_scale")};
+        u.shadow = mCascades->data;
+        u.lights = packPunctualLights(*mScene);
+        std::memcpy(mUniforms.mapped(), &u, sizeof(u));
+
+        VkDescriptorBufferInfo bi{mUniforms.buffer(), 0, sizeof(TransparentUniforms)};
+        VkDescriptorImageInfo ii[kSampled.size()];
+        VkWriteDescriptorSet w[1 + kSampled.size()];
+        w[0] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        w[0].dstSet = mSet;
+        w[0].dstBinding = 0;
+        w[0].descriptorCount = 1;
+        w[0].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+        w[0].pBufferInfo = &bi;
+        for (uint32_t i = 0; i < kSampled.size(); ++i) {
+            const GpuImage& image = ctx.input(kSampled[i]);
+            ii[i] = {std::string(kSampled[i]) == "sky" && linearFilterable(ctx.gpu(), image.desc().format) ? mLinear
+                                                                                                           : mNearest,
+                     image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+            w[i + 1] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+            w[i + 1].dstSet = mSet;
+            w[i + 1].dstBinding = i + 1;
+            w[i + 1].descriptorCount = 1;
+            w[i + 1].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+            w[i + 1].pImageInfo = &ii[i];
+        }
+        vkUpdateDescriptorSets(mDevice, static_cast<uint32_t>(std::size(w)), w, 0, nullptr);
+    }
+
+    void create(ExecuteContext& ctx, GpuScene& gpu) {
+        Context& c = ctx.gpu();
+        if (!c.dualSourceBlend())
+            throw UserError("forward.transparent needs the dualSrcBlend feature, which device '" + c.deviceInfo().name +
+                            "' lacks");
+        mContext = &c;
+        mDevice = c.device();
+        VkDescriptorSetLayoutBinding b[1 + kSampled.size()];
+        b[0] = {0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+        for (uint32_t i = 0; i < kSampled.size(); ++i)
+            b[i + 1] = {i + 1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+        li.bindingCount = static_cast<uint32_t>(std::size(b));
+        li.pBindings = b;
+        VK_CHECK(vkCreateDescriptorSetLayout(mDevice, &li, nullptr, &mSetLayout));
+        VkDescriptorPoolSize sizes[2] = {
+            {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+            {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, static_cast<uint32_t>(kSampled.size())}};
+        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        pi.maxSets = 1;
+        pi.poolSizeCount = 2;
+        pi.pPoolSizes = sizes;
+        VK_CHECK(vkCreateDescriptorPool(mDevice, &pi, nullptr, &mPool));
+        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        ai.descriptorPool = mPool;
+        ai.descriptorSetCount = 1;
+        ai.pSetLayouts = &mSetLayout;
+        VK_CHECK(vkAllocateDescriptorSets(mDevice, &ai, &mSet));
+        // Linear filtering for the sky's cube map; everything else is read with texelFetch (and the shadow map's
+        // depth format may not be filterable).
+        VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+        si.magFilter = si.minFilter = VK_FILTER_LINEAR;
+        si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+        si.maxLod = VK_LOD_CLAMP_NONE;
+        VK_CHECK(vkCreateSampler(mDevice, &si, nullptr, &mLinear));
+        si.magFilter = si.minFilter = VK_FILTER_NEAREST;
+        VK_CHECK(vkCreateSampler(mDevice, &si, nullptr, &mNearest));
+        mUniforms = GpuBuffer(c, sizeof(TransparentUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
+                              "forward.transparent.uniforms");
+
+        // The node's set is set 0 and the scene's set 1 (VITRINE_SCENE_SET), as in the ray tracers.
+        ShaderDefines defines = {{"VITRINE_SCENE_TEXTURES", std::to_string(std::max(1u, gpu.textureCount()))},
+                                 {"VITRINE_SCENE_SET", "1"}};
+        RasterPipelineDesc d;
+        d.setLayouts = {mSetLayout, gpu.setLayout()};
+        d.pushConstantSize = sizeof(SceneDrawPush);
+        d.colorFormats = {ctx.output("color").desc().format};
+        d.depthFormat = ctx.input("depth").desc().format;
+        d.depthWrite = false;
+
+        // The copy of the opaque colour: replaces the attachment (src × 1 + dst × 0).
+        d.name = "forward.transparent.copy";
+        d.vertex = ctx.shaders().compile("forward/fullscreen.vert");
+        d.fragment = ctx.shaders().compile("forward/copy.frag");
+        d.depthTest = false;
+        d.cullMode = VK_CULL_MODE_NONE;
+        VkPipelineColorBlendAttachmentState blend{};
+        blend.blendEnable = VK_TRUE;
+        blend.srcColorBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend.dstColorBlendFactor = VK_BLEND_FACTOR_SRC1_COLOR;
+        blend.colorBlendOp = VK_BLEND_OP_ADD;
+        blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_SRC1_ALPHA;
+        blend.alphaBlendOp = VK_BLEND_OP_ADD;
+        d.blend = blend;
+        mCopy = RasterPipeline(c, d);
+
+        // The surfaces: dst' = outColor + dst × outTransmit (shaders/forward/transparent.frag).
+        d.name = "forward.transparent";
+        d.vertex = ctx.shaders().compile("gbuffer/layered.vert", defines);
+        d.fragment = ctx.shaders().compile("forward/transparent.frag", defines);
+        d.vertexBindings = GpuScene::vertexBindings();
+        d.vertexAttributes = GpuScene::vertexAttributes();
+        d.depthTest = true;
+        d.cullMode = VK_CULL_MODE_BACK_BIT;
+        blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO; // alpha (1 from the lighting) stays
+        blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+        d.blend = blend;
+        mFrontFaces = RasterPipeline(c, d);
+        d.cullMode = VK_CULL_MODE_FRONT_BIT;
+        mBackFaces = RasterPipeline(c, d);
+    }
+
+    std::shared_ptr<SceneObject> mScene;
+    std::shared_ptr<CameraObject> mCamera;
+    std::shared_ptr<ShadowCascadesObject> mCascades;
+    bool mSort = true;
+    Context* mContext = nullptr;
+    VkDevice mDevice = VK_NULL_HANDLE;
+    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
+    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    VkDescriptorSet mSet = VK_NULL_HANDLE;
+    VkSampler mLinear = VK_NULL_HANDLE, mNearest = VK_NULL_HANDLE;
+    GpuBuffer mUniforms;
+    RasterPipeline mCopy, mFrontFaces, mBackFaces;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Transparent>(); });
+
+} // namespace
+} // namespace vitrine

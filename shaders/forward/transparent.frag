@@ -1,0 +1,88 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define VITRINE_SCENE_FRAGMENT
+// The scene's texture array is walked with a uniform loop index (scene/scene.glsl): indexing it with the material's
+// texture index in a fragment shader that also samples a cube map crashed lavapipe (Mesa 22.3) when the draw was
+// compiled. The walk costs a loop over the scene's textures per textured parameter; untextured glass pays nothing.
+#define VITRINE_SCENE_DIVERGENT_TEXTURES
+#include "scene/scene.glsl"
+#include "common/brdf.glsl"
+#include "forward/transparent.h"
+#include "lighting/ambient.glsl"
+#include "lighting/sun_shadow.glsl"
+
+// Set 0: the node's uniforms and inputs; set 1: the scene (VITRINE_SCENE_SET, defined by the node).
+// forward.transparent: alpha-blended and transmissive (thin glass) surfaces over the lit opaque colour, lit by
+// the terms of lighting.deferred (sun with cascaded shadows, point and spot lights, the sky's ambient diffuse
+// and Fresnel-weighted reflection, emissive). Dual-source blending: dst' = outColor + dst × outTransmit, so a
+// pane can tint what lies behind it per channel:
+//   outColor    = alpha × lit colour (reflection, the diffuse left by transmission, emission)
+//   outTransmit = (1 − alpha) + alpha × transmission × (1 − F(NoV)) × base colour
+// With no transmission this is the usual "over" of the lit colour with its coverage alpha.
+layout(set = 0, binding = 0) uniform Uniforms { TransparentUniforms u; };
+#define VITRINE_LIGHTS u.lights
+#include "lighting/punctual.glsl"
+layout(set = 0, binding = 1) uniform sampler2D in_shadow_map;
+layout(set = 0, binding = 2) uniform sampler2D in_sky_sh;
+layout(set = 0, binding = 3) uniform samplerCube in_sky;
+
+layout(location = 0) in vec3 vNormal;
+layout(location = 1) in vec4 vTangent;
+layout(location = 2) in vec2 vUv0;
+layout(location = 3) in vec2 vUv1;
+layout(location = 4) in vec4 vColor;
+layout(location = 5) in vec4 vClip;
+layout(location = 6) in vec4 vPrevClip;
+layout(location = 7) in float vViewDepth;
+
+layout(location = 0, index = 0) out vec4 outColor;
+layout(location = 0, index = 1) out vec4 outTransmit;
+
+void main() {
+    UvGradients grads = uvGradients(vUv0, vUv1);
+    GpuMaterial m = materials[draw.material];
+    LayeredSurface s = evaluateLayers(m, vUv0, vUv1, grads);
+    if (m.info.z == 1u && s.albedo.a < m.emissive.a) discard;
+    float alpha = m.info.z == 2u ? clamp(s.albedo.a, 0.0, 1.0) : 1.0;
+
+    vec3 N = shadingNormal(vNormal, vTangent, s.normal, gl_FrontFacing);
+    vec2 ndc = gl_FragCoord.xy / camera.params.zw * 2.0 - 1.0;
+    vec4 wh = camera.invViewProj * vec4(ndc, gl_FragCoord.z, 1.0);
+    vec3 world = wh.xyz / wh.w;
+    vec3 v = normalize(camera.position.xyz - world);
+
+    vec3 baseColor = s.albedo.rgb * vColor.rgb;
+    float metallic = clamp(s.metallic, 0.0, 1.0);
+    float roughness = roughnessFromShininess(clamp(s.shininess, 0.0, 1.0));
+    float cavity = clamp(s.cavity, 0.0, 1.0);
+    vec3 emissive = m.emissive.rgb;
+    if (m.emissiveRef.info.x >= 0) emissive *= sampleRef(m.emissiveRef, vUv0, vUv1, grads).rgb;
+
+    // KHR_materials_transmission takes the dielectric's diffuse; F0 from KHR_materials_ior.
+    float transmission = m.optics.x * (1.0 - metallic);
+    vec3 f0 = mix(vec3(m.optics.y), baseColor, metallic);
+    vec3 diffuseColor = baseColor * (1.0 - metallic) * (1.0 - transmission);
+
+    vec3 sh[9];
+    for (int i = 0; i < 9; ++i) sh[i] = texelFetch(in_sky_sh, ivec2(i, 0), 0).rgb;
+    vec3 sunE = texelFetch(in_sky_sh, ivec2(9, 0), 0).rgb * u.params.z;
+    vec3 l = normalize(texelFetch(in_sky_sh, ivec2(10, 0), 0).xyz);
+
+    float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, u.shadow, world, N, vViewDepth) : 1.0;
+    vec3 direct = brdfCosineF0(N, v, l, diffuseColor, f0, roughness) * sunE * visibility * cavity;
+    direct += shadePunctual(world, N, v, diffuseColor, f0, roughness) * cavity;
+    float occlusion = u.params.x * vColor.a * cavity;
+    vec3 diffuse = skyDiffuse(sh, N, diffuseColor) * occlusion;
+    vec3 specular = skySpecular(in_sky, sh, N, v, f0, roughness) * occlusion;
+    vec3 lit = direct + diffuse + specular + emissive * u.params.w;
+
+    // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour
+    // (no refraction offset, no blur by roughness).
+    vec3 through = transmission * (vec3(1.0) - schlickFresnel(f0, dot(N, v))) * baseColor;
+    if (m.optics.z > 0.5) { // KHR_materials_unlit: the colour is the radiance, as through the G-buffer's emissive
+        lit = baseColor * u.params.w;
+        through = vec3(0.0);
+    }
+    outColor = vec4(min(lit, vec3(kHalfMax)) * alpha, alpha);
+    outTransmit = vec4(vec3(1.0 - alpha) + alpha * through, 1.0);
+}

@@ -1,0 +1,22 @@
+#ifndef FORWARD_TRANSPARENT_H
+#define FORWARD_TRANSPARENT_H
+#include "../common/shared.h"
+#include "../lighting/lights.h"
+#include "../shadow/cascades.h"
+
+#ifdef __cplusplus
+namespace vitrine::gpu_types {
+#endif
+
+// Uniforms of forward.transparent (set 1, binding 0), filled per frame; the same parameters as lighting.deferred.
+struct TransparentUniforms {
+    vec4 params; // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
+    ShadowCascades shadow;
+    PunctualLights lights;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(TransparentUniforms) == 16 + sizeof(ShadowCascades) + sizeof(PunctualLights));
+}
+#endif
+#endif

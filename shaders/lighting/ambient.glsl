@@ -1,0 +1,41 @@
+// The sky's ambient terms, for lighting.deferred and forward.transparent: diffuse from the SH irradiance,
+// specular from the sky cube map along the mirror direction (blurred towards the SH radiance with roughness)
+// times Karis' analytic fit of the split-sum environment BRDF. Both before occlusion.
+#ifndef LIGHTING_AMBIENT_GLSL
+#define LIGHTING_AMBIENT_GLSL
+#include "common/brdf.glsl"
+#include "common/sh.glsl"
+
+const float kHalfMax = 60000.0; // keep RGBA16F outputs finite (sun glints on mirrors)
+
+vec3 skyDiffuse(vec3 sh[9], vec3 n, vec3 diffuseColor) {
+    return diffuseColor * max(shIrradiance(sh, n), vec3(0.0)) / kPi;
+}
+
+// Karis' analytic fit of the split-sum environment BRDF (mobile approximation): the factor an environment's
+// radiance along the mirror direction is scaled by.
+vec3 environmentBrdf(vec3 f0, float roughness, float NoV) {
+    vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+    vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+    vec4 rr = roughness * c0 + c1;
+    float a004 = min(rr.x * rr.x, exp2(-9.28 * NoV)) * rr.x + rr.y;
+    vec2 ab = vec2(-1.04, 1.04) * a004 + rr.zw;
+    return f0 * ab.x + ab.y;
+}
+
+vec3 skySpecular(samplerCube sky, vec3 sh[9], vec3 n, vec3 v, vec3 f0, float roughness) {
+    float NoV = clamp(dot(n, v), 1e-4, 1.0);
+    vec3 r = reflect(-v, n);
+    vec3 skyR = mix(textureLod(sky, r, 0.0).rgb, max(shRadiance(sh, r), vec3(0.0)), clamp(roughness * 2.0, 0.0, 1.0));
+    return environmentBrdf(f0, roughness, NoV) * min(skyR, vec3(kHalfMax));
+}
+
+// The same with an SH environment (bake.lightmap's irradiance volume): its low-frequency radiance along the
+// mirror direction, the room's own light as a stand-in until localized cube maps.
+vec3 volumeSpecular(vec3 volume[9], vec3 n, vec3 v, vec3 f0, float roughness) {
+    float NoV = clamp(dot(n, v), 1e-4, 1.0);
+    vec3 r = reflect(-v, n);
+    return environmentBrdf(f0, roughness, NoV) * min(max(shRadiance(volume, r), vec3(0.0)), vec3(kHalfMax));
+}
+
+#endif

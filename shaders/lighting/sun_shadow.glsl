@@ -1,0 +1,40 @@
+// The sun's visibility from shadow.directional's cascades (bilinear-weighted PCF), for every pass lit by the
+// sun: lighting.deferred, forward.transparent.
+#ifndef LIGHTING_SUN_SHADOW_GLSL
+#define LIGHTING_SUN_SHADOW_GLSL
+#include "shadow/cascades.h"
+
+float shadowTap(sampler2D shadowMap, ivec2 texel, float depth) {
+    ivec2 size = textureSize(shadowMap, 0);
+    texel = clamp(texel, ivec2(0), size - 1);
+    return depth <= texelFetch(shadowMap, texel, 0).r ? 1.0 : 0.0;
+}
+
+// Bilinear-weighted PCF: every tap compares 2x2 texels and interpolates the results; taps on a grid
+// of radius sc.lightDir.w texels around the point p (world) with normal n, at linear view depth viewDepth.
+float sunVisibility(sampler2D shadowMap, ShadowCascades sc, vec3 p, vec3 n, float viewDepth) {
+    int count = int(sc.params.x);
+    int c = 0;
+    while (c < count - 1 && viewDepth > sc.splits[c]) ++c;
+    if (viewDepth > sc.splits[count - 1]) return 1.0;
+    vec3 offsetP = p + n * sc.params.w * sc.texelWorld[c];
+    vec4 s = sc.worldToShadow[c] * vec4(offsetP, 1.0);
+    float atlas = sc.params.y;
+    vec2 st = s.xy * atlas - 0.5;
+    float depth = s.z;
+    int r = int(ceil(sc.lightDir.w));
+    float sum = 0.0, weight = 0.0;
+    for (int y = -r; y <= r; ++y)
+        for (int x = -r; x <= r; ++x) {
+            vec2 q = st + vec2(x, y);
+            ivec2 base = ivec2(floor(q));
+            vec2 f = q - vec2(base);
+            float a = mix(shadowTap(shadowMap, base, depth), shadowTap(shadowMap, base + ivec2(1, 0), depth), f.x);
+            float b = mix(shadowTap(shadowMap, base + ivec2(0, 1), depth), shadowTap(shadowMap, base + ivec2(1, 1), depth), f.x);
+            sum += mix(a, b, f.y);
+            weight += 1.0;
+        }
+    return sum / weight;
+}
+
+#endif

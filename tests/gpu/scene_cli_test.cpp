@@ -1,0 +1,107 @@
+// `vitrine run graphs/gltf.json --scene FILE`: a small glTF written by the test (a red ball far from the origin, no
+// camera, no lights of its own) renders centred by the automatic framing and exposed within a band by the graph's
+// metered daylight exposure; --scene's user errors. The real binary, validation on, at a small size.
+#include "tests/gpu/lighting_scene.hpp"
+
+#include "core/image/io.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <sys/wait.h>
+
+namespace vitrine::test {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace lighting;
+
+const std::string kSource = VITRINE_SOURCE_DIR;
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s)
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+// Exit status and merged output of `vitrine ARGS`.
+std::pair<int, std::string> vitrine(const std::string& args) {
+    std::string out;
+    FILE* pipe = popen((quote(VITRINE_BINARY) + " " + args + " 2>&1").c_str(), "r");
+    if (!pipe) return {-1, out};
+    char buffer[4096];
+    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+        out.append(buffer, n);
+    int status = pclose(pipe);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+class SceneCli : public GpuTest {};
+
+TEST_F(SceneCli, SceneShorthandFramesAndExposesASmallModel) {
+    const int W = 96, H = 64;
+    SceneBuilder b("red_ball");
+    const glm::vec3 centre(5.0f, 2.0f, -3.0f);
+    b.node("ball",
+           static_cast<int32_t>(
+               b.mesh("ball", sphereTris(0.3f, 48, 24), b.material("red", {0.8f, 0.08f, 0.05f}, 0.0f, 0.4f))),
+           centre);
+    const fs::path glb = b.write();
+    const fs::path out = fs::path(VITRINE_TEST_OUT) / "scene_shorthand";
+    fs::remove_all(out);
+    auto [status, text] =
+        vitrine("run " + quote(kSource + "/graphs/gltf.json") + " --scene " + quote(glb.string()) +
+                " --set frame.width=" + std::to_string(W) + " --set frame.height=" + std::to_string(H) +
+                " --validate --quiet --exr float --out " + quote(out.string()));
+    ASSERT_EQ(status, 0) << text;
+    // The tone-mapped image (display-linear [0, 1]) from the EXR.
+    Image img = loadExrLayer(out / "frame.0000.exr", "final");
+    ASSERT_EQ(img.width, W);
+    double sx = 0.0, sy = 0.0, red = 0.0;
+    int n = 0, clipped = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float* p = img.at(x, y);
+            if (p[0] < 2.5f * p[1] || p[0] < 2.5f * p[2] || p[0] < 0.01f) continue; // the ball: red
+            sx += x + 0.5;
+            sy += y + 0.5;
+            red += p[0];
+            clipped += p[0] > 0.98f;
+            ++n;
+        }
+    ASSERT_GT(n, 0) << "no red pixel: the ball is not in view";
+    const double cx = sx / n / W, cy = sy / n / H, meanRed = red / n;
+    std::printf("--scene: ball covers %.1f %% of the frame, centroid (%.3f, %.3f), mean red %.3f, %.1f %% clipped\n",
+                100.0 * n / (W * H), cx, cy, meanRed, 100.0 * clipped / n);
+    EXPECT_NEAR(cx, 0.5, 0.05);
+    EXPECT_NEAR(cy, 0.5, 0.05);
+    EXPECT_GT(n, W * H / 20); // framed, not a dot
+    // Exposure: the lit ball (red albedo 0.8, its far side in shadow) neither dark nor blown out. The tone mapper's
+    // output is display-linear: 0.08..0.6 is 0.31..0.80 after the sRGB encoding.
+    EXPECT_GT(meanRed, 0.08);
+    EXPECT_LT(meanRed, 0.6);
+    EXPECT_LT(clipped, n / 5);
+}
+
+TEST_F(SceneCli, SceneShorthandErrorsNameWhatIsWrong) {
+    auto [missing, text1] = vitrine("validate " + quote(kSource + "/graphs/gltf.json") + " --scene /nonexistent/x.glb");
+    EXPECT_EQ(missing, 1) << text1;
+    EXPECT_NE(text1.find("--scene /nonexistent/x.glb: file not found"), std::string::npos) << text1;
+    SceneBuilder b("any");
+    b.node("ball", static_cast<int32_t>(
+                       b.mesh("ball", sphereTris(0.3f, 8, 4), b.material("red", {0.8f, 0.1f, 0.1f}, 0.0f, 0.4f))));
+    const fs::path glb = b.write();
+    auto [none, text2] =
+        vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " --scene " + quote(glb.string()));
+    EXPECT_EQ(none, 1) << text2;
+    EXPECT_NE(text2.find("expected exactly one scene node (type scene.*) to replace, found 0"), std::string::npos)
+        << text2;
+    auto [ok, text3] =
+        vitrine("validate " + quote(kSource + "/graphs/museum.json") + " --scene " + quote(glb.string()));
+    EXPECT_EQ(ok, 0) << text3; // the museum's scene node (scene.museum) becomes scene.gltf with its params
+}
+
+} // namespace
+} // namespace vitrine::test
