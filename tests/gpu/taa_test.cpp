@@ -1,0 +1,339 @@
+// aa.taa and aa.accumulate against independent expectations (MUSEUM_SPEC §6): the tone-mapped running mean of a
+// pixel alternating between 0.1 and 100, reprojection of a panned textured plane (no drift, no blur build-up),
+// ghosting of a moving object, and the accumulated zone plate against pattern.zoneplate's own supersampling.
+// Scenes are built in code, written as glTF and loaded through scene.gltf + gbuffer.layered, so TAA reads the
+// real velocity and depth.
+#include "tests/gpu/gpu_test.hpp"
+
+#include "core/base/error.hpp"
+#include "core/graph/node.hpp"
+#include "core/graph/registry.hpp"
+#include "core/scene/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+namespace sc = vitrine::scene;
+
+// test.alternate: a uniform RGBA32F image, `a` on even frames and `b` on odd ones.
+const char* kAlternateSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_color;
+layout(push_constant) uniform Push { vec4 value; } pc;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(out_color)))) return;
+    imageStore(out_color, p, vec4(pc.value.rgb, 1.0));
+}
+)";
+
+class Alternate final : public Node {
+public:
+    void setup(SetupContext& ctx) override { mPipeline = ctx.computePipelineSource("test/alternate", kAlternateSource); }
+    void execute(ExecuteContext& ctx) override {
+        const float v = ctx.params().getFloat(ctx.frameIndex() % 2 == 0 ? "a" : "b");
+        const glm::vec4 push(v, v, v, 1.0f);
+        const ImageDesc& out = ctx.output("color").desc();
+        ctx.dispatch(mPipeline, &push, sizeof(push), out.width, out.height);
+    }
+
+private:
+    PipelineId mPipeline = 0;
+};
+
+NodeSchema alternateSchema() {
+    NodeSchema s;
+    s.type = "test.alternate";
+    s.doc = "test-only node of test_gpu";
+    OutputPort out;
+    out.name = "color";
+    out.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    out.doc = "test output";
+    s.outputs = {out};
+    s.params = {{"a", ParamType::Float, 0.1, 0.0, 1e6, {}, "even frames"},
+                {"b", ParamType::Float, 100.0, 0.0, 1e6, {}, "odd frames"}};
+    return s;
+}
+const NodeRegistration kAlternate(alternateSchema(), [] { return std::make_unique<Alternate>(); });
+
+json graph(json nodes, json outputs, int w, int h, int frames) {
+    return {{"format", "vitrine-graph/1"},
+            {"frame", {{"width", w}, {"height", h}, {"frames", frames}}},
+            {"nodes", nodes},
+            {"outputs", outputs}};
+}
+
+class Taa : public GpuTest {};
+
+// Reinhard on the largest channel, written out here: t = c s / (1 + max(c s)).
+double tonemapped(double c, double scale) { return c * scale / (1.0 + c * scale); }
+
+TEST_F(Taa, ToneMappedBlendConvergesToTheToneMappedMean) {
+    for (double exposure : {0.0, -3.0}) {
+        const int frames = 16;
+        auto out = runGraph(graph({{"src", {{"type", "test.alternate"}, {"params", {{"a", 0.1}, {"b", 100.0}}}}},
+                                   {"taa",
+                                    {{"type", "aa.taa"},
+                                     {"params", {{"clamp", "none"}, {"feedback", 1.0}, {"exposure", exposure}}},
+                                     {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
+                                  {{"out", "taa.color"}, {"weight", "taa.weight"}}, 16, 16, frames));
+        const double s = std::exp2(exposure);
+        const double expected = 0.5 * (tonemapped(0.1, s) + tonemapped(100.0, s));
+        double worst = 0.0;
+        const Image& img = out.at("out");
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x) {
+                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(tonemapped(img.at(x, y)[c], s) - expected));
+                EXPECT_EQ(img.at(x, y)[3], static_cast<float>(frames)); // the sample count
+            }
+        const double linear = img.at(3, 3)[0];
+        std::printf("exposure %.0f: output %.4f (linear mean 50.05), tone-mapped %.5f, expected %.5f, worst %.2e\n",
+                    exposure, linear, tonemapped(linear, s), expected, worst);
+        EXPECT_LT(worst, 1e-3);
+        EXPECT_LT(linear, 25.0); // nowhere near the linear mean
+        EXPECT_NEAR(out.at("weight").at(5, 5)[0], (frames - 1.0) / frames, 1e-3);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scenes
+
+struct Builder {
+    sc::Scene s;
+    explicit Builder(const std::string& name) { s.name = name; }
+
+    uint32_t texture(uint32_t size, uint32_t seed) {
+        sc::TextureImage img;
+        img.name = "noise";
+        img.width = img.height = size;
+        img.pixels.resize(size * size * 4);
+        uint32_t state = seed;
+        for (uint32_t y = 0; y < size; ++y)
+            for (uint32_t x = 0; x < size; ++x) {
+                state = state * 1664525u + 1013904223u;
+                const uint8_t v = static_cast<uint8_t>(40 + (state >> 24) % 180);
+                img.at(x, y)[0] = v;
+                img.at(x, y)[1] = static_cast<uint8_t>(255 - v);
+                img.at(x, y)[2] = 128;
+                img.at(x, y)[3] = 255;
+            }
+        s.images.push_back(std::move(img));
+        sc::Texture t;
+        t.name = "noise";
+        t.image = static_cast<uint32_t>(s.images.size() - 1);
+        t.usage = sc::TextureUsage::Color;
+        s.textures.push_back(t);
+        return static_cast<uint32_t>(s.textures.size() - 1);
+    }
+
+    uint32_t material(glm::vec3 albedo, int32_t texture = -1) {
+        sc::Material m;
+        m.name = "m" + std::to_string(s.materials.size());
+        sc::MaterialLayer l;
+        l.albedo.factor = glm::vec4(albedo, 1.0f);
+        l.albedo.texture.texture = texture;
+        l.shininess = {0.3f, 0.0f};
+        m.layers = {l};
+        s.materials.push_back(m);
+        return static_cast<uint32_t>(s.materials.size() - 1);
+    }
+
+    // A square of half-size `half` in the XY plane facing +Z.
+    uint32_t quad(float half, uint32_t material) {
+        std::vector<sc::Vertex> v(4);
+        const glm::vec2 corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int i = 0; i < 4; ++i) {
+            v[i].position = glm::vec3(corners[i] * half, 0.0f);
+            v[i].normal = {0, 0, 1};
+            v[i].tangent = {1, 0, 0, 1};
+            v[i].uv0 = corners[i] * 0.5f + 0.5f;
+            v[i].color = glm::vec4(1.0f);
+        }
+        sc::Primitive p;
+        p.firstIndex = static_cast<uint32_t>(s.indices.size());
+        p.indexCount = 6;
+        p.vertexOffset = static_cast<uint32_t>(s.vertices.size());
+        p.vertexCount = 4;
+        p.material = material;
+        s.vertices.insert(s.vertices.end(), v.begin(), v.end());
+        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) s.indices.push_back(i);
+        s.primitives.push_back(p);
+        sc::Mesh m;
+        m.name = "quad" + std::to_string(s.meshes.size());
+        m.firstPrimitive = static_cast<uint32_t>(s.primitives.size() - 1);
+        m.primitiveCount = 1;
+        s.meshes.push_back(m);
+        return static_cast<uint32_t>(s.meshes.size() - 1);
+    }
+
+    uint32_t node(uint32_t mesh, glm::vec3 t) {
+        sc::Node n;
+        n.name = "n" + std::to_string(s.nodes.size());
+        n.mesh = static_cast<int32_t>(mesh);
+        n.local.translation = t;
+        s.nodes.push_back(n);
+        return static_cast<uint32_t>(s.nodes.size() - 1);
+    }
+
+    void cameraPath(std::vector<sc::CameraKey> keys) {
+        sc::Camera lens;
+        lens.name = "cam";
+        lens.yfov = 0.8f;
+        lens.znear = 0.05f;
+        lens.zfar = 0.0f;
+        s.cameras.push_back(lens);
+        sc::CameraPath path;
+        path.name = "cam";
+        path.camera = 0;
+        path.smooth = false;
+        path.keys = std::move(keys);
+        s.cameraPaths.push_back(path);
+    }
+
+    void slide(uint32_t node, glm::vec3 from, glm::vec3 to) {
+        sc::Animation anim;
+        anim.name = "slide";
+        anim.samplers = {{sc::Interpolation::Linear, {0.0f, 1.0f}, {glm::vec4(from, 0.0f), glm::vec4(to, 0.0f)}}};
+        anim.channels = {{node, sc::AnimationPath::Translation, 0}};
+        s.animations.push_back(anim);
+    }
+};
+
+// scene.gltf -> gbuffer.layered -> aa.taa over the G-buffer's base colour (the "lit" image of these tests).
+json taaSceneGraph(const std::filesystem::path& glb, int w, int h, int frames, json taaParams, bool depth = true,
+                   bool velocity = true) {
+    json taaIn = {{"color", "gbuffer.base_color"}, {"history", "taa.color@prev"}};
+    if (velocity) taaIn["velocity"] = "gbuffer.velocity";
+    if (depth) {
+        taaIn["depth"] = "gbuffer.normal";
+        taaIn["history_depth"] = "gbuffer.normal@prev";
+    }
+    return graph({{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}, {"fps", 24.0}}}}},
+                  {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}},
+                  {"taa", {{"type", "aa.taa"}, {"params", taaParams}, {"in", taaIn}}}},
+                 {{"out", "taa.color"}, {"in", "gbuffer.base_color"}, {"weight", "taa.weight"}}, w, h, frames);
+}
+
+// RMSE over RGB of the pixels at least `margin` from the border (pixels that entered the view lately have no history).
+double interiorRmse(const Image& a, const Image& b, int margin) {
+    double sum = 0.0;
+    int n = 0;
+    for (int y = margin; y < a.height - margin; ++y)
+        for (int x = margin; x < a.width - margin; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double d = a.at(x, y)[c] - b.at(x, y)[c];
+                sum += d * d;
+                ++n;
+            }
+    return std::sqrt(sum / n);
+}
+
+// A camera panning across a static textured wall (about 0.6 px per frame right and 0.3 down), no jitter: after
+// 24 frames the TAA output must still be the current frame (no drift, and no more blur than the history filter
+// adds), with the history accepted (depth says same surface) in the interior.
+TEST_F(Taa, ReprojectionOfAPanKeepsTheImage) {
+    Builder b("taa_pan");
+    const uint32_t tex = b.texture(64, 7);
+    b.node(b.quad(12.0f, b.material(glm::vec3(1.0f), static_cast<int32_t>(tex))), glm::vec3(0.0f, 0.0f, -5.0f));
+    b.cameraPath({{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f}, {1.0f, glm::vec3(1.0f, -0.5f, 0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
+    const auto glb = writeSceneGlb(b.s, "taa_pan");
+    const int w = 96, h = 64, frames = 24;
+    auto run = [&](json params, bool velocity = true) {
+        params["clamp"] = "none";
+        return runGraph(taaSceneGraph(glb, w, h, frames, params, true, velocity));
+    };
+    auto cr = run({{"history_filter", "catmull_rom"}});
+    auto bilinear = run({{"history_filter", "bilinear"}});
+    auto still = run({{"history_filter", "catmull_rom"}}, false);
+    const double eCr = interiorRmse(cr.at("out"), cr.at("in"), 4);
+    const double eBilinear = interiorRmse(bilinear.at("out"), bilinear.at("in"), 4);
+    const double eStill = interiorRmse(still.at("out"), still.at("in"), 4);
+    double weight = 0.0;
+    for (int y = 4; y < h - 4; ++y)
+        for (int x = 4; x < w - 4; ++x) weight += cr.at("weight").at(x, y)[0] / ((w - 8) * (h - 8));
+    std::printf("pan: RMSE vs input: catmull-rom %.4f, bilinear %.4f, without velocity %.4f; mean history weight %.3f\n",
+                eCr, eBilinear, eStill, weight);
+    EXPECT_LT(eCr, 0.01);
+    EXPECT_GT(eBilinear, 1.5 * eCr); // the filter matters, and the test sees it
+    EXPECT_GT(eStill, 4.0 * eCr);    // without reprojection the image smears
+    EXPECT_NEAR(weight, 0.9, 0.01);  // the history was accepted: feedback 0.9 reached everywhere inside
+}
+
+// A bright square sliding over a dark wall at ~2.5 px per frame: where it was, the history holds it; the depth test
+// and the clamp must drop it. Trail energy: the summed |output - input| over pixels the square no longer covers,
+// relative to the square's own energy (its area x contrast), after 8 frames.
+TEST_F(Taa, GhostingTrailOfAMovingObjectIsRejected) {
+    Builder b("taa_ghost");
+    b.node(b.quad(12.0f, b.material(glm::vec3(0.05f))), glm::vec3(0.0f, 0.0f, -5.0f));
+    const uint32_t box = b.node(b.quad(0.5f, b.material(glm::vec3(1.0f))), glm::vec3(-1.0f, 0.0f, -4.0f));
+    b.slide(box, glm::vec3(-1.5f, 0.0f, -4.0f), glm::vec3(3.5f, 0.0f, -4.0f));
+    b.cameraPath({{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
+    const auto glb = writeSceneGlb(b.s, "taa_ghost");
+    const int w = 96, h = 64, frames = 9;
+    auto trail = [&](json params, bool depth) {
+        auto out = runGraph(taaSceneGraph(glb, w, h, frames, params, depth));
+        const Image& o = out.at("out");
+        const Image& in = out.at("in");
+        double energy = 0.0, box = 0.0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool covered = in.at(x, y)[0] > 0.5f;
+                if (covered) box += in.at(x, y)[0] - 0.05;
+                else energy += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
+            }
+        return box > 0.0 ? energy / box : 1e9;
+    };
+    const double defaults = trail(json::object(), true);
+    const double clampOnly = trail({{"clamp", "minmax"}}, false);
+    const double depthOnly = trail({{"clamp", "none"}}, true);
+    const double none = trail({{"clamp", "none"}}, false);
+    std::printf("ghost trail energy / object energy: defaults %.4f, min/max clamp only %.4f, depth test only %.4f, "
+                "neither %.4f\n", defaults, clampOnly, depthOnly, none);
+    EXPECT_LT(defaults, 0.02);
+    EXPECT_LT(clampOnly, 0.06);
+    EXPECT_LT(depthOnly, 0.05);
+    EXPECT_GT(none, 0.3); // without rejection there is a trail, so the test can see one
+}
+
+// ---------------------------------------------------------------------------------------------
+// aa.accumulate
+
+class Accumulate : public GpuTest {};
+
+// 16 frames of a zone plate jittered over the 4 x 4 stratified cell centres, averaged by aa.accumulate, against
+// pattern.zoneplate's own 4 x 4 supersampling: the same sample positions, summed in another order.
+TEST_F(Accumulate, ZonePlateEqualsItsOwnSupersampling) {
+    const int n = 4, frames = 20; // frames past N^2 keep the mean
+    auto out = runGraph(graph(
+        {{"jittered", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}, {"jitter", "stratified"}, {"jitter_grid", n}}}}},
+         {"acc", {{"type", "aa.accumulate"}, {"params", {{"grid", n}}}, {"in", {{"color", "jittered.color"}, {"history", "acc.color@prev"}}}}},
+         {"reference", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}, {"supersample", n}}}}},
+         {"single", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}}}}}},
+        {{"acc", "acc.color"}, {"reference", "reference.color"}, {"single", "single.color"}}, 80, 48, frames));
+    const double err = maxAbsDiff(out.at("acc"), out.at("reference"));
+    const double aliased = rmse(out.at("single"), out.at("reference"));
+    std::printf("accumulated vs supersampled: max |diff| %.2e (one sample per pixel: RMSE %.3f)\n", err, aliased);
+    EXPECT_LT(err, 1e-5);
+    EXPECT_GT(aliased, 0.1);
+}
+
+TEST_F(Accumulate, RefusesTooFewFrames) {
+    json g = graph({{"p", {{"type", "pattern.zoneplate"}, {"params", {{"jitter", "stratified"}, {"jitter_grid", 4}}}}},
+                    {"acc", {{"type", "aa.accumulate"}, {"params", {{"grid", 4}}}, {"in", {{"color", "p.color"}, {"history", "acc.color@prev"}}}}}},
+                   {{"acc", "acc.color"}}, 16, 16, 8);
+    try {
+        runGraph(g);
+        FAIL() << "expected a UserError";
+    } catch (const UserError& e) {
+        EXPECT_NE(std::string(e.what()).find("/nodes/acc/params/grid"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("16 frames"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace vitrine::test
