@@ -56,6 +56,13 @@ const std::vector<std::string>& jitterPatternNames() {
     return names;
 }
 
+uint32_t jitterGridFor(uint32_t grid, uint32_t frames) {
+    if (grid > 0) return grid;
+    uint32_t n = 1;
+    while ((n + 1) * (n + 1) <= frames) ++n;
+    return n;
+}
+
 JitterGrid jitterGrid(JitterPattern pattern) {
     const Cells* cells = cellsOf(pattern);
     if (!cells) return {};

@@ -39,6 +39,9 @@ inline glm::vec2 jitterOffset(JitterPattern pattern, uint32_t frame, uint32_t gr
     return pattern == JitterPattern::Off ? glm::vec2(0.0f) : glm::vec2(0.5f) - jitterSample(pattern, frame, grid);
 }
 
+// N of the stratified pattern: `grid`, or when it is 0 the largest N with N * N <= frames (at least 1).
+uint32_t jitterGridFor(uint32_t grid, uint32_t frames);
+
 // Cells of the 16 samples of a grid pattern in order, on its grid (4 for Ordered, 16 for Rotated / Improved).
 struct JitterGrid {
     uint32_t size = 0;

@@ -28,7 +28,9 @@ NodeSchema schema() {
     out.doc = "Mean of the frames so far (of all N x N once frame N^2 - 1 has run)";
     s.outputs = {out};
     s.params = {
-        {"grid", ParamType::Int, 16, 1.0, 64.0, {}, "N: N x N sub-pixel samples, one per frame (the graph needs N^2 frames)"},
+        {"grid", ParamType::Int, 0, 0.0, 64.0, {},
+         "N: N x N sub-pixel samples, one per frame (the graph needs N^2 frames). 0: the largest N with N^2 <= the "
+         "graph's frame count (16 frames: 4 x 4; --frames 256: 16 x 16)"},
     };
     return s;
 }
@@ -36,7 +38,7 @@ NodeSchema schema() {
 class Accumulate final : public Node {
 public:
     void setup(SetupContext& ctx) override {
-        const uint32_t n = static_cast<uint32_t>(ctx.params().getInt("grid"));
+        const uint32_t n = scene::jitterGridFor(static_cast<uint32_t>(ctx.params().getInt("grid")), ctx.frame().frames);
         mSamples = n * n;
         if (ctx.frame().frames < mSamples)
             ctx.failParam("grid", "needs " + std::to_string(mSamples) + " frames (N x N) but the graph runs " +

@@ -24,14 +24,18 @@ NodeSchema schema() {
          "sine: smooth cosine rings; binary: hard-edged rings (what edge anti-aliasing is for)"},
         {"jitter", ParamType::Enum, "off", {}, {}, scene::jitterPatternNames(),
          "Sub-pixel jitter per frame, the scene nodes' patterns (for aa.taa and aa.accumulate tests)"},
-        {"jitter_grid", ParamType::Int, 16, 1.0, 64.0, {}, "N of the stratified jitter"},
+        {"jitter_grid", ParamType::Int, 0, 0.0, 64.0, {},
+         "N of the stratified jitter; 0: the largest N with N^2 <= the frame count"},
     };
     return s;
 }
 
 class Zoneplate final : public Node {
 public:
-    void setup(SetupContext& ctx) override { mPipeline = ctx.computePipeline("pattern/zoneplate.comp"); }
+    void setup(SetupContext& ctx) override {
+        mJitterGrid = scene::jitterGridFor(static_cast<uint32_t>(ctx.params().getInt("jitter_grid")), ctx.frame().frames);
+        mPipeline = ctx.computePipeline("pattern/zoneplate.comp");
+    }
     void execute(ExecuteContext& ctx) override {
         const auto& p = ctx.params();
         gpu_types::ZoneplatePush push{};
@@ -39,13 +43,14 @@ public:
         push.supersample = static_cast<uint32_t>(p.getInt("supersample"));
         push.mode = static_cast<uint32_t>(p.getEnumIndex("mode"));
         push.samplePos = scene::jitterSample(static_cast<scene::JitterPattern>(p.getEnumIndex("jitter")), ctx.frameIndex(),
-                                          static_cast<uint32_t>(p.getInt("jitter_grid")));
+                                          mJitterGrid);
         const ImageDesc& out = ctx.output("color").desc();
         ctx.dispatch(mPipeline, push, out.width, out.height);
     }
 
 private:
     PipelineId mPipeline = 0;
+    uint32_t mJitterGrid = 1;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Zoneplate>(); });

@@ -34,8 +34,9 @@ void addSceneNodeSchema(NodeSchema& s) {
                         "ordered 4x4 grid; rotated grid (16-rooks); improved (16-rooks, no weak edge direction); the "
                         "16-sample grids move inside their sub-grid cells every 16 frames. stratified: jitter_grid^2 "
                         "cell centres in turn, for aa.accumulate's supersampled ground truth"});
-    s.params.push_back({"jitter_grid", ParamType::Int, 16, 1.0, 64.0, {},
-                        "N of the stratified pattern: N x N sub-pixel positions, one per frame"});
+    s.params.push_back({"jitter_grid", ParamType::Int, 0, 0.0, 64.0, {},
+                        "N of the stratified pattern: N x N sub-pixel positions, one per frame. 0: the largest N with "
+                        "N^2 <= the graph's frame count (as aa.accumulate's grid 0)"});
     s.params.push_back({"jitter_space", ParamType::Enum, "frustum", {}, {}, {"frustum", "vertex"},
                         "frustum: the whole projection is shifted; vertex: each vertex is shifted in the vertex stage, "
                         "less the faster it moves on screen (static pixels supersample, moving ones do not wobble)"});
@@ -49,7 +50,7 @@ void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> s
     mFps = p.getFloat("fps");
     mStart = p.getFloat("start");
     mJitter = static_cast<scene::JitterPattern>(p.getEnumIndex("jitter"));
-    mJitterGrid = static_cast<uint32_t>(p.getInt("jitter_grid"));
+    mJitterGrid = scene::jitterGridFor(static_cast<uint32_t>(p.getInt("jitter_grid")), ctx.frame().frames);
     mVertexJitterThreshold = p.getString("jitter_space") == "vertex" ? p.getFloat("vertex_jitter_threshold") : 0.0f;
     mCameraPath = p.getString("camera");
     if (!mCameraPath.empty()) {

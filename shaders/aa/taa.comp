@@ -113,11 +113,18 @@ void main() {
     bool valid = (pc.flags & TAA_HISTORY_VALID) != 0u && all(greaterThanEqual(prevPos, vec2(0.0))) &&
                  all(lessThanEqual(prevPos, vec2(gSize))) && length(velocity) <= pc.maxVelocity;
     if (valid && hasDepth) {
-        // Same surface: last frame's nearest depth around the reprojected point is this frame's nearest depth.
-        ivec2 b = ivec2(floor(prevPos - 0.5));
-        float before = min(min(viewDepth(in_history_depth, b), viewDepth(in_history_depth, b + ivec2(1, 0))),
-                           min(viewDepth(in_history_depth, b + ivec2(0, 1)), viewDepth(in_history_depth, b + ivec2(1, 1))));
-        valid = abs(before - nearest) <= pc.depthTolerance * max(before, nearest);
+        // Same surface: this pixel's surface was somewhere in the 3x3 around the reprojected point last frame (a
+        // window, because the sub-pixel jitter moves edges by up to a pixel between frames). A disoccluded pixel's
+        // surface was hidden there.
+        float here = viewDepth(in_depth, p);
+        ivec2 b = ivec2(floor(prevPos));
+        float closest = 1e31;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                float before = viewDepth(in_history_depth, b + ivec2(dx, dy));
+                closest = min(closest, abs(before - here) / max(before, here));
+            }
+        valid = closest <= pc.depthTolerance;
     }
 
     vec4 history = valid ? fetchHistory(prevPos) : vec4(0.0);
