@@ -21,46 +21,56 @@ namespace {
 using nlohmann::json;
 namespace sc = vitrine::scene;
 
-// test.alternate: a uniform RGBA32F image, `a` on even frames and `b` on odd ones.
-const char* kAlternateSource = R"(#version 460
+// test.sequence: a uniform RGBA32F image of colour `a` on frame 0; then, with `alternate`, `b` and `a` in turn,
+// else a one-pixel checkerboard of `b` (x + y even) and `c`.
+const char* kSequenceSource = R"(#version 460
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) writeonly uniform image2D out_color;
-layout(push_constant) uniform Push { vec4 value; } pc;
+layout(push_constant) uniform Push { vec4 even; vec4 odd; } pc;
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(out_color)))) return;
-    imageStore(out_color, p, vec4(pc.value.rgb, 1.0));
+    imageStore(out_color, p, vec4((p.x + p.y) % 2 == 0 ? pc.even.rgb : pc.odd.rgb, 1.0));
 }
 )";
 
-class Alternate final : public Node {
+class Sequence final : public Node {
 public:
-    void setup(SetupContext& ctx) override { mPipeline = ctx.computePipelineSource("test/alternate", kAlternateSource); }
+    void setup(SetupContext& ctx) override { mPipeline = ctx.computePipelineSource("test/sequence", kSequenceSource); }
     void execute(ExecuteContext& ctx) override {
-        const float v = ctx.params().getFloat(ctx.frameIndex() % 2 == 0 ? "a" : "b");
-        const glm::vec4 push(v, v, v, 1.0f);
+        const Params& p = ctx.params();
+        const uint32_t f = ctx.frameIndex();
+        glm::vec3 even = p.getVec3("a"), odd = even;
+        if (f > 0 && p.getBool("alternate")) even = odd = f % 2 ? p.getVec3("b") : p.getVec3("a");
+        if (f > 0 && !p.getBool("alternate")) {
+            even = p.getVec3("b");
+            odd = p.getVec3("c");
+        }
+        const glm::vec4 push[2] = {glm::vec4(even, 1.0f), glm::vec4(odd, 1.0f)};
         const ImageDesc& out = ctx.output("color").desc();
-        ctx.dispatch(mPipeline, &push, sizeof(push), out.width, out.height);
+        ctx.dispatch(mPipeline, push, sizeof(push), out.width, out.height);
     }
 
 private:
     PipelineId mPipeline = 0;
 };
 
-NodeSchema alternateSchema() {
+NodeSchema sequenceSchema() {
     NodeSchema s;
-    s.type = "test.alternate";
+    s.type = "test.sequence";
     s.doc = "test-only node of test_gpu";
     OutputPort out;
     out.name = "color";
     out.format = VK_FORMAT_R32G32B32A32_SFLOAT;
     out.doc = "test output";
     s.outputs = {out};
-    s.params = {{"a", ParamType::Float, 0.1, 0.0, 1e6, {}, "even frames"},
-                {"b", ParamType::Float, 100.0, 0.0, 1e6, {}, "odd frames"}};
+    s.params = {{"a", ParamType::Vec3, json::array({0.1, 0.1, 0.1}), {}, {}, {}, "frame 0 (and even frames)"},
+                {"b", ParamType::Vec3, json::array({100.0, 100.0, 100.0}), {}, {}, {}, "odd frames / checker"},
+                {"c", ParamType::Vec3, json::array({1.0, 1.0, 1.0}), {}, {}, {}, "checker"},
+                {"alternate", ParamType::Bool, true, {}, {}, {}, "a, b, a, b ... (else a, then the b/c checker)"}};
     return s;
 }
-const NodeRegistration kAlternate(alternateSchema(), [] { return std::make_unique<Alternate>(); });
+const NodeRegistration kSequence(sequenceSchema(), [] { return std::make_unique<Sequence>(); });
 
 json graph(json nodes, json outputs, int w, int h, int frames) {
     return {{"format", "vitrine-graph/1"},
@@ -71,33 +81,106 @@ json graph(json nodes, json outputs, int w, int h, int frames) {
 
 class Taa : public GpuTest {};
 
-// Reinhard on the largest channel, written out here: t = c s / (1 + max(c s)).
-double tonemapped(double c, double scale) { return c * scale / (1.0 + c * scale); }
+// Reinhard on the largest channel and its inverse, written out here: t = c s / (1 + max(c s)), c = t / (1 - max t) / s.
+glm::dvec3 tonemapped(glm::dvec3 c, double scale) {
+    c = glm::max(c, glm::dvec3(0.0)) * scale;
+    return c / (1.0 + std::max({c.x, c.y, c.z}));
+}
+glm::dvec3 linearOf(glm::dvec3 t, double scale) { return t / (1.0 - std::max({t.x, t.y, t.z})) / scale; }
+glm::dvec3 rgb(const Image& img, int x, int y) { return {img.at(x, y)[0], img.at(x, y)[1], img.at(x, y)[2]}; }
 
+// A pixel alternating between 0.1 and 100 (a warm colour, so the curve's largest channel matters): with the
+// running mean (feedback 1) the output is the mean in the tone-mapped space, not the linear mean (~50).
 TEST_F(Taa, ToneMappedBlendConvergesToTheToneMappedMean) {
+    const glm::dvec3 a(0.1, 0.06, 0.02), b(100.0, 40.0, 10.0);
     for (double exposure : {0.0, -3.0}) {
         const int frames = 16;
-        auto out = runGraph(graph({{"src", {{"type", "test.alternate"}, {"params", {{"a", 0.1}, {"b", 100.0}}}}},
+        auto out = runGraph(graph({{"src", {{"type", "test.sequence"}, {"params", {{"a", {a.x, a.y, a.z}}, {"b", {b.x, b.y, b.z}}}}}},
                                    {"taa",
                                     {{"type", "aa.taa"},
                                      {"params", {{"clamp", "none"}, {"feedback", 1.0}, {"exposure", exposure}}},
                                      {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
                                   {{"out", "taa.color"}, {"weight", "taa.weight"}}, 16, 16, frames));
         const double s = std::exp2(exposure);
-        const double expected = 0.5 * (tonemapped(0.1, s) + tonemapped(100.0, s));
+        const glm::dvec3 expected = 0.5 * (tonemapped(a, s) + tonemapped(b, s));
         double worst = 0.0;
         const Image& img = out.at("out");
         for (int y = 0; y < img.height; ++y)
             for (int x = 0; x < img.width; ++x) {
-                for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(tonemapped(img.at(x, y)[c], s) - expected));
+                const glm::dvec3 d = glm::abs(tonemapped(rgb(img, x, y), s) - expected);
+                worst = std::max({worst, d.x, d.y, d.z});
                 EXPECT_EQ(img.at(x, y)[3], static_cast<float>(frames)); // the sample count
             }
         const double linear = img.at(3, 3)[0];
-        std::printf("exposure %.0f: output %.4f (linear mean 50.05), tone-mapped %.5f, expected %.5f, worst %.2e\n",
-                    exposure, linear, tonemapped(linear, s), expected, worst);
+        std::printf("exposure %.0f: output red %.4f (linear mean 50.05), tone-mapped %.5f, expected %.5f, worst %.2e\n",
+                    exposure, linear, tonemapped(rgb(img, 3, 3), s).x, expected.x, worst);
         EXPECT_LT(worst, 1e-3);
         EXPECT_LT(linear, 25.0); // nowhere near the linear mean
         EXPECT_NEAR(out.at("weight").at(5, 5)[0], (frames - 1.0) / frames, 1e-3);
+    }
+}
+
+glm::dvec3 toYCoCg(glm::dvec3 c) {
+    return {0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b};
+}
+glm::dvec3 fromYCoCg(glm::dvec3 y) { return {y.x + y.y - y.z, y.x + y.z, y.x - y.y - y.z}; }
+
+// Frame 0 is a uniform colour, frame 1 a checkerboard of two others: the second frame's output is the history
+// (frame 0) rectified against the checkerboard's 3x3 neighbourhood in YCoCg and blended half and half with the current
+// pixel, all in the tone-mapped space; recomputed here for every clamp mode and with sharpening.
+TEST_F(Taa, HistoryRectificationMatchesCpu) {
+    const glm::dvec3 a(8.0, 0.3, 0.1), b(0.2, 0.5, 0.9), c(3.0, 2.0, 0.4);
+    struct Case {
+        std::string clamp;
+        double gamma, sharpen;
+    };
+    for (const Case& k : {Case{"none", 1.0, 0.0}, Case{"minmax", 1.0, 0.0}, Case{"variance", 1.0, 0.0},
+                          Case{"variance", 0.5, 0.0}, Case{"none", 1.0, 0.6}}) {
+        auto out = runGraph(graph(
+            {{"src", {{"type", "test.sequence"}, {"params", {{"a", {a.x, a.y, a.z}}, {"b", {b.x, b.y, b.z}}, {"c", {c.x, c.y, c.z}}, {"alternate", false}}}}},
+             {"taa", {{"type", "aa.taa"},
+                      {"params", {{"clamp", k.clamp}, {"gamma", k.gamma}, {"sharpen", k.sharpen}, {"exposure", -1.0}}},
+                      {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
+            {{"out", "taa.color"}}, 12, 12, 2));
+        const double s = 0.5;
+        double worst = 0.0, moved = 0.0;
+        for (int y = 1; y < 11; ++y)
+            for (int x = 1; x < 11; ++x) {
+                glm::dvec3 m1(0.0), m2(0.0), lo(1e30), hi(-1e30), cross(0.0), centre(0.0);
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const glm::dvec3 t = tonemapped((x + dx + y + dy) % 2 == 0 ? b : c, s);
+                        if (dx == 0 && dy == 0) centre = t;
+                        else if (dx == 0 || dy == 0) cross += t;
+                        const glm::dvec3 yc = toYCoCg(t);
+                        m1 += yc;
+                        m2 += yc * yc;
+                        lo = glm::min(lo, yc);
+                        hi = glm::max(hi, yc);
+                    }
+                glm::dvec3 current = centre;
+                if (k.sharpen > 0.0) current = glm::clamp(centre + k.sharpen * (centre - 0.25 * cross), 0.0, 0.9999);
+                glm::dvec3 h = toYCoCg(tonemapped(a, s));
+                if (k.clamp == "minmax") h = glm::clamp(h, lo, hi);
+                if (k.clamp == "variance") {
+                    const glm::dvec3 mean = m1 / 9.0, sigma = glm::sqrt(glm::max(m2 / 9.0 - mean * mean, 0.0));
+                    const glm::dvec3 boxLo = glm::max(mean - k.gamma * sigma, lo), boxHi = glm::min(mean + k.gamma * sigma, hi);
+                    const glm::dvec3 mid = 0.5 * (boxLo + boxHi), half = 0.5 * (boxHi - boxLo) + 1e-6;
+                    const glm::dvec3 units = glm::abs((h - mid) / half);
+                    const double most = std::max({units.x, units.y, units.z});
+                    if (most > 1.0) h = mid + (h - mid) / most;
+                }
+                const glm::dvec3 history = glm::clamp(fromYCoCg(h), 0.0, 0.9999);
+                const glm::dvec3 expected = 0.5 * (current + history);
+                const glm::dvec3 got = tonemapped(rgb(out.at("out"), x, y), s);
+                const glm::dvec3 d = glm::abs(got - expected);
+                worst = std::max({worst, d.x, d.y, d.z});
+                moved = std::max(moved, glm::length(history - tonemapped(a, s)));
+            }
+        std::printf("clamp %s, gamma %.1f, sharpen %.1f: worst tone-mapped error %.2e (history moved by up to %.3f)\n",
+                    k.clamp.c_str(), k.gamma, k.sharpen, worst, moved);
+        EXPECT_LT(worst, 2e-5) << k.clamp << " " << k.gamma << " " << k.sharpen;
+        if (k.clamp != "none") EXPECT_GT(moved, 0.05) << k.clamp; // the rectification did something
     }
 }
 
@@ -251,18 +334,23 @@ TEST_F(Taa, ReprojectionOfAPanKeepsTheImage) {
     auto cr = run({{"history_filter", "catmull_rom"}});
     auto bilinear = run({{"history_filter", "bilinear"}});
     auto still = run({{"history_filter", "catmull_rom"}}, false);
+    auto tooFast = run({{"max_velocity", 0.3}}); // the pan is faster: the history is skipped
     const double eCr = interiorRmse(cr.at("out"), cr.at("in"), 4);
     const double eBilinear = interiorRmse(bilinear.at("out"), bilinear.at("in"), 4);
     const double eStill = interiorRmse(still.at("out"), still.at("in"), 4);
-    double weight = 0.0;
+    double weight = 0.0, skipped = 0.0;
     for (int y = 4; y < h - 4; ++y)
-        for (int x = 4; x < w - 4; ++x) weight += cr.at("weight").at(x, y)[0] / ((w - 8) * (h - 8));
+        for (int x = 4; x < w - 4; ++x) {
+            weight += cr.at("weight").at(x, y)[0] / ((w - 8) * (h - 8));
+            skipped += tooFast.at("weight").at(x, y)[0] / ((w - 8) * (h - 8));
+        }
     std::printf("pan: RMSE vs input: catmull-rom %.4f, bilinear %.4f, without velocity %.4f; mean history weight %.3f\n",
                 eCr, eBilinear, eStill, weight);
     EXPECT_LT(eCr, 0.01);
     EXPECT_GT(eBilinear, 1.5 * eCr); // the filter matters, and the test sees it
     EXPECT_GT(eStill, 4.0 * eCr);    // without reprojection the image smears
     EXPECT_NEAR(weight, 0.9, 0.01);  // the history was accepted: feedback 0.9 reached everywhere inside
+    EXPECT_EQ(skipped, 0.0);         // max_velocity below the pan's speed
 }
 
 // A bright square sliding over a dark wall at ~2.5 px per frame: where it was, the history holds it; the depth test
