@@ -517,5 +517,26 @@ TEST_F(Accumulate, RefusesTooFewFrames) {
     }
 }
 
+TEST_F(Accumulate, RefusesACameraWithAnotherJitter) {
+    Builder b("accumulate_camera");
+    b.node(b.quad(2.0f, b.material(glm::vec3(0.5f))), glm::vec3(0.0f, 0.0f, -5.0f));
+    b.cameraPath({{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
+    const auto glb = writeSceneGlb(b.s, "accumulate_camera");
+    for (const char* jitter : {"halton", "stratified"}) {
+        json g = graph({{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}, {"jitter", jitter}, {"jitter_grid", 3}}}}},
+                        {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}},
+                        {"acc", {{"type", "aa.accumulate"}, {"params", {{"grid", 4}}},
+                                 {"in", {{"color", "gbuffer.base_color"}, {"history", "acc.color@prev"}, {"camera", "scene.camera"}}}}}},
+                       {{"acc", "acc.color"}}, 16, 16, 16);
+        try {
+            runGraph(g);
+            FAIL() << jitter << ": expected a UserError";
+        } catch (const UserError& e) {
+            EXPECT_NE(std::string(e.what()).find("/nodes/acc/params/grid"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("jitter_grid to 4"), std::string::npos) << e.what();
+        }
+    }
+}
+
 } // namespace
 } // namespace vitrine::test
