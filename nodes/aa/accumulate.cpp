@@ -1,8 +1,8 @@
 // aa.accumulate: the supersampled ground truth of anti-aliasing, as the mean of N x N stratified jittered frames.
+#include "shaders/aa/accumulate.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
-#include "shaders/aa/accumulate.h"
 
 #include <string>
 
@@ -16,9 +16,18 @@ NodeSchema schema() {
             "stratified jitter (scene jitter: stratified, jitter_grid N) is exactly the box-filtered N x N "
             "supersampled image, at any resolution, without a larger render target. Later frames keep the mean.";
     s.inputs = {
-        {"color", PortKind::Texture, {}, false, Usage::Sampled, "This frame's colour, rendered with the stratified jitter"},
+        {"color",
+         PortKind::Texture,
+         {},
+         false,
+         Usage::Sampled,
+         "This frame's colour, rendered with the stratified jitter"},
         {"history", PortKind::Texture, {}, false, Usage::Sampled, "This node's own color@prev"},
-        {"camera", PortKind::Camera, {}, true, Usage::Sampled,
+        {"camera",
+         PortKind::Camera,
+         {},
+         true,
+         Usage::Sampled,
          "The scene's camera: checks that its jitter is the stratified N x N one (patterns have none)"},
     };
     OutputPort out;
@@ -28,7 +37,12 @@ NodeSchema schema() {
     out.doc = "Mean of the frames so far (of all N x N once frame N^2 - 1 has run)";
     s.outputs = {out};
     s.params = {
-        {"grid", ParamType::Int, 0, 0.0, 64.0, {},
+        {"grid",
+         ParamType::Int,
+         0,
+         0.0,
+         64.0,
+         {},
          "N: N x N sub-pixel samples, one per frame (the graph needs N^2 frames). 0: the largest N with N^2 <= the "
          "graph's frame count (16 frames: 4 x 4; --frames 256: 16 x 16)"},
     };

@@ -1,7 +1,7 @@
 // aa.taa: temporal anti-aliasing after Karis 2014 (MUSEUM_SPEC §6), history through its own color@prev.
+#include "shaders/aa/taa.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
-#include "shaders/aa/taa.h"
 
 #include <cmath>
 
@@ -38,18 +38,43 @@ NodeSchema schema() {
     weight.doc = "Debug: the history's weight in the blend (rgb; 0 where it was rejected), a = 1";
     s.outputs = {color, weight};
     s.params = {
-        {"feedback", ParamType::Float, 0.9, 0.0, 1.0, {},
+        {"feedback",
+         ParamType::Float,
+         0.9,
+         0.0,
+         1.0,
+         {},
          "Largest weight of the history; until it is reached the blend is the running mean of the samples"},
-        {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {},
+        {"exposure",
+         ParamType::Float,
+         0.0,
+         -24.0,
+         24.0,
+         {},
          "Stops applied before the blend's tone curve (as post.tonemap's exposure; the output stays unscaled)"},
-        {"clamp", ParamType::Enum, "variance", {}, {}, {"none", "minmax", "variance"},
+        {"clamp",
+         ParamType::Enum,
+         "variance",
+         {},
+         {},
+         {"none", "minmax", "variance"},
          "History rectification in YCoCg: none, clamp to the 3x3 min/max box, or clip toward the centre of the "
          "mean +- gamma sigma box (within min/max)"},
         {"gamma", ParamType::Float, 1.0, 0.25, 4.0, {}, "Variance clip: box half-size in standard deviations"},
-        {"history_filter", ParamType::Enum, "catmull_rom", {}, {}, {"catmull_rom", "bilinear"},
+        {"history_filter",
+         ParamType::Enum,
+         "catmull_rom",
+         {},
+         {},
+         {"catmull_rom", "bilinear"},
          "Reprojected history fetch: Catmull-Rom (sharp) or bilinear (blurs under motion)"},
         {"max_velocity", ParamType::Float, 32.0, 0.0, 1e6, {}, "Pixels per frame beyond which the history is skipped"},
-        {"depth_tolerance", ParamType::Float, 0.05, 0.0, 1e6, {},
+        {"depth_tolerance",
+         ParamType::Float,
+         0.05,
+         0.0,
+         1e6,
+         {},
          "Relative view-depth difference beyond which the reprojected history is another surface (with depth)"},
         {"sharpen", ParamType::Float, 0.0, 0.0, 1.0, {}, "Unsharp mask of the current frame before the blend"},
     };

@@ -86,8 +86,12 @@ glm::dvec3 tonemapped(glm::dvec3 c, double scale) {
     c = glm::max(c, glm::dvec3(0.0)) * scale;
     return c / (1.0 + std::max({c.x, c.y, c.z}));
 }
-glm::dvec3 linearOf(glm::dvec3 t, double scale) { return t / (1.0 - std::max({t.x, t.y, t.z})) / scale; }
-glm::dvec3 rgb(const Image& img, int x, int y) { return {img.at(x, y)[0], img.at(x, y)[1], img.at(x, y)[2]}; }
+glm::dvec3 linearOf(glm::dvec3 t, double scale) {
+    return t / (1.0 - std::max({t.x, t.y, t.z})) / scale;
+}
+glm::dvec3 rgb(const Image& img, int x, int y) {
+    return {img.at(x, y)[0], img.at(x, y)[1], img.at(x, y)[2]};
+}
 
 // A pixel alternating between 0.1 and 100 (a warm colour, so the curve's largest channel matters): with the
 // running mean (feedback 1) the output is the mean in the tone-mapped space, not the linear mean (~50).
@@ -95,12 +99,13 @@ TEST_F(Taa, ToneMappedBlendConvergesToTheToneMappedMean) {
     const glm::dvec3 a(0.1, 0.06, 0.02), b(100.0, 40.0, 10.0);
     for (double exposure : {0.0, -3.0}) {
         const int frames = 16;
-        auto out = runGraph(graph({{"src", {{"type", "test.sequence"}, {"params", {{"a", {a.x, a.y, a.z}}, {"b", {b.x, b.y, b.z}}}}}},
-                                   {"taa",
-                                    {{"type", "aa.taa"},
-                                     {"params", {{"clamp", "none"}, {"feedback", 1.0}, {"exposure", exposure}}},
-                                     {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
-                                  {{"out", "taa.color"}, {"weight", "taa.weight"}}, 16, 16, frames));
+        auto out = runGraph(
+            graph({{"src", {{"type", "test.sequence"}, {"params", {{"a", {a.x, a.y, a.z}}, {"b", {b.x, b.y, b.z}}}}}},
+                   {"taa",
+                    {{"type", "aa.taa"},
+                     {"params", {{"clamp", "none"}, {"feedback", 1.0}, {"exposure", exposure}}},
+                     {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
+                  {{"out", "taa.color"}, {"weight", "taa.weight"}}, 16, 16, frames));
         const double s = std::exp2(exposure);
         const glm::dvec3 expected = 0.5 * (tonemapped(a, s) + tonemapped(b, s));
         double worst = 0.0;
@@ -123,7 +128,9 @@ TEST_F(Taa, ToneMappedBlendConvergesToTheToneMappedMean) {
 glm::dvec3 toYCoCg(glm::dvec3 c) {
     return {0.25 * c.r + 0.5 * c.g + 0.25 * c.b, 0.5 * c.r - 0.5 * c.b, -0.25 * c.r + 0.5 * c.g - 0.25 * c.b};
 }
-glm::dvec3 fromYCoCg(glm::dvec3 y) { return {y.x + y.y - y.z, y.x + y.z, y.x - y.y - y.z}; }
+glm::dvec3 fromYCoCg(glm::dvec3 y) {
+    return {y.x + y.y - y.z, y.x + y.z, y.x - y.y - y.z};
+}
 
 // Frame 0 is a uniform colour, frame 1 a checkerboard of two others: the second frame's output is the history
 // (frame 0) rectified against the checkerboard's 3x3 neighbourhood in YCoCg and blended half and half with the current
@@ -136,12 +143,16 @@ TEST_F(Taa, HistoryRectificationMatchesCpu) {
     };
     for (const Case& k : {Case{"none", 1.0, 0.0}, Case{"minmax", 1.0, 0.0}, Case{"variance", 1.0, 0.0},
                           Case{"variance", 0.5, 0.0}, Case{"none", 1.0, 0.6}}) {
-        auto out = runGraph(graph(
-            {{"src", {{"type", "test.sequence"}, {"params", {{"a", {a.x, a.y, a.z}}, {"b", {b.x, b.y, b.z}}, {"c", {c.x, c.y, c.z}}, {"alternate", false}}}}},
-             {"taa", {{"type", "aa.taa"},
-                      {"params", {{"clamp", k.clamp}, {"gamma", k.gamma}, {"sharpen", k.sharpen}, {"exposure", -1.0}}},
-                      {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
-            {{"out", "taa.color"}}, 12, 12, 2));
+        auto out = runGraph(
+            graph({{"src",
+                    {{"type", "test.sequence"},
+                     {"params",
+                      {{"a", {a.x, a.y, a.z}}, {"b", {b.x, b.y, b.z}}, {"c", {c.x, c.y, c.z}}, {"alternate", false}}}}},
+                   {"taa",
+                    {{"type", "aa.taa"},
+                     {"params", {{"clamp", k.clamp}, {"gamma", k.gamma}, {"sharpen", k.sharpen}, {"exposure", -1.0}}},
+                     {"in", {{"color", "src.color"}, {"history", "taa.color@prev"}}}}}},
+                  {{"out", "taa.color"}}, 12, 12, 2));
         const double s = 0.5;
         double worst = 0.0, moved = 0.0;
         for (int y = 1; y < 11; ++y)
@@ -150,8 +161,10 @@ TEST_F(Taa, HistoryRectificationMatchesCpu) {
                 for (int dy = -1; dy <= 1; ++dy)
                     for (int dx = -1; dx <= 1; ++dx) {
                         const glm::dvec3 t = tonemapped((x + dx + y + dy) % 2 == 0 ? b : c, s);
-                        if (dx == 0 && dy == 0) centre = t;
-                        else if (dx == 0 || dy == 0) cross += t;
+                        if (dx == 0 && dy == 0)
+                            centre = t;
+                        else if (dx == 0 || dy == 0)
+                            cross += t;
                         const glm::dvec3 yc = toYCoCg(t);
                         m1 += yc;
                         m2 += yc * yc;
@@ -164,7 +177,8 @@ TEST_F(Taa, HistoryRectificationMatchesCpu) {
                 if (k.clamp == "minmax") h = glm::clamp(h, lo, hi);
                 if (k.clamp == "variance") {
                     const glm::dvec3 mean = m1 / 9.0, sigma = glm::sqrt(glm::max(m2 / 9.0 - mean * mean, 0.0));
-                    const glm::dvec3 boxLo = glm::max(mean - k.gamma * sigma, lo), boxHi = glm::min(mean + k.gamma * sigma, hi);
+                    const glm::dvec3 boxLo = glm::max(mean - k.gamma * sigma, lo),
+                                     boxHi = glm::min(mean + k.gamma * sigma, hi);
                     const glm::dvec3 mid = 0.5 * (boxLo + boxHi), half = 0.5 * (boxHi - boxLo) + 1e-6;
                     const glm::dvec3 units = glm::abs((h - mid) / half);
                     const double most = std::max({units.x, units.y, units.z});
@@ -245,7 +259,8 @@ struct Builder {
         p.vertexCount = 4;
         p.material = material;
         s.vertices.insert(s.vertices.end(), v.begin(), v.end());
-        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) s.indices.push_back(i);
+        for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u})
+            s.indices.push_back(i);
         s.primitives.push_back(p);
         sc::Mesh m;
         m.name = "quad" + std::to_string(s.meshes.size());
@@ -324,7 +339,8 @@ TEST_F(Taa, ReprojectionOfAPanKeepsTheImage) {
     Builder b("taa_pan");
     const uint32_t tex = b.texture(64, 7);
     b.node(b.quad(12.0f, b.material(glm::vec3(1.0f), static_cast<int32_t>(tex))), glm::vec3(0.0f, 0.0f, -5.0f));
-    b.cameraPath({{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f}, {1.0f, glm::vec3(1.0f, -0.5f, 0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
+    b.cameraPath({{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f},
+                  {1.0f, glm::vec3(1.0f, -0.5f, 0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
     const auto glb = writeSceneGlb(b.s, "taa_pan");
     const int w = 96, h = 64, frames = 24;
     auto run = [&](json params, bool velocity = true) {
@@ -344,8 +360,9 @@ TEST_F(Taa, ReprojectionOfAPanKeepsTheImage) {
             weight += cr.at("weight").at(x, y)[0] / ((w - 8) * (h - 8));
             skipped += tooFast.at("weight").at(x, y)[0] / ((w - 8) * (h - 8));
         }
-    std::printf("pan: RMSE vs input: catmull-rom %.4f, bilinear %.4f, without velocity %.4f; mean history weight %.3f\n",
-                eCr, eBilinear, eStill, weight);
+    std::printf(
+        "pan: RMSE vs input: catmull-rom %.4f, bilinear %.4f, without velocity %.4f; mean history weight %.3f\n", eCr,
+        eBilinear, eStill, weight);
     EXPECT_LT(eCr, 0.01);
     EXPECT_GT(eBilinear, 1.5 * eCr); // the filter matters, and the test sees it
     EXPECT_GT(eStill, 4.0 * eCr);    // without reprojection the image smears
@@ -372,8 +389,10 @@ TEST_F(Taa, GhostingTrailOfAMovingObjectIsRejected) {
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 const bool covered = in.at(x, y)[0] > 0.5f;
-                if (covered) box += in.at(x, y)[0] - 0.05;
-                else energy += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
+                if (covered)
+                    box += in.at(x, y)[0] - 0.05;
+                else
+                    energy += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
             }
         return box > 0.0 ? energy / box : 1e9;
     };
@@ -382,7 +401,8 @@ TEST_F(Taa, GhostingTrailOfAMovingObjectIsRejected) {
     const double depthOnly = trail({{"clamp", "none"}}, true);
     const double none = trail({{"clamp", "none"}}, false);
     std::printf("ghost trail energy / object energy: defaults %.4f, min/max clamp only %.4f, depth test only %.4f, "
-                "neither %.4f\n", defaults, clampOnly, depthOnly, none);
+                "neither %.4f\n",
+                defaults, clampOnly, depthOnly, none);
     EXPECT_LT(defaults, 0.02);
     EXPECT_LT(clampOnly, 0.06);
     // The depth test alone accepts a pixel whose surface was within the 3x3 window last frame (the jitter moves edges
@@ -440,10 +460,15 @@ TEST_F(VertexJitter, StaticVerticesMoveByTheJitterFastOnesDoNot) {
     const int w = 96, h = 64, frames = 3;
     const double start = 0.5 - 1.0 / 24.0; // the moving square is centred on the last frame
     auto depth = [&](const std::string& jitter, const std::string& space, double threshold = 2.0) {
-        json g = graph({{"scene", {{"type", "scene.gltf"},
-                                   {"params", {{"path", glb.string()}, {"fps", 24.0}, {"start", start - 1.0 / 24.0},
-                                               {"jitter", jitter}, {"jitter_space", space},
-                                               {"vertex_jitter_threshold", threshold}}}}},
+        json g = graph({{"scene",
+                         {{"type", "scene.gltf"},
+                          {"params",
+                           {{"path", glb.string()},
+                            {"fps", 24.0},
+                            {"start", start - 1.0 / 24.0},
+                            {"jitter", jitter},
+                            {"jitter_space", space},
+                            {"vertex_jitter_threshold", threshold}}}}},
                         {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}}},
                        {{"depth", "gbuffer.depth"}, {"velocity", "gbuffer.velocity"}}, w, h, frames);
         return runGraph(g);
@@ -458,7 +483,8 @@ TEST_F(VertexJitter, StaticVerticesMoveByTheJitterFastOnesDoNot) {
     for (int y = 0; y < h; ++y)
         for (int x = w / 2; x < w; ++x) {
             if (plain.at("depth").at(x, y)[0] <= 0.0f) continue;
-            const double v = glm::length(glm::dvec2(plain.at("velocity").at(x, y)[0], plain.at("velocity").at(x, y)[1]));
+            const double v =
+                glm::length(glm::dvec2(plain.at("velocity").at(x, y)[0], plain.at("velocity").at(x, y)[1]));
             speed = std::max(speed, v);
             meanSpeed += v;
             ++covered;
@@ -469,9 +495,10 @@ TEST_F(VertexJitter, StaticVerticesMoveByTheJitterFastOnesDoNot) {
     const double fStill = jitterRatio(plain.at("depth"), frustum.at("depth"), jitter, false);
     const double fMoving = jitterRatio(plain.at("depth"), frustum.at("depth"), jitter, true);
     const double sMoving = jitterRatio(plain.at("depth"), slow.at("depth"), jitter, true);
-    std::printf("jitter (%.4f, %.4f); moving square %.2f px/frame; share of the jitter applied: per-vertex still %.4f, "
-                "moving %.4f; frustum still %.4f, moving %.4f; threshold 20: moving %.4f (1 - mean speed / 20 = %.4f)\n",
-                jitter.x, jitter.y, speed, vStill, vMoving, fStill, fMoving, sMoving, 1.0 - meanSpeed / 20.0);
+    std::printf(
+        "jitter (%.4f, %.4f); moving square %.2f px/frame; share of the jitter applied: per-vertex still %.4f, "
+        "moving %.4f; frustum still %.4f, moving %.4f; threshold 20: moving %.4f (1 - mean speed / 20 = %.4f)\n",
+        jitter.x, jitter.y, speed, vStill, vMoving, fStill, fMoving, sMoving, 1.0 - meanSpeed / 20.0);
     ASSERT_GT(glm::length(jitter), 0.1);
     EXPECT_GT(speed, 3.0); // well above the threshold
     EXPECT_NEAR(vStill, 1.0, 0.02);
@@ -491,12 +518,17 @@ class Accumulate : public GpuTest {};
 // pattern.zoneplate's own 4 x 4 supersampling: the same sample positions, summed in another order.
 TEST_F(Accumulate, ZonePlateEqualsItsOwnSupersampling) {
     const int n = 4, frames = 20; // frames past N^2 keep the mean
-    auto out = runGraph(graph(
-        {{"jittered", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}, {"jitter", "stratified"}, {"jitter_grid", n}}}}},
-         {"acc", {{"type", "aa.accumulate"}, {"params", {{"grid", n}}}, {"in", {{"color", "jittered.color"}, {"history", "acc.color@prev"}}}}},
-         {"reference", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}, {"supersample", n}}}}},
-         {"single", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}}}}}},
-        {{"acc", "acc.color"}, {"reference", "reference.color"}, {"single", "single.color"}}, 80, 48, frames));
+    auto out = runGraph(
+        graph({{"jittered",
+                {{"type", "pattern.zoneplate"},
+                 {"params", {{"max_frequency", 0.8}, {"jitter", "stratified"}, {"jitter_grid", n}}}}},
+               {"acc",
+                {{"type", "aa.accumulate"},
+                 {"params", {{"grid", n}}},
+                 {"in", {{"color", "jittered.color"}, {"history", "acc.color@prev"}}}}},
+               {"reference", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}, {"supersample", n}}}}},
+               {"single", {{"type", "pattern.zoneplate"}, {"params", {{"max_frequency", 0.8}}}}}},
+              {{"acc", "acc.color"}, {"reference", "reference.color"}, {"single", "single.color"}}, 80, 48, frames));
     const double err = maxAbsDiff(out.at("acc"), out.at("reference"));
     const double aliased = rmse(out.at("single"), out.at("reference"));
     std::printf("accumulated vs supersampled: max |diff| %.2e (one sample per pixel: RMSE %.3f)\n", err, aliased);
@@ -506,7 +538,10 @@ TEST_F(Accumulate, ZonePlateEqualsItsOwnSupersampling) {
 
 TEST_F(Accumulate, RefusesTooFewFrames) {
     json g = graph({{"p", {{"type", "pattern.zoneplate"}, {"params", {{"jitter", "stratified"}, {"jitter_grid", 4}}}}},
-                    {"acc", {{"type", "aa.accumulate"}, {"params", {{"grid", 4}}}, {"in", {{"color", "p.color"}, {"history", "acc.color@prev"}}}}}},
+                    {"acc",
+                     {{"type", "aa.accumulate"},
+                      {"params", {{"grid", 4}}},
+                      {"in", {{"color", "p.color"}, {"history", "acc.color@prev"}}}}}},
                    {{"acc", "acc.color"}}, 16, 16, 8);
     try {
         runGraph(g);
@@ -523,11 +558,15 @@ TEST_F(Accumulate, RefusesACameraWithAnotherJitter) {
     b.cameraPath({{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 0.8f}});
     const auto glb = writeSceneGlb(b.s, "accumulate_camera");
     for (const char* jitter : {"halton", "stratified"}) {
-        json g = graph({{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}, {"jitter", jitter}, {"jitter_grid", 3}}}}},
-                        {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}},
-                        {"acc", {{"type", "aa.accumulate"}, {"params", {{"grid", 4}}},
-                                 {"in", {{"color", "gbuffer.base_color"}, {"history", "acc.color@prev"}, {"camera", "scene.camera"}}}}}},
-                       {{"acc", "acc.color"}}, 16, 16, 16);
+        json g = graph(
+            {{"scene",
+              {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}, {"jitter", jitter}, {"jitter_grid", 3}}}}},
+             {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}},
+             {"acc",
+              {{"type", "aa.accumulate"},
+               {"params", {{"grid", 4}}},
+               {"in", {{"color", "gbuffer.base_color"}, {"history", "acc.color@prev"}, {"camera", "scene.camera"}}}}}},
+            {{"acc", "acc.color"}}, 16, 16, 16);
         try {
             runGraph(g);
             FAIL() << jitter << ": expected a UserError";

@@ -14,16 +14,19 @@ int jitterCommand(const Args& args) {
     std::vector<size_t> chosen;
     for (const std::string& name : args.positional) {
         size_t i = 0;
-        while (i < names.size() && names[i] != name) ++i;
+        while (i < names.size() && names[i] != name)
+            ++i;
         if (i == names.size() || i == 0) {
             std::string known;
-            for (size_t k = 1; k < names.size(); ++k) known += (k > 1 ? ", " : "") + names[k];
+            for (size_t k = 1; k < names.size(); ++k)
+                known += (k > 1 ? ", " : "") + names[k];
             throw UserError("jitter: unknown pattern '" + name + "'; expected one of: " + known);
         }
         chosen.push_back(i);
     }
     if (chosen.empty())
-        for (size_t i = 1; i < names.size(); ++i) chosen.push_back(i);
+        for (size_t i = 1; i < names.size(); ++i)
+            chosen.push_back(i);
     const uint32_t frames = args.getUint("frames", 64);
     const std::filesystem::path dir = args.get("out", "out/jitter");
     std::filesystem::create_directories(dir);

@@ -18,7 +18,8 @@ const JitterPattern kGridPatterns[] = {JitterPattern::Ordered, JitterPattern::Ro
 
 std::vector<glm::dvec2> samples(JitterPattern p, uint32_t first, uint32_t count) {
     std::vector<glm::dvec2> s;
-    for (uint32_t f = first; f < first + count; ++f) s.push_back(glm::dvec2(jitterSample(p, f)));
+    for (uint32_t f = first; f < first + count; ++f)
+        s.push_back(glm::dvec2(jitterSample(p, f)));
     return s;
 }
 
@@ -61,7 +62,8 @@ double edgeDiscrepancy(const std::vector<glm::dvec2>& pts) {
     for (int step = 0; step < 720; ++step) {
         const double theta = step * M_PI / 720.0, c = std::cos(theta), s = std::sin(theta);
         std::vector<double> proj;
-        for (const auto& p : pts) proj.push_back(std::fabs(c) * (c >= 0 ? p.x : 1 - p.x) + s * p.y);
+        for (const auto& p : pts)
+            proj.push_back(std::fabs(c) * (c >= 0 ? p.x : 1 - p.x) + s * p.y);
         std::sort(proj.begin(), proj.end());
         for (size_t k = 0; k < proj.size(); ++k) {
             const double a = area(std::fabs(c), s, proj[k]);
@@ -93,7 +95,8 @@ TEST(Jitter, GridPatternsHaveOneSamplePerCellRowOrColumn) {
             std::set<int> rows, columns;
             std::set<std::pair<int, int>> cells;
             for (const auto& s : samples(p, round * 16, 16)) {
-                const int x = static_cast<int>(std::floor(s.x * g.size)), y = static_cast<int>(std::floor(s.y * g.size));
+                const int x = static_cast<int>(std::floor(s.x * g.size)),
+                          y = static_cast<int>(std::floor(s.y * g.size));
                 rows.insert(y);
                 columns.insert(x);
                 cells.insert({x, y});
@@ -113,7 +116,8 @@ TEST(Jitter, ContiguousRunsAreWellSpread) {
     // Every run of 4 and of 8 consecutive frames (any start, across the sub-grid shifts) has a star discrepancy below
     // these bounds (measured: ordered 0.54 / 0.38, rotated 0.44 / 0.25, improved 0.45 / 0.29, Halton 0.56 / 0.30);
     // the same grid sets in raster order reach 0.79-0.89 (runs of 4) and 0.55-0.67 (runs of 8).
-    for (JitterPattern p : {JitterPattern::Ordered, JitterPattern::Rotated, JitterPattern::Improved, JitterPattern::Halton}) {
+    for (JitterPattern p :
+         {JitterPattern::Ordered, JitterPattern::Rotated, JitterPattern::Improved, JitterPattern::Halton}) {
         double worst4 = 0.0, worst8 = 0.0;
         for (uint32_t start = 0; start < 64; ++start) {
             worst4 = std::max(worst4, starDiscrepancy(samples(p, start, 4)));
@@ -129,17 +133,20 @@ TEST(Jitter, ContiguousRunsAreWellSpread) {
 TEST(Jitter, SubGridShiftGivesMoreThan16PositionsAndKeepsTheMeanCentred) {
     for (JitterPattern p : kGridPatterns) {
         std::set<std::pair<float, float>> distinct;
-        for (uint32_t f = 0; f < 64; ++f) distinct.insert({jitterSample(p, f).x, jitterSample(p, f).y});
+        for (uint32_t f = 0; f < 64; ++f)
+            distinct.insert({jitterSample(p, f).x, jitterSample(p, f).y});
         EXPECT_EQ(distinct.size(), 64u) << jitterPatternNames()[static_cast<size_t>(p)];
         for (uint32_t round = 0; round < 4; ++round) {
             glm::dvec2 mean(0.0);
-            for (const auto& s : samples(p, round * 16, 16)) mean += s / 16.0;
+            for (const auto& s : samples(p, round * 16, 16))
+                mean += s / 16.0;
             EXPECT_NEAR(mean.x, 0.5, 1e-6);
             EXPECT_NEAR(mean.y, 0.5, 1e-6);
         }
     }
     std::set<std::pair<float, float>> halton;
-    for (uint32_t f = 0; f < 64; ++f) halton.insert({jitterSample(JitterPattern::Halton, f).x, jitterSample(JitterPattern::Halton, f).y});
+    for (uint32_t f = 0; f < 64; ++f)
+        halton.insert({jitterSample(JitterPattern::Halton, f).x, jitterSample(JitterPattern::Halton, f).y});
     EXPECT_GT(halton.size(), 16u);
 }
 
@@ -172,7 +179,8 @@ TEST(Jitter, StratifiedVisitsEveryCellCentreOnce) {
 }
 
 TEST(Jitter, OffIsTheCentre) {
-    for (uint32_t f = 0; f < 8; ++f) EXPECT_EQ(jitterOffset(JitterPattern::Off, f), glm::vec2(0.0f));
+    for (uint32_t f = 0; f < 8; ++f)
+        EXPECT_EQ(jitterOffset(JitterPattern::Off, f), glm::vec2(0.0f));
 }
 
 } // namespace
