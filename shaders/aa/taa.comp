@@ -113,16 +113,17 @@ void main() {
     bool valid = (pc.flags & TAA_HISTORY_VALID) != 0u && all(greaterThanEqual(prevPos, vec2(0.0))) &&
                  all(lessThanEqual(prevPos, vec2(gSize))) && length(velocity) <= pc.maxVelocity;
     if (valid && hasDepth) {
-        // Same surface: this pixel's surface was somewhere in the 3x3 around the reprojected point last frame (a
-        // window, because the sub-pixel jitter moves edges by up to a pixel between frames). A disoccluded pixel's
-        // surface was hidden there.
+        // Same surface: this pixel's surface, or the nearest one whose velocity it took, was somewhere in the 3x3
+        // around the reprojected point last frame (a window, because the sub-pixel jitter moves edges by up to a
+        // pixel between frames). A disoccluded pixel's surfaces were hidden there.
         float here = viewDepth(in_depth, p);
         ivec2 b = ivec2(floor(prevPos));
         float closest = 1e31;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 float before = viewDepth(in_history_depth, b + ivec2(dx, dy));
-                closest = min(closest, abs(before - here) / max(before, here));
+                closest = min(closest, min(abs(before - here) / max(before, here),
+                                           abs(before - nearest) / max(before, nearest)));
             }
         valid = closest <= pc.depthTolerance;
     }

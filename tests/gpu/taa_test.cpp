@@ -396,6 +396,25 @@ TEST_F(Taa, GhostingTrailOfAMovingObjectIsRejected) {
             }
         return box > 0.0 ? energy / box : 1e9;
     };
+    // The edges of the moving square keep their history (Karis: each pixel takes the velocity of the nearest surface
+    // in its 3x3, so a pixel just outside the leading edge follows the square): share of the pixels next to the
+    // square (not covered, a covered 4-neighbour) whose history was accepted.
+    {
+        auto out = runGraph(taaSceneGraph(glb, w, h, frames, json::object(), true));
+        const Image& in = out.at("in");
+        int rim = 0, kept = 0;
+        for (int y = 1; y < h - 1; ++y)
+            for (int x = 1; x < w - 1; ++x) {
+                auto covered = [&](int i, int j) { return in.at(i, j)[0] > 0.5f; };
+                if (covered(x, y) || !(covered(x - 1, y) || covered(x + 1, y) || covered(x, y - 1) || covered(x, y + 1)))
+                    continue;
+                ++rim;
+                kept += out.at("weight").at(x, y)[0] > 0.0f;
+            }
+        std::printf("moving square: history kept at %d of %d pixels around it\n", kept, rim);
+        EXPECT_GT(rim, 20);
+        EXPECT_GT(kept, 0.9 * rim);
+    }
     const double defaults = trail(json::object(), true);
     const double clampOnly = trail({{"clamp", "minmax"}}, false);
     const double depthOnly = trail({{"clamp", "none"}}, true);
