@@ -31,7 +31,7 @@ gpu_types::GpuCamera CameraFrame::gpu() const {
     c.position = glm::vec4(state.position, 1.0f);
     c.params = {state.lens.znear, state.lens.zfar, static_cast<float>(width), static_cast<float>(height)};
     c.jitter = {jitter, prevJitter};
-    c.time = {static_cast<float>(time), static_cast<float>(frame), 0.0f, 0.0f};
+    c.time = {static_cast<float>(time), static_cast<float>(frame), 0.0f, vertexJitterThreshold};
     return c;
 }
 

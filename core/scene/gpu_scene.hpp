@@ -9,6 +9,7 @@
 #include "core/gpu/buffer_set.hpp"
 #include "core/gpu/resources.hpp"
 #include "core/graph/node.hpp"
+#include "core/scene/jitter.hpp"
 #include "core/scene/scene.hpp"
 #include "shaders/scene/scene.h"
 
@@ -37,6 +38,7 @@ struct CameraFrame {
     glm::mat4 invViewProj{1.0f};
     glm::vec2 jitter{0.0f}; // pixels
     glm::vec2 prevJitter{0.0f};
+    float vertexJitterThreshold = 0.0f; // > 0: per-vertex jitter (shaders/scene/jitter.glsl), pixels per frame
     uint32_t width = 1, height = 1;
     double time = 0.0;
     uint32_t frame = 0;
@@ -47,6 +49,9 @@ struct CameraFrame {
 class CameraObject final : public PortObject {
 public:
     CameraFrame current;
+    // The scene node's jitter settings (known at setup, so consumers such as aa.accumulate can check them).
+    scene::JitterPattern jitterPattern = scene::JitterPattern::Off;
+    uint32_t jitterGrid = 16;
 };
 
 struct GpuDraw {

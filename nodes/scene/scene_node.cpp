@@ -29,28 +29,29 @@ void addSceneNodeSchema(NodeSchema& s) {
     s.params.push_back({"anisotropy", ParamType::Float, -1.0, -1.0, 16.0, {},
                         "Anisotropic texture filtering (1 = off). -1: 8x on GPUs, off on CPU devices (lavapipe's "
                         "software anisotropic filtering takes minutes per frame)"});
-    s.params.push_back({"jitter", ParamType::Bool, false, {}, {}, {},
-                        "Sub-pixel Halton(2,3) jitter of the projection, for temporal anti-aliasing"});
-}
-
-glm::vec2 haltonJitter(uint32_t frame) {
-    auto halton = [](uint32_t i, uint32_t base) {
-        float f = 1.0f, r = 0.0f;
-        for (; i > 0; i /= base) {
-            f /= static_cast<float>(base);
-            r += f * static_cast<float>(i % base);
-        }
-        return r;
-    };
-    uint32_t i = frame % 8 + 1;
-    return {halton(i, 2) - 0.5f, halton(i, 3) - 0.5f};
+    s.params.push_back({"jitter", ParamType::Enum, "off", {}, {}, scene::jitterPatternNames(),
+                        "Sub-pixel jitter of the projection, for temporal AA (core/scene/jitter.hpp): halton (2,3); "
+                        "ordered 4x4 grid; rotated grid (16-rooks); improved (16-rooks, no weak edge direction); the "
+                        "16-sample grids move inside their sub-grid cells every 16 frames. stratified: jitter_grid^2 "
+                        "cell centres in turn, for aa.accumulate's supersampled ground truth"});
+    s.params.push_back({"jitter_grid", ParamType::Int, 0, 0.0, 64.0, {},
+                        "N of the stratified pattern: N x N sub-pixel positions, one per frame. 0: the largest N with "
+                        "N^2 <= the graph's frame count (as aa.accumulate's grid 0)"});
+    s.params.push_back({"jitter_space", ParamType::Enum, "frustum", {}, {}, {"frustum", "vertex"},
+                        "frustum: the whole projection is shifted; vertex: each vertex is shifted in the vertex stage, "
+                        "less the faster it moves on screen (static pixels supersample, moving ones do not wobble)"});
+    s.params.push_back({"vertex_jitter_threshold", ParamType::Float, 2.0, 0.01, 1000.0, {},
+                        "jitter_space vertex: screen speed (pixels per frame) at and above which a vertex is not "
+                        "jittered; slower vertices get (1 - speed / threshold) of the jitter"});
 }
 
 void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> scene) {
     const Params& p = ctx.params();
     mFps = p.getFloat("fps");
     mStart = p.getFloat("start");
-    mJitter = p.getBool("jitter");
+    mJitter = static_cast<scene::JitterPattern>(p.getEnumIndex("jitter"));
+    mJitterGrid = scene::jitterGridFor(static_cast<uint32_t>(p.getInt("jitter_grid")), ctx.frame().frames);
+    mVertexJitterThreshold = p.getString("jitter_space") == "vertex" ? p.getFloat("vertex_jitter_threshold") : 0.0f;
     mCameraPath = p.getString("camera");
     if (!mCameraPath.empty()) {
         if (!scene->findCameraPath(mCameraPath)) {
@@ -71,6 +72,8 @@ void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> s
     mScene = std::make_shared<SceneObject>(std::move(scene));
     mScene->anisotropy = p.getFloat("anisotropy");
     mCamera = std::make_shared<CameraObject>();
+    mCamera->jitterPattern = mJitter;
+    mCamera->jitterGrid = mJitterGrid;
     ctx.setObject("scene", mScene);
     ctx.setObject("camera", mCamera);
     mCamera->current.width = ctx.frame().width;
@@ -125,8 +128,9 @@ void SceneNode::execute(ExecuteContext& ctx) {
     mLastFrame = frame;
 
     c.projNoJitter = c.state.projection(aspect, true);
-    c.prevJitter = frame == 0 || !mJitter ? glm::vec2(0.0f) : haltonJitter(frame - 1);
-    c.jitter = mJitter ? haltonJitter(frame) : glm::vec2(0.0f);
+    c.prevJitter = frame == 0 ? glm::vec2(0.0f) : scene::jitterOffset(mJitter, frame - 1, mJitterGrid);
+    c.jitter = scene::jitterOffset(mJitter, frame, mJitterGrid);
+    c.vertexJitterThreshold = mVertexJitterThreshold;
     glm::mat4 shift = glm::translate(glm::mat4(1.0f), glm::vec3(2.0f * c.jitter.x / c.width, 2.0f * c.jitter.y / c.height, 0.0f));
     c.proj = shift * c.projNoJitter;
     c.viewProj = c.proj * c.state.view;

@@ -4,6 +4,7 @@
 
 #include "core/graph/node.hpp"
 #include "core/scene/gpu_scene.hpp"
+#include "core/scene/jitter.hpp"
 
 #include <memory>
 #include <string>
@@ -30,12 +31,11 @@ private:
     int mCameraNode = -1;
     float mFps = 24.0f;
     float mStart = 0.0f;
-    bool mJitter = false;
+    scene::JitterPattern mJitter = scene::JitterPattern::Off;
+    uint32_t mJitterGrid = 16;
+    float mVertexJitterThreshold = 0.0f; // 0: frustum jitter
     bool mEvaluated = false; // pose and camera of mLastFrame are in mScene / mCamera
     uint32_t mLastFrame = 0;
 };
-
-// Halton(2, 3) sub-pixel offsets in pixels, in (-0.5, 0.5), cycling over 8 frames.
-glm::vec2 haltonJitter(uint32_t frame);
 
 } // namespace vitrine

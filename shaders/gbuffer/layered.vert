@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "scene/scene.glsl"
+#include "scene/jitter.glsl"
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
@@ -31,5 +32,5 @@ void main() {
     vClip = camera.viewProjNoJitter * world;
     vPrevClip = camera.prevViewProjNoJitter * prevWorld;
     vViewDepth = -(camera.view * world).z;
-    gl_Position = camera.viewProj * world;
+    gl_Position = jitteredClip(world, vClip, vPrevClip);
 }

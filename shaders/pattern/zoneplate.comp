@@ -23,7 +23,7 @@ void main() {
     float sum = 0.0;
     for (uint j = 0u; j < n; ++j)
         for (uint i = 0u; i < n; ++i)
-            sum += plate(vec2(p) + (vec2(i, j) + 0.5) / float(n), centre, radius);
+            sum += plate(vec2(p) + (vec2(i, j) + 0.5) / float(n) + (zp.samplePos - 0.5), centre, radius);
     float v = sum / float(n * n);
     imageStore(out_color, p, vec4(v, v, v, 1.0));
 }

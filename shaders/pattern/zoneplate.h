@@ -13,9 +13,11 @@ VITRINE_PUSH_BEGIN(ZoneplatePush)
     uint supersample;   // N: N x N stratified samples per pixel, box filter
     uint mode;          // ZONEPLATE_*
     float pad;
+    vec2 samplePos;     // this frame's sample position in the pixel (0.5, 0.5 = centre), core/scene/jitter.hpp
+    vec2 pad2;
 VITRINE_PUSH_END(zp)
 #ifdef __cplusplus
-static_assert(sizeof(ZoneplatePush) == 16);
+static_assert(sizeof(ZoneplatePush) == 32);
 }
 #endif
 #endif

@@ -63,7 +63,8 @@ struct GpuCamera {
     vec4 position;            // world, w = 1
     vec4 params;              // x: near, y: far (0 = infinite), z: width, w: height (pixels)
     vec4 jitter;              // xy: this frame's jitter in pixels, zw: last frame's
-    vec4 time;                // x: seconds, y: frame index, z: ev100 (physical camera), w: 0
+    vec4 time;                // x: seconds, y: frame index, z: ev100 (physical camera), w: per-vertex jitter
+                              // threshold in pixels per frame (0: the jitter is the frustum's, in viewProj)
 };
 
 // Push constants of every scene draw. Compute passes that read the scene with push constants of their own

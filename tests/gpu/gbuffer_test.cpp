@@ -401,7 +401,7 @@ struct VelocityRun {
 };
 
 VelocityRun runVelocity(const std::filesystem::path& glb, bool jitter) {
-    auto out = runGraph(gbufferGraph(glb, kVW, kVH, {{"fps", kFps}, {"start", kStart}, {"jitter", jitter}}, json::object(), kFrames));
+    auto out = runGraph(gbufferGraph(glb, kVW, kVH, {{"fps", kFps}, {"start", kStart}, {"jitter", jitter ? "halton" : "off"}}, json::object(), kFrames));
     return {out["velocity"], out["normal"], out["depth"]};
 }
 
@@ -416,7 +416,7 @@ struct VelocityStats {
 VelocityStats compareVelocity(const VelocityRun& plain, const VelocityRun& jittered,
                               const std::function<glm::dvec3(glm::dvec2)>& expected) {
     VelocityStats st;
-    const glm::vec2 j = haltonJitter(kFrames - 1);
+    const glm::vec2 j = scene::jitterOffset(scene::JitterPattern::Halton, kFrames - 1);
     for (int y = 0; y < kVH; ++y)
         for (int x = 0; x < kVW; ++x) {
             if (plain.depth.at(x, y)[0] <= 0.0f) continue;

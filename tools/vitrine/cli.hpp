@@ -35,5 +35,6 @@ int devicesCommand(const Args& args);
 int compareCommand(const Args& args);
 int goldenCommand(const Args& args);
 int exportSceneCommand(const Args& args);
+int jitterCommand(const Args& args);
 
 } // namespace vitrine::cli

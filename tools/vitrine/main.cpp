@@ -39,6 +39,9 @@ commands:
       --skip-missing: exit 77 (skipped) when this device class has no goldens yet.
   export-scene museum|FILE OUT.glb [--seed N] [--texture-size N] [--force]
       Write the procedural museum (or re-write a glTF file) as glTF binary for other tools.
+  jitter [PATTERN]... [--out DIR] [--frames N]
+      Plot the camera jitter patterns (halton, ordered, rotated, improved, stratified) as SVG:
+      the first 16 samples numbered in order, later frames (sub-grid shifts) as dots.
   devices                           List Vulkan devices.
 
 common options:
@@ -75,6 +78,7 @@ int main(int argc, char** argv) {
         if (args.command == "compare") return cli::compareCommand(args);
         if (args.command == "golden") return cli::goldenCommand(args);
         if (args.command == "export-scene") return cli::exportSceneCommand(args);
+        if (args.command == "jitter") return cli::jitterCommand(args);
         throw UserError("unknown command '" + args.command + "'; run `vitrine help`");
     } catch (const UserError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());
