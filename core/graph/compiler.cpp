@@ -232,9 +232,12 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
         for (const auto& u : g.passes[pi].uses) {
             GraphResource& r = g.resources[u.resource];
             r.desc.usage |= usageFlags(u.usage);
-            if (!u.output)
+            if (!u.output) {
                 if (const InputPort* in = g.passes[pi].schema->findInput(u.port); in && in->readBack)
                     r.desc.usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+            } else if (const OutputPort* out = g.passes[pi].schema->findOutput(u.port); out && out->readBack) {
+                r.desc.usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+            }
             if (!u.previous) r.lastPass = std::max(r.lastPass, pi);
         }
     }

@@ -54,6 +54,9 @@ struct OutputPort {
     Usage usage = Usage::StorageWrite;
     bool persistent = false; // contents survive across frames (uploaded once, accumulated, ...)
     std::string doc;
+    // The node copies this output to the host itself (after ExecuteContext::splitSubmission, with readImage):
+    // its image gets VK_IMAGE_USAGE_TRANSFER_SRC_BIT.
+    bool readBack = false;
 };
 
 enum class ParamType { Bool, Int, Float, Vec2, Vec3, Vec4, String, Enum, Path };

@@ -1,12 +1,16 @@
 // render.pathtrace: progressive path-traced reference of the scene camera (shaders/render/pathtrace.comp).
 #include "shaders/render/pathtrace.h"
 #include "core/accel/gpu_bvh.hpp"
+#include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
+#include "core/gpu/transfer.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
 
 #include <algorithm>
 #include <array>
+#include <chrono>
+#include <cstdio>
 #include <memory>
 #include <string>
 
@@ -54,6 +58,7 @@ NodeSchema schema() {
     color.doc = "Mean radiance (cd/m², rgb) of all samples since the last restart; a = 1";
     OutputPort stats = color;
     stats.name = "stats";
+    stats.readBack = true; // the progress line's noise estimate
     stats.doc = "x: samples per pixel since the restart; y: mean luminance; z: sum of squared deviations of the "
                 "samples' luminance; w: standard error of the mean luminance (cd/m²)";
     s.outputs = {color, stats};
@@ -100,6 +105,14 @@ NodeSchema schema() {
          {},
          {},
          "Jitter camera rays over the pixel (off: through pixel centres)"},
+        {"report",
+         ParamType::Bool,
+         true,
+         {},
+         {},
+         {},
+         "A progress bar while a frame traces, then its samples per pixel, time and estimated noise (reads `stats` "
+         "back once a frame)"},
         {"seed",
          ParamType::Int,
          0,
@@ -145,6 +158,15 @@ public:
         const uint32_t seed = static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu;
         const uint32_t spp = static_cast<uint32_t>(p.getInt("spp"));
         const ImageDesc& out = ctx.output("color").desc();
+        const auto start = std::chrono::steady_clock::now();
+        const bool report = p.getBool("report");
+        const uint32_t chunks = (spp + PATHTRACE_SAMPLES_PER_DISPATCH - 1) / PATHTRACE_SAMPLES_PER_DISPATCH;
+        const uint32_t every = std::max(1u, chunks / 10);
+        std::unique_ptr<Progress> bar;
+        if (report && chunks >= 4)
+            bar = std::make_unique<Progress>("path tracing " + std::to_string(out.width) + "x" +
+                                                 std::to_string(out.height) + " at " + std::to_string(spp) + " spp",
+                                             chunks);
         std::array<VkDescriptorSetLayout, 3> layouts = {bvh.setLayout(), gpu.setLayout(), geometry.layout()};
         std::array<VkDescriptorSet, 3> sets = {bvh.set(), gpu.set(), geometry.set()};
         for (uint32_t done = 0, chunk = 0; done < spp; ++chunk) {
@@ -155,8 +177,48 @@ public:
             if (done > 0) ctx.computeBarrier();
             ctx.dispatchWithSets(mPipeline, &push, sizeof(push), out.width, out.height, layouts, sets);
             done += count;
+            if (bar && (chunk + 1) % every == 0 && done < spp) {
+                ctx.splitSubmission(); // so the bar moves with the GPU's work
+                bar->advance(every);
+            }
         }
+        if (report) reportFrame(ctx, start);
     }
+
+private:
+    // Waits for the frame, then prints the samples per pixel since the restart, the frame's time and the median
+    // (and 90th percentile) of the per-pixel standard error relative to the pixel's mean luminance.
+    void reportFrame(ExecuteContext& ctx, std::chrono::steady_clock::time_point start) {
+        ctx.splitSubmission();
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const Image stats = readImage(ctx.gpu(), ctx.output("stats"), VK_IMAGE_LAYOUT_GENERAL);
+        std::vector<float> relative;
+        relative.reserve(static_cast<size_t>(stats.width) * stats.height);
+        float samples = 0.0f;
+        for (int y = 0; y < stats.height; ++y)
+            for (int x = 0; x < stats.width; ++x) {
+                const float* s = stats.at(x, y);
+                samples = std::max(samples, s[0]);
+                if (s[1] > 0.0f) relative.push_back(s[3] / s[1]);
+            }
+        std::string noise = "no lit pixel";
+        if (!relative.empty()) {
+            auto at = [&](double q) {
+                auto it = relative.begin() + static_cast<std::ptrdiff_t>(q * double(relative.size() - 1));
+                std::nth_element(relative.begin(), it, relative.end());
+                return *it * 100.0f;
+            };
+            char text[96];
+            std::snprintf(text, sizeof text, "standard error %.1f %% of the pixel's mean (median), %.1f %% (p90)",
+                          at(0.5), at(0.9));
+            noise = text;
+        }
+        char line[160];
+        std::snprintf(line, sizeof line, "render.pathtrace: %.0f spp accumulated, frame %.1f s; ", samples, seconds);
+        logInfo(line + noise);
+    }
+
+public:
 
 private:
     std::shared_ptr<SceneObject> mScene;

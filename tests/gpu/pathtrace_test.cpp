@@ -349,7 +349,13 @@ TEST_F(PathTrace, AccumulationConvergesAndRestartsWhenTheCameraMoves) {
     json sky = uniformSky(glb, C);
     json params = {{"spp", 4}, {"antialias", false}};
     auto one = runGraph(traceGraph(glb, sky, params, W, H, 1, true));
+    // The progress line of every frame reports the samples accumulated so far and the estimated noise.
+    ::testing::internal::CaptureStderr();
     auto many = runGraph(traceGraph(glb, sky, params, W, H, 16, true));
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(log.find("render.pathtrace: 4 spp accumulated"), std::string::npos) << log;
+    EXPECT_NE(log.find("render.pathtrace: 64 spp accumulated"), std::string::npos) << log;
+    EXPECT_NE(log.find("of the pixel's mean (median)"), std::string::npos) << log;
     Pinhole cam(s, W, H);
     double seOne = 0.0, seMany = 0.0, sumOne = 0.0, sumMany = 0.0;
     int n = 0;
