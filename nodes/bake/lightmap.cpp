@@ -83,10 +83,7 @@ NodeSchema schema() {
     return s;
 }
 
-uint64_t hashImage(const Image& image, scene::Hasher& h) {
-    h.array(image.pixels);
-    return h.result();
-}
+void hashImage(const Image& image, scene::Hasher& h) { h.array(image.pixels); }
 
 class LightmapBake final : public Node {
 public:
