@@ -9,7 +9,6 @@
 #include "common/brdf.glsl"
 #include "forward/transparent.h"
 #include "lighting/ambient.glsl"
-#include "lighting/sun_shadow.glsl"
 
 // Set 0: the node's uniforms and inputs; set 1: the scene (VITRINE_SCENE_SET, defined by the node).
 // forward.transparent: alpha-blended and transmissive (thin glass) surfaces over the lit opaque colour, lit by
@@ -21,6 +20,8 @@
 // With no transmission this is the usual "over" of the lit colour with its coverage alpha.
 layout(set = 0, binding = 0) uniform Uniforms { TransparentUniforms u; };
 #define VITRINE_LIGHTS u.lights
+#define VITRINE_SHADOW u.shadow
+#include "lighting/sun_shadow.glsl"
 #include "lighting/punctual.glsl"
 layout(set = 0, binding = 1) uniform sampler2D in_shadow_map;
 layout(set = 0, binding = 2) uniform sampler2D in_sky_sh;
@@ -68,7 +69,7 @@ void main() {
     vec3 sunE = texelFetch(in_sky_sh, ivec2(9, 0), 0).rgb * u.params.z;
     vec3 l = normalize(texelFetch(in_sky_sh, ivec2(10, 0), 0).xyz);
 
-    float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, u.shadow, world, N, vViewDepth) : 1.0;
+    float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, N, vViewDepth) : 1.0;
     vec3 direct = brdfCosineF0(N, v, l, diffuseColor, f0, roughness) * sunE * visibility * cavity;
     direct += shadePunctual(world, N, v, diffuseColor, f0, roughness) * cavity;
     float occlusion = u.params.x * vColor.a * cavity;

@@ -5,7 +5,6 @@
 #include "common/octahedral.glsl"
 #include "common/sh.glsl"
 #include "lighting/ambient.glsl"
-#include "lighting/sun_shadow.glsl"
 #include "bake/irradiance_volume.glsl"
 
 // Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance GGX/Smith/Schlick + Lambert for the sun with
@@ -30,6 +29,8 @@ layout(binding = 9) writeonly uniform image2D out_specular_indirect;
 layout(binding = 10) uniform Uniforms { DeferredUniforms u; };
 layout(binding = 11) uniform sampler2D in_volume;
 #define VITRINE_LIGHTS u.lights
+#define VITRINE_SHADOW u.shadow
+#include "lighting/sun_shadow.glsl"
 #include "lighting/punctual.glsl"
 
 void main() {
@@ -71,7 +72,7 @@ void main() {
     vec3 l = normalize(texelFetch(in_sky_sh, ivec2(10, 0), 0).xyz);
 
     // Sun: E / pi is the light's intensity in the pi convention of brdf.glsl.
-    float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, u.shadow, world, n, viewDepth) : 1.0;
+    float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, n, viewDepth) : 1.0;
     vec3 direct = shadeDirectional(n, v, l, baseColor, metallic, roughness, sunE / kPi) * visibility * cavity;
 
     // Indirect light: baked (lightmap in the emissive channel, or the irradiance volume), else the sky's SH

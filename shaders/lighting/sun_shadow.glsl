@@ -4,6 +4,13 @@
 #define LIGHTING_SUN_SHADOW_GLSL
 #include "shadow/cascades.h"
 
+// VITRINE_SHADOW names the shader's ShadowCascades (a uniform member). It is read in place, not passed as an
+// argument: a copy of the struct, indexed by cascade, costs lavapipe a scratch array per invocation (the
+// deferred pass ran about 1.7x slower that way).
+#ifndef VITRINE_SHADOW
+#error "define VITRINE_SHADOW (the ShadowCascades to read) before including lighting/sun_shadow.glsl"
+#endif
+
 float shadowTap(sampler2D shadowMap, ivec2 texel, float depth) {
     ivec2 size = textureSize(shadowMap, 0);
     texel = clamp(texel, ivec2(0), size - 1);
@@ -11,18 +18,18 @@ float shadowTap(sampler2D shadowMap, ivec2 texel, float depth) {
 }
 
 // Bilinear-weighted PCF: every tap compares 2x2 texels and interpolates the results; taps on a grid
-// of radius sc.lightDir.w texels around the point p (world) with normal n, at linear view depth viewDepth.
-float sunVisibility(sampler2D shadowMap, ShadowCascades sc, vec3 p, vec3 n, float viewDepth) {
-    int count = int(sc.params.x);
+// of radius lightDir.w texels around the point p (world) with normal n, at linear view depth viewDepth.
+float sunVisibility(sampler2D shadowMap, vec3 p, vec3 n, float viewDepth) {
+    int count = int(VITRINE_SHADOW.params.x);
     int c = 0;
-    while (c < count - 1 && viewDepth > sc.splits[c]) ++c;
-    if (viewDepth > sc.splits[count - 1]) return 1.0;
-    vec3 offsetP = p + n * sc.params.w * sc.texelWorld[c];
-    vec4 s = sc.worldToShadow[c] * vec4(offsetP, 1.0);
-    float atlas = sc.params.y;
+    while (c < count - 1 && viewDepth > VITRINE_SHADOW.splits[c]) ++c;
+    if (viewDepth > VITRINE_SHADOW.splits[count - 1]) return 1.0;
+    vec3 offsetP = p + n * VITRINE_SHADOW.params.w * VITRINE_SHADOW.texelWorld[c];
+    vec4 s = VITRINE_SHADOW.worldToShadow[c] * vec4(offsetP, 1.0);
+    float atlas = VITRINE_SHADOW.params.y;
     vec2 st = s.xy * atlas - 0.5;
     float depth = s.z;
-    int r = int(ceil(sc.lightDir.w));
+    int r = int(ceil(VITRINE_SHADOW.lightDir.w));
     float sum = 0.0, weight = 0.0;
     for (int y = -r; y <= r; ++y)
         for (int x = -r; x <= r; ++x) {
