@@ -8,6 +8,7 @@
 #include "core/gpu/vk_check.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
+#include "nodes/bake/baked_lighting.hpp"
 #include "nodes/lighting/punctual_lights.hpp"
 #include "nodes/shadow/cascades.hpp"
 
@@ -49,6 +50,9 @@ NodeSchema schema() {
         tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
         tex("sky", "A sky node's cube map (reflections)"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera (the sort's eye point)"},
+        {"volume", PortKind::Texture, {}, true, Usage::Sampled,
+         "bake.lightmap's irradiance volume: the ambient terms lighting.deferred uses for what has no lightmap"},
+        {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's `layout` (with `volume`)"},
     };
     OutputPort color;
     color.name = "color";
@@ -88,8 +92,9 @@ bool linearFilterable(Context& ctx, VkFormat format) {
     return (props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT) != 0;
 }
 
-// Set 0 of the pipelines (set 1 is the scene's): binding 0 the uniforms, 1-4 the sampled inputs.
-constexpr std::array<const char*, 4> kSampled = {"shadow_map", "sky_sh", "sky", "color"};
+// Set 0 of the pipelines (set 1 is the scene's): binding 0 the uniforms, 1-5 the sampled inputs. Without a
+// volume, binding 5 holds sky_sh instead (the shader never reads it when the volume's counts are zero).
+constexpr std::array<const char*, 5> kSampled = {"shadow_map", "sky_sh", "sky", "color", "volume"};
 
 class Transparent final : public Node {
 public:
@@ -98,6 +103,9 @@ public:
         mCamera = ctx.objectAs<CameraObject>("camera");
         mCascades = ctx.objectAs<ShadowCascadesObject>("cascades");
         mSort = ctx.params().getString("sort") == "back_to_front";
+        if (ctx.hasInput("volume") != ctx.hasInput("baked"))
+            ctx.failParam("sky_ambient", "connect both volume and baked (bake.lightmap's volume and layout), or neither");
+        if (ctx.hasInput("baked")) mBaked = ctx.objectAs<BakedLightingObject>("baked");
         warnLightCount(mScene->scene(), "forward.transparent");
     }
 
@@ -192,6 +200,10 @@ private:
                     p.getFloat("emissive_scale")};
         u.shadow = mCascades->data;
         u.lights = packPunctualLights(*mScene);
+        if (mBaked) {
+            u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
+            u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
+        }
         std::memcpy(mUniforms.mapped(), &u, sizeof(u));
 
         VkDescriptorBufferInfo bi{mUniforms.buffer(), 0, sizeof(TransparentUniforms)};
@@ -204,7 +216,8 @@ private:
         w[0].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
         w[0].pBufferInfo = &bi;
         for (uint32_t i = 0; i < kSampled.size(); ++i) {
-            const GpuImage& image = ctx.input(kSampled[i]);
+            const std::string port = std::string(kSampled[i]) == "volume" && !mBaked ? "sky_sh" : kSampled[i];
+            const GpuImage& image = ctx.input(port);
             ii[i] = {std::string(kSampled[i]) == "sky" && linearFilterable(ctx.gpu(), image.desc().format) ? mLinear
                                                                                                            : mNearest,
                      image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
@@ -304,6 +317,7 @@ private:
     std::shared_ptr<SceneObject> mScene;
     std::shared_ptr<CameraObject> mCamera;
     std::shared_ptr<ShadowCascadesObject> mCascades;
+    std::shared_ptr<BakedLightingObject> mBaked;
     bool mSort = true;
     Context* mContext = nullptr;
     VkDevice mDevice = VK_NULL_HANDLE;

@@ -9,6 +9,7 @@
 #include "common/brdf.glsl"
 #include "forward/transparent.h"
 #include "lighting/ambient.glsl"
+#include "bake/irradiance_volume.glsl"
 
 // Set 0: the node's uniforms and inputs; set 1: the scene (VITRINE_SCENE_SET, defined by the node).
 // forward.transparent: alpha-blended and transmissive (thin glass) surfaces over the lit opaque colour, lit by
@@ -26,6 +27,7 @@ layout(set = 0, binding = 0) uniform Uniforms { TransparentUniforms u; };
 layout(set = 0, binding = 1) uniform sampler2D in_shadow_map;
 layout(set = 0, binding = 2) uniform sampler2D in_sky_sh;
 layout(set = 0, binding = 3) uniform samplerCube in_sky;
+layout(set = 0, binding = 5) uniform sampler2D in_volume; // bound to another image, never read, without a volume
 
 layout(location = 0) in vec3 vNormal;
 layout(location = 1) in vec4 vTangent;
@@ -72,9 +74,14 @@ void main() {
     float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, N, vViewDepth) : 1.0;
     vec3 direct = brdfCosineF0(N, v, l, diffuseColor, f0, roughness) * sunE * visibility * cavity;
     direct += shadePunctual(world, N, v, diffuseColor, f0, roughness) * cavity;
-    float occlusion = u.params.x * vColor.a * cavity;
-    vec3 diffuse = skyDiffuse(sh, N, diffuseColor) * occlusion;
-    vec3 specular = skySpecular(in_sky, sh, N, v, f0, roughness) * occlusion;
+    // The same indirect terms as lighting.deferred: bake.lightmap's irradiance volume where it is connected
+    // (transparent surfaces have no lightmap), else the sky scaled by sky_ambient.
+    vec3 volume[9];
+    bool baked = volumeSh(in_volume, u.volumeOrigin, u.volumeCounts.xyz, world, N, volume);
+    float occlusion = baked ? vColor.a * cavity : u.params.x * vColor.a * cavity;
+    vec3 diffuse = skyDiffuse(baked ? volume : sh, N, diffuseColor) * occlusion;
+    vec3 specular = (baked ? volumeSpecular(volume, N, v, f0, roughness) : skySpecular(in_sky, sh, N, v, f0, roughness)) *
+                    occlusion;
     vec3 lit = direct + diffuse + specular + emissive * u.params.w;
 
     // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour

@@ -11,12 +11,14 @@ namespace vitrine::gpu_types {
 // Uniforms of forward.transparent (set 1, binding 0), filled per frame; the same parameters as lighting.deferred.
 struct TransparentUniforms {
     vec4 params; // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
+    vec4 volumeOrigin;  // bake.lightmap's irradiance volume: xyz probe (0, 0, 0), w spacing (m)
+    uvec4 volumeCounts; // xyz probes per axis (0: no volume connected)
     ShadowCascades shadow;
     PunctualLights lights;
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(TransparentUniforms) == 16 + sizeof(ShadowCascades) + sizeof(PunctualLights));
+static_assert(sizeof(TransparentUniforms) == 48 + sizeof(ShadowCascades) + sizeof(PunctualLights));
 }
 #endif
 #endif
