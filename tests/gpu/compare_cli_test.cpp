@@ -3,6 +3,7 @@
 // supersampled ground truth, the report exists and parses, bad input exits 1 naming the file, a perturbed render
 // fails the golden check), not numbers the code under test produced.
 #include "core/image/io.hpp"
+#include "tests/gpu/cli.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -24,47 +25,6 @@ using nlohmann::json;
 const std::string kSource = VITRINE_SOURCE_DIR;
 const std::string kSmall = "--set frame.width=160 --set frame.height=90";
 
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s)
-        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-struct CliResult {
-    int status = -1; // exit status, or -1 when the program did not exit normally
-    std::string output;
-};
-
-// Runs `vitrine ARGS` with stderr merged into stdout.
-CliResult vitrine(const std::string& args) {
-    const std::string command = quote(VITRINE_BINARY) + " " + args + " 2>&1";
-    CliResult r;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return r;
-    char buffer[4096];
-    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
-        r.output.append(buffer, n);
-    const int status = pclose(pipe);
-    if (WIFEXITED(status)) r.status = WEXITSTATUS(status);
-    return r;
-}
-
-// A fresh, empty directory per test under the build tree.
-fs::path freshDir(const std::string& name) {
-    const fs::path dir = fs::path(VITRINE_TEST_OUT) / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string readText(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
 const json* findPair(const json& metrics, const std::string& test, const std::string& reference) {
     for (const json& p : metrics["pairs"])
         if (p["test"] == test && p["reference"] == reference) return &p;
@@ -85,7 +45,7 @@ TEST(CompareCli, FxaaBeatsNoAaAgainstTheSupersampledReference) {
                                 quote(kSource + "/graphs/variants/supersampled.json") + " " + kSmall +
                                 " --validate --quiet --out " + quote(out.string()));
     ASSERT_EQ(r.status, 0) << r.output;
-    const json metrics = json::parse(readText(out / "metrics.json"));
+    const json metrics = json::parse(readFile(out / "metrics.json"));
     const json* fxaa = findPair(metrics, "A", "reference");
     const json* none = findPair(metrics, "B", "reference");
     ASSERT_TRUE(fxaa && none) << metrics.dump(2);
@@ -102,7 +62,7 @@ TEST(CompareCli, FxaaBeatsNoAaAgainstTheSupersampledReference) {
         removedFxaa |= c["op"] == "removed" && c["pointer"] == "/nodes/fxaa";
     EXPECT_TRUE(removedFxaa) << metrics["graphChanges"].dump(2);
 
-    const std::string html = readText(out / "report.html");
+    const std::string html = readFile(out / "report.html");
     EXPECT_NE(html.find("<html"), std::string::npos);
     EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
     // Self-contained: nothing is fetched from the network.
@@ -122,7 +82,7 @@ TEST(CompareCli, FramesRangeAddsTemporalMetrics) {
                 quote(kSource + "/graphs/variants/no_fxaa.json") +
                 " --set frame.width=48 --set frame.height=32 --frames 1:3 --validate --quiet --out " + quote(out.string()));
     ASSERT_EQ(r.status, 0) << r.output;
-    const json metrics = json::parse(readText(out / "metrics.json"));
+    const json metrics = json::parse(readFile(out / "metrics.json"));
     ASSERT_EQ(metrics["temporal"].size(), 3u);
     for (const json& t : metrics["temporal"]) {
         EXPECT_EQ(t["frames"], 3);
@@ -191,12 +151,12 @@ TEST(CompareCli, DoesNotOverwriteFilesItDidNotWriteUnlessForced) {
     const CliResult refused = vitrine(args);
     EXPECT_EQ(refused.status, 1) << refused.output;
     EXPECT_NE(refused.output.find("--force"), std::string::npos) << refused.output;
-    EXPECT_EQ(readText(dir / "out" / "report.html"), "mine");
+    EXPECT_EQ(readFile(dir / "out" / "report.html"), "mine");
     EXPECT_FALSE(fs::exists(dir / "out" / "a.png"));
 
     const CliResult forced = vitrine(args + " --force");
     ASSERT_EQ(forced.status, 0) << forced.output;
-    EXPECT_NE(readText(dir / "out" / "report.html"), "mine");
+    EXPECT_NE(readFile(dir / "out" / "report.html"), "mine");
     // What vitrine wrote itself it may replace on the next run without being told.
     EXPECT_EQ(vitrine(args).status, 0);
 }
@@ -212,7 +172,7 @@ TEST(GoldenCli, PerturbedRenderFailsTheCheckAndWritesAReport) {
     EXPECT_NE(r.output.find("FAIL fxaa_zoneplate"), std::string::npos) << r.output;
     EXPECT_TRUE(fs::is_regular_file(out / "fxaa_zoneplate" / "report.html"));
     EXPECT_TRUE(fs::is_regular_file(out / "fxaa_zoneplate" / "flip.png"));
-    const json metrics = json::parse(readText(out / "fxaa_zoneplate" / "metrics.json"));
+    const json metrics = json::parse(readFile(out / "fxaa_zoneplate" / "metrics.json"));
     EXPECT_GT(metrics["pairs"][0]["flip"]["mean"].get<double>(), 0.002);
 }
 

@@ -6,6 +6,7 @@
 #include "core/gpu/memory_budget.hpp"
 #include "core/image/io.hpp"
 #include "gpu_test.hpp"
+#include "tests/gpu/cli.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -34,50 +35,6 @@ using nlohmann::json;
 const std::string kSource = VITRINE_SOURCE_DIR;
 const std::string kZoneplate = kSource + "/graphs/fxaa_zoneplate.json";
 const std::string kTiny = "--set frame.width=32 --set frame.height=18";
-
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s)
-        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-struct CliResult {
-    int status = -1;    // exit status, or -1 when the program did not exit normally
-    int signal = 0;     // the signal that ended it, if one did
-    std::string output; // stdout and stderr
-};
-
-// Runs `ENV vitrine ARGS` through the shell with stderr merged into stdout.
-CliResult vitrine(const std::string& args, const std::string& env = "") {
-    const std::string command = env + (env.empty() ? "" : " ") + quote(VITRINE_BINARY) + " " + args + " 2>&1";
-    CliResult r;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return r;
-    char buffer[4096];
-    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
-        r.output.append(buffer, n);
-    const int status = pclose(pipe);
-    if (WIFEXITED(status)) r.status = WEXITSTATUS(status);
-    // The shell reports a child killed by signal N as exit status 128 + N (or is itself replaced by the child).
-    if (r.status > 128) r.signal = r.status - 128;
-    if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
-    return r;
-}
-
-fs::path freshDir(const std::string& name) {
-    const fs::path dir = fs::path(VITRINE_TEST_OUT) / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string readFile(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 std::vector<std::string> temporaryFiles(const fs::path& dir) {
     std::vector<std::string> found;

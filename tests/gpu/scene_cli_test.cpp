@@ -1,6 +1,7 @@
 // `vitrine run graphs/gltf.json --scene FILE`: a small glTF written by the test (a red ball far from the origin, no
 // camera, no lights of its own) renders centred by the automatic framing and exposed within a band by the graph's
 // metered daylight exposure; --scene's user errors. The real binary, validation on, at a small size.
+#include "tests/gpu/cli.hpp"
 #include "tests/gpu/lighting_scene.hpp"
 
 #include "core/image/io.hpp"
@@ -19,25 +20,6 @@ using namespace lighting;
 
 const std::string kSource = VITRINE_SOURCE_DIR;
 
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s)
-        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-// Exit status and merged output of `vitrine ARGS`.
-std::pair<int, std::string> vitrine(const std::string& args) {
-    std::string out;
-    FILE* pipe = popen((quote(VITRINE_BINARY) + " " + args + " 2>&1").c_str(), "r");
-    if (!pipe) return {-1, out};
-    char buffer[4096];
-    for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;)
-        out.append(buffer, n);
-    int status = pclose(pipe);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
 class SceneCli : public GpuTest {};
 
 TEST_F(SceneCli, SceneShorthandFramesAndExposesASmallModel) {
@@ -51,11 +33,11 @@ TEST_F(SceneCli, SceneShorthandFramesAndExposesASmallModel) {
     const fs::path glb = b.write();
     const fs::path out = fs::path(VITRINE_TEST_OUT) / "scene_shorthand";
     fs::remove_all(out);
-    auto [status, text] =
+    const CliResult r =
         vitrine("run " + quote(kSource + "/graphs/gltf.json") + " --scene " + quote(glb.string()) +
                 " --set frame.width=" + std::to_string(W) + " --set frame.height=" + std::to_string(H) +
                 " --validate --quiet --exr float --out " + quote(out.string()));
-    ASSERT_EQ(status, 0) << text;
+    ASSERT_EQ(r.status, 0) << r.output;
     // The tone-mapped image (display-linear [0, 1]) from the EXR.
     Image img = loadExrLayer(out / "frame.0000.exr", "final");
     ASSERT_EQ(img.width, W);
@@ -86,21 +68,21 @@ TEST_F(SceneCli, SceneShorthandFramesAndExposesASmallModel) {
 }
 
 TEST_F(SceneCli, SceneShorthandErrorsNameWhatIsWrong) {
-    auto [missing, text1] = vitrine("validate " + quote(kSource + "/graphs/gltf.json") + " --scene /nonexistent/x.glb");
-    EXPECT_EQ(missing, 1) << text1;
-    EXPECT_NE(text1.find("--scene /nonexistent/x.glb: file not found"), std::string::npos) << text1;
+    const CliResult missing = vitrine("validate " + quote(kSource + "/graphs/gltf.json") + " --scene /nonexistent/x.glb");
+    EXPECT_EQ(missing.status, 1) << missing.output;
+    EXPECT_NE(missing.output.find("--scene /nonexistent/x.glb: file not found"), std::string::npos) << missing.output;
     SceneBuilder b("any");
     b.node("ball", static_cast<int32_t>(
                        b.mesh("ball", sphereTris(0.3f, 8, 4), b.material("red", {0.8f, 0.1f, 0.1f}, 0.0f, 0.4f))));
     const fs::path glb = b.write();
-    auto [none, text2] =
+    const CliResult none =
         vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json") + " --scene " + quote(glb.string()));
-    EXPECT_EQ(none, 1) << text2;
-    EXPECT_NE(text2.find("expected exactly one scene node (type scene.*) to replace, found 0"), std::string::npos)
-        << text2;
-    auto [ok, text3] =
+    EXPECT_EQ(none.status, 1) << none.output;
+    EXPECT_NE(none.output.find("expected exactly one scene node (type scene.*) to replace, found 0"), std::string::npos)
+        << none.output;
+    const CliResult ok =
         vitrine("validate " + quote(kSource + "/graphs/museum.json") + " --scene " + quote(glb.string()));
-    EXPECT_EQ(ok, 0) << text3; // the museum's scene node (scene.museum) becomes scene.gltf with its params
+    EXPECT_EQ(ok.status, 0) << ok.output; // the museum's scene node (scene.museum) becomes scene.gltf with its params
 }
 
 } // namespace
