@@ -206,6 +206,24 @@ struct Room {
     Aabb bounds;
 };
 
+// A localized reflection probe (MUSEUM_SPEC §4), placed in the scene like a light: a cube map captured at
+// `position` (ibl.capture) that shades only the pixels inside its influence volume (ibl.localized). Probe i of
+// Scene::probes is layer block [6i, 6i + 6) of the captured cube-map array.
+enum class ProbeShape : uint8_t { Box, Sphere };
+
+struct ReflectionProbe {
+    std::string name;
+    glm::vec3 position{0.0f};  // capture point, world
+    ProbeShape shape = ProbeShape::Box;
+    glm::vec3 center{0.0f};    // influence volume centre, world
+    glm::vec3 halfExtents{1.0f}; // box: half sizes along its local axes; sphere: x is the radius
+    glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f}; // box orientation (local -> world)
+    float fade = 0.5f;         // metres inside the border over which the blend weight ramps from 0 to 1
+    // Overlapping probes blend by weight; a probe's weight is its fade weight times 16^priority, so a
+    // higher-priority probe (an alcove inside a hall) dominates where both apply.
+    int32_t priority = 0;
+};
+
 // World transforms of every node and instance at one time.
 struct ScenePose {
     std::vector<glm::mat4> nodeWorld;     // index = node
@@ -235,6 +253,7 @@ struct Scene {
     bool hasSun = false;
     std::vector<PunctualLight> lights;
     std::vector<Room> rooms;
+    std::vector<ReflectionProbe> probes;
     Aabb bounds; // world, at rest, set by finalize()
 
     // Derives parent links, dynamic flags, instances, primitive/mesh bounds and scene bounds from the
@@ -253,7 +272,7 @@ struct Scene {
     const CameraPath* findCameraPath(std::string_view path) const;
 
     // 64-bit hash of all content (geometry, materials, textures, nodes, cameras, paths, animations,
-    // sun, rooms) but not of derived data. Equal scenes hash equal on every run and build; used by
+    // sun, rooms, probes) but not of derived data. Equal scenes hash equal on every run and build; used by
     // determinism tests and as a key of bake caches.
     uint64_t contentHash() const;
 

@@ -171,6 +171,19 @@ uint64_t Scene::contentHash() const {
         h.string(r.name);
         h.value(r.bounds);
     }
+    if (!probes.empty()) { // hashed only when present, so scenes without probes keep their hashes
+        h.value(probes.size());
+        for (const ReflectionProbe& p : probes) {
+            h.string(p.name);
+            h.value(p.position);
+            h.value(p.shape);
+            h.value(p.center);
+            h.value(p.halfExtents);
+            h.value(p.rotation);
+            h.value(p.fade);
+            h.value(p.priority);
+        }
+    }
     return h.result();
 }
 
@@ -266,6 +279,13 @@ void Scene::validate() const {
         c.index("roots", r, nodes.size(), "nodes");
     for (size_t i = 0; i < lights.size(); ++i)
         c.index("lights[" + std::to_string(i) + "].node", lights[i].node, nodes.size(), "nodes");
+    for (size_t i = 0; i < probes.size(); ++i) {
+        const ReflectionProbe& p = probes[i];
+        std::string e = "probes[" + std::to_string(i) + "] '" + p.name + "'";
+        if (!(p.halfExtents.x > 0.0f) || (p.shape == ProbeShape::Box && !(p.halfExtents.y > 0.0f && p.halfExtents.z > 0.0f)))
+            c.fail(e, "influence volume has no extent");
+        if (!(p.fade >= 0.0f)) c.fail(e, "fade is negative");
+    }
     for (size_t i = 0; i < cameraPaths.size(); ++i) {
         const CameraPath& p = cameraPaths[i];
         std::string e = "cameraPaths[" + std::to_string(i) + "] '" + p.name + "'";
