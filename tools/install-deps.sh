@@ -13,6 +13,7 @@ packages=(
     libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
     libopenexr-dev libimath-dev libopencolorio-dev
     libgtest-dev libgmock-dev libbenchmark-dev
+    python3-jsonschema
 )
 if [ "${1:-}" = "--fuzz" ]; then
     packages+=(clang libclang-rt-dev)

@@ -24,10 +24,10 @@ public:
         g.file = mFile;
         g.document = mDoc;
         if (!mDoc.is_object()) fail("", "expected a JSON object (a vitrine graph)");
-        static const std::set<std::string> kTop = {"format", "description", "frame", "nodes", "outputs", "ui", "extends"};
+        static const std::set<std::string> kTop = {"$schema", "format", "description", "frame", "nodes", "outputs", "ui", "extends"};
         for (const auto& [key, value] : mDoc.items())
             if (!kTop.count(key))
-                fail("/" + pointerToken(key), "unknown key; expected one of format, description, frame, nodes, outputs, ui");
+                fail("/" + pointerToken(key), "unknown key; expected one of $schema, format, description, frame, nodes, outputs, ui");
         if (auto it = mDoc.find("format"); it != mDoc.end() && *it != "vitrine-graph/1")
             fail("/format", "expected \"vitrine-graph/1\", got " + brief(*it));
         if (mDoc.contains("frame")) g.frame = frame(mDoc["frame"]);

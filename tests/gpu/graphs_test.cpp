@@ -19,7 +19,8 @@ std::vector<std::string> shippedGraphs() {
     std::vector<std::string> files;
     const fs::path root = fs::path(VITRINE_SOURCE_DIR) / "graphs";
     for (const auto& entry : fs::recursive_directory_iterator(root))
-        if (entry.is_regular_file() && entry.path().extension() == ".json")
+        if (entry.is_regular_file() && entry.path().extension() == ".json" &&
+            !entry.path().filename().string().ends_with(".schema.json")) // vitrine-graph.schema.json is not a graph
             files.push_back(fs::relative(entry.path(), root).generic_string());
     std::sort(files.begin(), files.end());
     return files;

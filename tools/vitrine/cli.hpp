@@ -29,6 +29,7 @@ Args parse(int argc, char** argv, const std::vector<std::string>& valued,
 int runCommand(const Args& args);
 int validateCommand(const Args& args);
 int nodesCommand(const Args& args);
+int schemaCommand(const Args& args);
 int benchCommand(const Args& args);
 int graphCommand(const Args& args);
 int devicesCommand(const Args& args);

@@ -5,6 +5,7 @@
 #include "core/gpu/formats.hpp"
 #include "core/graph/compiler.hpp"
 #include "core/graph/executor.hpp"
+#include "core/graph/json_schema.hpp"
 #include "core/graph/loader.hpp"
 #include "core/graph/registry.hpp"
 #include "core/image/io.hpp"
@@ -148,6 +149,14 @@ int nodesCommand(const Args& args) {
             std::printf("    param %-12s %s = %s: %s\n", p.name.c_str(), toString(p.type), p.defaultValue.dump().c_str(),
                         p.doc.c_str());
     }
+    return 0;
+}
+
+int schemaCommand(const Args& args) {
+    const std::string text = graphJsonSchema(NodeRegistry::global()).dump(2) + "\n";
+    const std::string path = args.get("out");
+    if (path.empty() || path == "-") std::cout << text;
+    else writeFileAtomically(path, text);
     return 0;
 }
 

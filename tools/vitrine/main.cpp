@@ -21,6 +21,8 @@ commands:
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
   nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
                                     JSON on stdout (or in FILE).
+  schema [--out FILE]               The graph format as a JSON Schema (draft 2020-12) generated from the
+                                    node types, on stdout (or in FILE); graphs name it with "$schema".
   bench GRAPH [--frames N] [--warmup N] [--json FILE] [--set K=V]... [--bvh]
       Per-node GPU ms (median of timestamp queries), CPU record ms, compile ms, memory.
       --bvh: also the scene's ray-tracing BVH: build ms, nodes, memory, bake-cache load ms,
@@ -72,6 +74,7 @@ int main(int argc, char** argv) {
         if (args.command == "run") return cli::runCommand(args);
         if (args.command == "validate") return cli::validateCommand(args);
         if (args.command == "nodes") return cli::nodesCommand(args);
+        if (args.command == "schema") return cli::schemaCommand(args);
         if (args.command == "bench") return cli::benchCommand(args);
         if (args.command == "graph") return cli::graphCommand(args);
         if (args.command == "devices") return cli::devicesCommand(args);
