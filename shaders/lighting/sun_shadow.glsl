@@ -1,5 +1,5 @@
 // The sun's visibility from shadow.directional's cascades (bilinear-weighted PCF), for every pass lit by the
-// sun: lighting.deferred, forward.transparent.
+// sun: lighting.deferred, forward.transparent, fog.volumetric.
 #ifndef LIGHTING_SUN_SHADOW_GLSL
 #define LIGHTING_SUN_SHADOW_GLSL
 #include "shadow/cascades.h"
@@ -42,6 +42,23 @@ float sunVisibility(sampler2D shadowMap, vec3 p, vec3 n, float viewDepth) {
             weight += 1.0;
         }
     return sum / weight;
+}
+
+// The sun's visibility at a point in the air (no surface, so no normal offset), at linear view depth viewDepth:
+// one bilinear-weighted 2x2 comparison, no PCF grid. fog.volumetric reads it at every step of its march, where a
+// wider filter would cost taps per step and the march's own sampling already blurs the shafts.
+float sunVisibilityPoint(sampler2D shadowMap, vec3 p, float viewDepth) {
+    int count = int(VITRINE_SHADOW.params.x);
+    if (viewDepth > VITRINE_SHADOW.splits[count - 1]) return 1.0;
+    int c = 0;
+    while (c < count - 1 && viewDepth > VITRINE_SHADOW.splits[c]) ++c;
+    vec4 s = VITRINE_SHADOW.worldToShadow[c] * vec4(p, 1.0);
+    vec2 st = s.xy * VITRINE_SHADOW.params.y - 0.5;
+    ivec2 base = ivec2(floor(st));
+    vec2 f = st - vec2(base);
+    float a = mix(shadowTap(shadowMap, base, s.z), shadowTap(shadowMap, base + ivec2(1, 0), s.z), f.x);
+    float b = mix(shadowTap(shadowMap, base + ivec2(0, 1), s.z), shadowTap(shadowMap, base + ivec2(1, 1), s.z), f.x);
+    return mix(a, b, f.y);
 }
 
 #endif
