@@ -11,7 +11,8 @@
 // animations (objects and cameras), KHR_texture_transform, KHR_materials_emissive_strength,
 // KHR_lights_punctual (the first directional light becomes the sun; point and spot lights are kept with their
 // nodes), KHR_materials_unlit, KHR_materials_transmission (the factor; its texture is ignored with a warning),
-// KHR_materials_ior, KHR_mesh_quantization and VITRINE_material_layers (VITRINE_material_layers.md). Any other
+// KHR_materials_ior, KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's
+// reflection probes in VITRINE_reflection_probes (VITRINE_reflection_probes.md). Any other
 // extension in extensionsRequired is refused by name. Skins, morph targets and point/line primitives
 // are ignored with a warning. Embedded (data: URI, GLB) and external buffers and images both work.
 //
@@ -33,6 +34,7 @@
 namespace vitrine::scene {
 
 inline constexpr const char* kLayersExtension = "VITRINE_material_layers";
+inline constexpr const char* kProbesExtension = "VITRINE_reflection_probes";
 
 // Loads a .gltf (JSON, external or data: URI buffers) or a .glb (recognised by its magic, whatever the
 // file is called). The result is finalized and valid (Scene::validate() passes).
@@ -47,8 +49,8 @@ Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesyste
 // Writes the scene as one self-contained .glb: geometry (one interleaved vertex buffer view), materials
 // with VITRINE_material_layers plus a plain metallic-roughness fallback made from layer 0, textures as
 // embedded PNG, cameras, camera paths as animated camera nodes, the sun as a KHR_lights_punctual light,
-// rooms and exact physical parameters in `extras`. loadGltf() of the result gives back a scene with the
-// same contentHash(). UserError when the file cannot be written.
+// reflection probes in VITRINE_reflection_probes, rooms and exact physical parameters in `extras`. loadGltf() of
+// the result gives back a scene with the same contentHash(). UserError when the file cannot be written.
 void exportGlb(const Scene& scene, const std::filesystem::path& file);
 
 } // namespace vitrine::scene

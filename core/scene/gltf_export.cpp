@@ -2,6 +2,7 @@
 
 #include "core/scene/gltf.hpp"
 #include "core/scene/gltf_detail.hpp"
+#include "core/scene/probe_json.hpp"
 
 #include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
@@ -405,6 +406,7 @@ void Exporter::nodesAndScene() {
     if (!roots.empty()) scene["nodes"] = roots; // glTF forbids an empty list
     if (!mScene.name.empty()) scene["name"] = mScene.name;
     if (!ours.empty()) scene["extras"][gltf::kExtrasKey] = ours;
+    if (!mScene.probes.empty()) scene["extensions"][kProbesExtension] = {{"probes", probejson::write(mScene.probes)}};
     mDoc["scenes"] = Json::array({scene});
     mDoc["scene"] = 0;
 }
@@ -507,6 +509,7 @@ std::vector<uint8_t> Exporter::run() {
     if (unlit) used.push_back(gltf::kUnlit);
     if (transmission) used.push_back(gltf::kTransmission);
     if (ior) used.push_back(gltf::kIor);
+    if (!mScene.probes.empty()) used.push_back(kProbesExtension);
     mDoc["extensionsUsed"] = used;
     while (mBin.size() % 4)
         mBin.push_back(0);

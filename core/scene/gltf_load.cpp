@@ -2,6 +2,7 @@
 
 #include "core/scene/gltf.hpp"
 #include "core/scene/gltf_detail.hpp"
+#include "core/scene/probe_json.hpp"
 
 #include "core/base/error.hpp"
 
@@ -253,6 +254,21 @@ void readSceneExtras(LoadContext& ctx, const Json& sceneJson, const std::string&
     }
 }
 
+// VITRINE_reflection_probes on the scene (VITRINE_reflection_probes.md).
+void readProbes(LoadContext& ctx, const Json& sceneJson, const std::string& e) {
+    const Json* ext = object(ctx, sceneJson, "extensions", e);
+    const Json* ours = ext ? object(ctx, *ext, kProbesExtension, e + ".extensions") : nullptr;
+    if (!ours) return;
+    std::string pe = e + ".extensions." + kProbesExtension;
+    for (const auto& item : ours->items()) {
+        if (item.key() != "probes" && item.key() != "extensions" && item.key() != "extras")
+            ctx.fail(pe + "." + item.key(), "unknown key; expected probes");
+    }
+    const Json* list = member(*ours, "probes");
+    if (!list) ctx.fail(pe + ".probes", "missing; expected an array of probes");
+    ctx.scene->probes = probejson::read(*list, probejson::Where{ctx.file, false}, pe + ".probes");
+}
+
 // KHR_lights_punctual: the first directional light becomes the sun (when the file has no exact sun in our
 // extras), point and spot lights are kept with their nodes; other directional lights are ignored with a warning.
 void readLights(LoadContext& ctx, const std::vector<int32_t>& remap) {
@@ -426,6 +442,7 @@ void loadNodesAndScene(LoadContext& ctx) {
             }
         }
         readSceneExtras(ctx, sceneJson, e);
+        readProbes(ctx, sceneJson, e);
     }
     scene.finalize();
     readLights(ctx, remap);

@@ -210,7 +210,7 @@ bool looksLikeGlb(const std::filesystem::path& file, const std::vector<uint8_t>&
 void checkRequiredExtensions(const LoadContext& ctx) {
     static const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength, kLightsPunctual,
                                                      kMeshQuantization, kLayersExtension, kUnlit,
-                                                     kTransmission, kIor};
+                                                     kTransmission, kIor, kProbesExtension};
     const Json* required = member(ctx.doc, "extensionsRequired");
     if (!required) return;
     if (!required->is_array()) ctx.fail("extensionsRequired", "expected an array of extension names");

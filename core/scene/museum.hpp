@@ -10,6 +10,7 @@
 // paintings, benches, thin railings; exhibits on pedestals that span the material space (mirror sphere,
 // brushed steel, gold with a dirt layer, rough stone bust, draped cloth, lacquered wood, a finely
 // engraved plate that aliases); a walking robot (dynamic, animated). Rooms are recorded as named boxes;
+// 41 reflection probes (box influence volumes: 8 nave slices, 18 aisle bays, 3 doorways, 2 × 2 per gallery);
 // camera paths "walkthrough", "dolly" and "static"; one sun.
 
 #include "core/scene/scene.hpp"

@@ -3,6 +3,7 @@
 #include "core/accel/gpu_bvh.hpp"
 #include "core/base/error.hpp"
 #include "core/gpu/context.hpp"
+#include "core/scene/probes.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -43,10 +44,39 @@ void addSceneNodeSchema(NodeSchema& s) {
     s.params.push_back({"vertex_jitter_threshold", ParamType::Float, 2.0, 0.01, 1000.0, {},
                         "jitter_space vertex: screen speed (pixels per frame) at and above which a vertex is not "
                         "jittered; slower vertices get (1 - speed / threshold) of the jitter"});
+    s.params.push_back({"probes", ParamType::Path, "", {}, {}, {},
+                        "Reflection probes from a JSON file {\"probes\": [...]} (relative to the graph file; each probe "
+                        "as in core/scene/VITRINE_reflection_probes.md), combined with the scene's as probes_mode says. "
+                        "Empty: the scene's own probes"});
+    s.params.push_back({"probes_mode", ParamType::Enum, "merge", {}, {}, {"merge", "replace"},
+                        "How the probes file combines with the scene's probes: merge (a file probe named like a scene "
+                        "probe replaces it, the others are added) or replace (the file's probes only; [] removes all)"});
 }
+
+namespace {
+
+// The scene with the `probes` param's file applied; the scene itself when the param is empty.
+std::shared_ptr<const scene::Scene> withProbeFile(SetupContext& ctx, std::shared_ptr<const scene::Scene> scene) {
+    const Params& p = ctx.params();
+    const std::string path = p.getString("probes");
+    if (path.empty()) return scene;
+    auto mode = p.getString("probes_mode") == "replace" ? scene::ProbeMerge::Replace : scene::ProbeMerge::Merge;
+    auto edited = std::make_shared<scene::Scene>(*scene);
+    try {
+        scene::applyProbes(edited->probes, scene::readProbeFile(ctx.resolvePath(path)), mode);
+    } catch (const UserError& e) {
+        // The probe file's error names its file and JSON pointer; the graph's file and param say where it came from.
+        ctx.failParam("probes", e.what());
+    }
+    edited->validate();
+    return edited;
+}
+
+} // namespace
 
 void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> scene) {
     const Params& p = ctx.params();
+    scene = withProbeFile(ctx, std::move(scene));
     mFps = p.getFloat("fps");
     mStart = p.getFloat("start");
     mJitter = static_cast<scene::JitterPattern>(p.getEnumIndex("jitter"));

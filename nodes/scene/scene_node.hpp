@@ -1,6 +1,6 @@
 #pragma once
 // What scene.museum and scene.gltf share: the scene/camera outputs, the camera choice, the frame clock,
-// sub-pixel jitter, and the per-frame pose + camera update of the GPU scene.
+// sub-pixel jitter, reflection probes from a file (`probes`), and the per-frame pose + camera update of the GPU scene.
 
 #include "core/graph/node.hpp"
 #include "core/scene/gpu_scene.hpp"

@@ -52,5 +52,6 @@ void buildArchitecture(Museum& m);
 void buildExhibits(Museum& m);
 void buildDecor(Museum& m); // paintings, frames, benches, stanchions
 void buildRobot(Museum& m);
+void placeProbes(Scene& scene); // probes.cpp: reflection probes per room, aisle bay and doorway
 
 } // namespace vitrine::scene::museum

@@ -1,5 +1,5 @@
 // buildMuseum(): materials, lenses, camera paths, the sun and rooms; the geometry comes from the parts
-// in architecture.cpp, exhibits.cpp, decor.cpp and robot.cpp.
+// in architecture.cpp, exhibits.cpp, decor.cpp and robot.cpp, the reflection probes from probes.cpp.
 
 #include "core/scene/museum.hpp"
 
@@ -296,6 +296,7 @@ Scene buildMuseum(const MuseumOptions& options) {
     buildRobot(m);
     addCameras(scene);
     addRooms(scene);
+    placeProbes(scene);
     scene.hasSun = true;
     // From the south, a little east, 46° up: through the south windows onto the nave floor and through
     // the skylights' louvres onto the north aisle.

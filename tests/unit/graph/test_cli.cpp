@@ -119,6 +119,9 @@ const BadGraph kBadGraphRows[] = {
      ": /nodes/scene/params/path: ", "number_too_large.gltf: JSON line 10, column 55: the number '1e309' is too large"},
     {"gltf_bad_magic.json", "",
      ": /nodes/scene/params/path: ", "bad_magic.glb: GLB header: magic is 'glTX' (0x58546C67); expected 'glTF'"},
+    // A probe file's error names the param, then the probe file and the JSON pointer inside it.
+    {"probes_bad_radius.json", "",
+     ": /nodes/scene/params/probes: ", "bad_radius.json: /probes/1/radius: expected a number > 0 (metres), got 0"},
     // --frames is frame.frames before validation: frame.write may name frames the file alone does not have.
     {"graphs/fxaa_zoneplate.json", "--frames 4 --set 'frame.write=[0,4]'",
      ": /frame/write/1: ", "expected an integer in [0, 3], got 4"},
