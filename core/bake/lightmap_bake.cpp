@@ -153,7 +153,7 @@ BakeKey lightmapCacheKey(const scene::Scene& scene, const LightmapBakeSettings& 
     scene::Hasher h;
     h.string("lightmap");
     h.value(kVersion);
-    h.value(scene.contentHash());
+    h.value(scene.lightTransportHash()); // probes do not change the lightmaps
     h.value(lightingHash);
     h.value(s.atlas.texelsPerMeter);
     h.value(s.atlas.minSize);

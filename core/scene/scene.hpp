@@ -275,10 +275,16 @@ struct Scene {
     // sun, rooms, probes) but not of derived data. Equal scenes hash equal on every run and build; used by
     // determinism tests and as a key of bake caches.
     uint64_t contentHash() const;
+    // The same without the reflection probes: what light transport (the lightmap bake) depends on, so moving a
+    // probe does not re-bake the lightmaps.
+    uint64_t lightTransportHash() const;
 
     size_t triangleCount() const { return indices.size() / 3; }
     // CPU bytes of geometry and texture pixels: what an upload will roughly cost.
     size_t memoryBytes() const;
+
+private:
+    uint64_t hashContent(bool withProbes) const;
 };
 
 } // namespace vitrine::scene

@@ -80,7 +80,11 @@ bool usesUvSet(const Material& m, uint32_t uvSet) {
     return uses(m.emissiveTexture);
 }
 
-uint64_t Scene::contentHash() const {
+uint64_t Scene::contentHash() const { return hashContent(true); }
+
+uint64_t Scene::lightTransportHash() const { return hashContent(false); }
+
+uint64_t Scene::hashContent(bool withProbes) const {
     Hasher h;
     h.string(name);
     h.array(vertices);
@@ -171,7 +175,7 @@ uint64_t Scene::contentHash() const {
         h.string(r.name);
         h.value(r.bounds);
     }
-    if (!probes.empty()) { // hashed only when present, so scenes without probes keep their hashes
+    if (withProbes && !probes.empty()) { // hashed only when present, so scenes without probes keep their hashes
         h.value(probes.size());
         for (const ReflectionProbe& p : probes) {
             h.string(p.name);

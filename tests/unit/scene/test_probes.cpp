@@ -345,5 +345,19 @@ TEST(ProbeHash, EveryFieldChangesTheContentHash) {
     EXPECT_NE(reordered.contentHash(), base) << "the order decides the cube-map layers";
 }
 
+TEST(ProbeHash, ProbesDoNotChangeTheLightTransportHash) {
+    // The lightmap bake is keyed by lightTransportHash(): moving or adding a probe must not re-bake, while any
+    // other content (here one vertex) still does.
+    Scene scene = loadGltf(test::dataDir() / "quad.gltf");
+    const uint64_t without = scene.lightTransportHash();
+    scene.probes = oddProbes();
+    EXPECT_EQ(scene.lightTransportHash(), without);
+    scene.probes[0].position.x += 0.5f;
+    EXPECT_EQ(scene.lightTransportHash(), without);
+    EXPECT_NE(scene.contentHash(), scene.lightTransportHash());
+    scene.vertices[0].position.x += 0.01f;
+    EXPECT_NE(scene.lightTransportHash(), without);
+}
+
 } // namespace
 } // namespace vitrine::scene
