@@ -111,14 +111,14 @@ vec4 traceRay(vec3 origin, vec3 o, vec3 r, float coneTan) {
     }
     if (!found) return vec4(0.0);
 
-    // A level-0 texel holds one depth, so the hit is only known to a pixel or two: bisect (6 steps, 1/16 px) the
+    // A level-0 texel holds one depth, so the hit is only known to a pixel or two: bisect (4 steps, 1/4 px) the
     // ray's depth minus the interpolated surface depth over two pixels either side, where it changes sign.
     float tPixel = 100.0 * nudge;
     float ta = max(t - 2.0 * tPixel, 0.0), tb = min(t + 2.0 * tPixel, tEnd);
     bool refined = op.z + dp.z * ta > surfaceDepthAt((op + dp * ta).xy) &&
                    op.z + dp.z * tb <= surfaceDepthAt((op + dp * tb).xy);
     if (refined) {
-        for (int k = 0; k < 6; ++k) {
+        for (int k = 0; k < 4; ++k) {
             float tm = 0.5 * (ta + tb);
             if (op.z + dp.z * tm > surfaceDepthAt((op + dp * tm).xy)) ta = tm;
             else tb = tm;
@@ -174,7 +174,7 @@ void main() {
     float alpha = ggxAlpha(roughness);
     // 1 ray for mirrors, up to max_rays as the lobe widens; each covers 1/rays of the lobe's solid angle, whose
     // half-angle is about atan(1.29 alpha) (twice the GGX half-vector lobe's half-maximum, 0.64 alpha).
-    int rays = clamp(int(ceil(roughness * 8.0)), 1, int(u.config.y));
+    int rays = clamp(int(ceil(roughness * 5.0)), 1, int(u.config.y));
     float coneTan = 1.29 * alpha / sqrt(float(rays));
     uint seed = rngSeed(uvec2(q), u.config.w, 0u);
     vec3 radiance = vec3(0.0);

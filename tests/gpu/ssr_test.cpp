@@ -454,7 +454,7 @@ TEST_F(Ssr, TapLimitBoundsTheMarch) {
     EXPECT_LE(farthest, 8.0);
 }
 
-// ssr.composite on a lit glossy floor (two rays a pixel, cavity 0.8, vertex AO 0.5..1) with SSR at half
+// ssr.composite on a lit glossy floor (roughness 0.15, cavity 0.8, vertex AO 0.5..1) with SSR at half
 // resolution: every pixel against the blend evaluated on the CPU from the read-back inputs, with Karis' environment
 // BRDF from core/shading and the half-resolution reflection upsampled bilinearly (clamped at the edges).
 TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
@@ -534,8 +534,8 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
     EXPECT_GT(blended, 100);
 }
 
-// Cone tracing: on a rough floor (roughness 0.4: four rays, cones of tan 1.29 alpha / 2 = 0.1) every hit's
-// footprint is several pixels wide (2 x distance x 0.1 over a pixel's ~2.4 cm at 6 m: > 2 px beyond 0.25 m), so the
+// Cone tracing: on a rough floor (roughness 0.4: two rays, cones of tan 1.29 alpha / sqrt 2 = 0.15) every hit's
+// footprint is several pixels wide (2 x distance x 0.15 over a pixel's ~2.4 cm at 6 m: > 2 px beyond 0.25 m), so the
 // pyramid is read at level 1 or coarser, where a one-pixel checkerboard is exactly 0.5; read at level 0 it is not.
 TEST_F(Ssr, ConeFootprintSelectsACoarsePyramidLevel) {
     MirrorScene m(0.6f);
