@@ -621,5 +621,60 @@ TEST_F(Ssr, ReducesTheFlipErrorAgainstThePathTracedReference) {
     EXPECT_LT(with, 0.42);
 }
 
+// Back faces: a mirror floor in front of a shelf (a single-sided plane at 1 m, its top facing the camera above
+// it). Mirror rays from the floor in front rise into the shelf's underside; on screen they meet the shelf's top at
+// the same depth, whose normal faces along the ray: the back-face test gives them no confidence.
+TEST_F(Ssr, RaysIntoABackFaceHaveNoConfidence) {
+    const int W = 128, H = 96;
+    const double shelfY = 1.0, shelfNear = -1.0, shelfFar = -3.0;
+    SceneBuilder b("ssr_shelf");
+    std::vector<Tri> floorTris, shelfTris;
+    addQuad(floorTris, {0.0f, 0.0f, 1.5f}, {6.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 4.5f}, {0, 1, 0});
+    addQuad(shelfTris, {0.0f, 1.0f, -2.0f}, {6.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {0, 1, 0});
+    b.node("floor", static_cast<int32_t>(b.mesh("floor", floorTris, b.material("mirror", glm::vec3(0.9f), 1.0f, 1.0f))));
+    b.node("shelf", static_cast<int32_t>(b.mesh("shelf", shelfTris, b.material("matte", glm::vec3(0.5f), 0.0f, 0.5f))));
+    b.camera({0.3f, 2.6f, 4.5f}, {0.0f, 0.5f, -1.0f}, 0.9f);
+    b.sun({0.3f, 1.0f, 0.6f});
+    auto glb = b.write();
+    Pinhole cam(b.s, W, H);
+    json nodes = baseNodes(glb);
+    nodes["coords"] = {{"type", "test.ssr_coords"}};
+    nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
+    nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
+    nodes["ssr"] = {{"type", "ssr.hiz"},
+                    {"in",
+                     {{"normal", "gbuffer.normal"},
+                      {"depth", "gbuffer.depth"},
+                      {"hiz", "hiz.hiz"},
+                      {"color", "pyramid.pyramid"},
+                      {"camera", "scene.camera"}}},
+                    {"params", mirrorParams(64)}};
+    auto out = runGraph(graph(nodes, {{"ssr", "ssr.reflection"}}, W, H));
+    const Image& ssr = out.at("ssr");
+    int intoBack = 0, confident = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= 0.0) continue;
+            glm::dvec3 p = cam.position + (-cam.position.y / d.y) * d;
+            // The floor, seen in front of the shelf (which hides what lies behind its near edge), 0.2 m clear of it.
+            double tShelf = (shelfY - cam.position.y) / d.y;
+            glm::dvec3 q = cam.position + tShelf * d;
+            if (std::abs(q.x) < 6.0 && q.z < shelfNear + 0.2) continue;
+            if (std::abs(p.x) > 5.0) continue;
+            glm::dvec3 r(d.x, -d.y, d.z);
+            glm::dvec3 h = p + r * (shelfY / r.y);
+            if (std::abs(h.x) > 5.5 || h.z > shelfNear - 0.2 || h.z < shelfFar + 0.2 || glm::length(h - p) > 4.0)
+                continue;
+            ++intoBack;
+            if (ssr.at(x, y)[3] >= 0.02f) ++confident;
+        }
+    std::printf("back faces: %d floor pixels reflect into the shelf's underside, %d of them with confidence >= "
+                "0.02\n",
+                intoBack, confident);
+    EXPECT_GT(intoBack, 200);
+    EXPECT_LE(confident, intoBack / 20);
+}
+
 } // namespace
 } // namespace vitrine::test
