@@ -47,8 +47,13 @@ public:
     const FrameSettings& frame() const override { return mGraph.desc.frame; }
     bool hasInput(const std::string& port) const override { return mDecl.inputs.count(port) != 0; }
     const ImageDesc& input(const std::string& port) const override {
-        for (const auto& u : mPass.uses)
-            if (!u.output && u.port == port) return mGraph.resources[u.resource].desc;
+        for (const auto& u : mPass.uses) {
+            if (u.output || u.port != port) continue;
+            if (u.previous)
+                throw InternalError("node " + mDecl.id + " asks in setup() for input '" + port +
+                                    "', which reads an @prev history whose producer is set up later");
+            return mGraph.resources[u.resource].desc;
+        }
         throw InternalError("node " + mDecl.id + " asks for unconnected input '" + port + "'");
     }
     ImageDesc& output(const std::string& port) override {

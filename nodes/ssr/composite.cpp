@@ -1,0 +1,62 @@
+// ssr.composite: the indirect specular of lighting.deferred replaced by SSR where it found something (MUSEUM_SPEC §5).
+#include "shaders/ssr/composite.h"
+#include "core/graph/registry.hpp"
+#include "core/scene/gpu_scene.hpp"
+
+namespace vitrine {
+namespace {
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "ssr.composite";
+    s.doc = "Blends the environment's indirect specular with SSR by the SSR confidence c and writes the final "
+            "colour: color - I + mix(I, E L_ssr vertexAO cavity, c), where I is lighting.deferred's "
+            "specular_indirect and E the same split-sum environment BRDF that weighs I (shaders/lighting/"
+            "ambient.glsl). The reflection is upsampled bilinearly.";
+    auto tex = [](const char* name, const char* doc) {
+        return InputPort{name, PortKind::Texture, {}, false, Usage::Sampled, doc};
+    };
+    s.inputs = {
+        tex("color", "Lit HDR colour that includes specular_indirect (lighting.color)"),
+        tex("specular_indirect", "The environment's indirect specular inside color (lighting.specular_indirect)"),
+        tex("reflection", "ssr.hiz's reflection (or its temporal accumulation): rgb radiance, a confidence"),
+        tex("normal", "G-buffer: octahedral normal, view depth, shininess"),
+        tex("base_color", "G-buffer: base colour, metallic"),
+        tex("material", "G-buffer: alpha, clothness, vertex AO, cavity"),
+        tex("depth", "Hardware depth, reverse Z"),
+        {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
+    };
+    OutputPort color;
+    color.name = "color";
+    color.formatFrom = "color";
+    color.size = SizeRule::ofInput("color");
+    color.doc = "HDR colour with SSR in place of the environment where it is confident";
+    s.outputs = {color};
+    return s;
+}
+
+class SsrComposite final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        mCamera = ctx.objectAs<CameraObject>("camera");
+        mPipeline = ctx.computePipeline("ssr/composite.comp");
+    }
+    void execute(ExecuteContext& ctx) override {
+        const CameraFrame& cam = mCamera->current;
+        gpu_types::SsrCompositeUniforms u{};
+        u.invViewProj = cam.invViewProj;
+        u.cameraPos = glm::vec4(cam.state.position, 1.0f);
+        ctx.setUniforms(u);
+        const ImageDesc& out = ctx.output("color").desc();
+        ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
+    }
+
+private:
+    std::shared_ptr<CameraObject> mCamera;
+    PipelineId mPipeline = 0;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<SsrComposite>(); });
+
+} // namespace
+} // namespace vitrine
