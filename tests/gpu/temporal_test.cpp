@@ -291,41 +291,46 @@ TEST_F(Temporal, MovingObjectLeavesNoGhostAndDisocclusionRestartsTheCount) {
     };
     // Also the square's own pixels: their history must follow it (reprojected by its velocity), so the mean
     // |output - input| over them stays small (returned in `inside`).
-    double inside = 0.0;
+    double inside = 0.0, insideSamples = 0.0; // and the mean sample count there
     // Frame 0's velocity buffer has no motion yet (zero everywhere), so what the square covered on frame 0 is not
     // rejected by the velocity difference on frame 1: those pixels are left out of the trail (`first`, per resolution).
     Image first;
-    auto trail = [&inside, &first](const std::map<std::string, Image>& out) {
+    auto trail = [&inside, &insideSamples, &first](const std::map<std::string, Image>& out) {
         const Image& o = out.at("out");
         const Image& in = out.at("in");
         double energy = 0.0, box = 0.0;
         int covered = 0;
-        inside = 0.0;
+        inside = insideSamples = 0.0;
         for (int y = 0; y < in.height; ++y)
             for (int x = 0; x < in.width; ++x) {
                 if (in.at(x, y)[0] > 0.5f) {
                     box += in.at(x, y)[0] - 0.05;
                     inside += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
+                    insideSamples += out.at("samples").at(x, y)[0];
                     ++covered;
                 } else if (first.at(x, y)[0] <= 0.5f) {
                     energy += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
                 }
             }
         inside /= std::max(covered, 1);
+        insideSamples /= std::max(covered, 1);
         return box > 0.0 ? energy / box : 1e9;
     };
     const int frames = 9;
     for (bool half : {false, true}) {
         first = run(half, true, true, 1).at("in");
         const double both = trail(run(half, true, true, frames));
-        const double insideBoth = inside;
+        const double insideBoth = inside, samplesBoth = insideSamples;
         const double velocityOnly = trail(run(half, true, false, frames));
         const double depthOnly = trail(run(half, false, true, frames));
         const double none = trail(run(half, false, false, frames));
         std::printf("%s resolution: trail after %d frames: velocity + depth %.4f, velocity difference only %.4f, depth "
-                    "only %.4f, no rejection %.4f; mean |output - input| on the square %.4f\n",
-                    half ? "half" : "full", frames, both, velocityOnly, depthOnly, none, insideBoth);
+                    "only %.4f, no rejection %.4f; on the square: mean |output - input| %.4f, mean samples %.2f\n",
+                    half ? "half" : "full", frames, both, velocityOnly, depthOnly, none, insideBoth, samplesBoth);
         EXPECT_LT(insideBoth, 0.05);
+        // The square's history follows it (reprojected by its velocity, scaled to the input's pixels): its pixels keep
+        // their samples; without reprojection its leading band (a fifth of it) would restart every frame.
+        EXPECT_GT(samplesBoth, 7.5);
         EXPECT_LT(both, 0.01);
         EXPECT_LT(velocityOnly, 0.01);
         EXPECT_LT(depthOnly, 0.01);
