@@ -35,6 +35,8 @@ NodeSchema schema() {
         {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's `layout` (with `volume`)"},
         {"scene", PortKind::Scene, {}, true, Usage::Sampled,
          "The scene, for its KHR_lights_punctual point and spot lights (unshadowed); without it only the sun"},
+        tex("ao", "Ambient visibility in r (ao.alchemy, accumulated), any size: the indirect diffuse and specular "
+                  "(baked or not) are multiplied by lerp(baseColor, 1, ao); none: 1", true),
     };
     OutputPort color;
     color.name = "color";
@@ -86,6 +88,7 @@ public:
             u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
             u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
         }
+        u.volumeCounts.w = ctx.hasInput("ao") ? 1u : 0u;
         if (mScene) u.lights = packPunctualLights(*mScene);
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("color").desc();

@@ -28,6 +28,7 @@ layout(binding = 8) writeonly uniform image2D out_color;
 layout(binding = 9) writeonly uniform image2D out_specular_indirect;
 layout(binding = 10) uniform Uniforms { DeferredUniforms u; };
 layout(binding = 11) uniform sampler2D in_volume;
+layout(binding = 12) uniform sampler2D in_ao;
 #define VITRINE_LIGHTS u.lights
 #define VITRINE_SHADOW u.shadow
 #include "lighting/sun_shadow.glsl"
@@ -88,6 +89,14 @@ void main() {
     // KHR_lights_punctual point and spot lights (unshadowed), with the cavity as the sun has it.
     direct += shadePunctual(world, n, v, diffuseAlbedo(baseColor, metallic), f0, roughness) * cavity;
 
+    // Screen-space AO on the indirect terms only (MUSEUM_SPEC §5), tinted by the base colour like a little GI; a
+    // lightmapped pixel's emissive channel is its baked diffuse (and any emission with it).
+    if (u.volumeCounts.w != 0u) {
+        vec3 tint = mix(baseColor, vec3(1.0), textureLod(in_ao, uv, 0.0).r);
+        diffuse *= tint;
+        specular *= tint;
+        if (lightmapped) emissive *= tint;
+    }
     // Lightmapped pixels carry emission and baked diffuse together: emissive_scale leaves them as baked.
     vec3 color = direct + diffuse + specular + emissive * (lightmapped ? 1.0 : u.params.w);
     imageStore(out_color, p, vec4(min(color, vec3(kHalfMax)), 1.0));

@@ -1,0 +1,451 @@
+// temporal.accumulate and gbuffer.temporal_filter (MUSEUM_SPEC §5) against independent expectations: the running mean
+// of per-pixel noise recomputed on the CPU, one blend step with velocity / depth / luminance rejection written out from
+// the node's documented formulas, the ghost trail of a moving object (scene.gltf + gbuffer.layered, full and half
+// resolution input), the restart of the sample count where the background is disoccluded; the normal filter's running
+// blend and Toksvig shininess against core/shading, and on the Museum's dolly shot shininess never increases.
+#include "tests/gpu/lighting_scene.hpp"
+
+#include "core/graph/node.hpp"
+#include "core/graph/registry.hpp"
+#include "core/shading/brdf.hpp"
+#include "core/shading/octahedral.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+using namespace lighting;
+
+// test.frames: a uniform RGBA32F image of `a` on frame 0 and `b` afterwards (with `alternate`: a on even frames, b on
+// odd ones), or with `noise` a per-pixel, per-frame PCG hash in [0, 1) in every channel (noiseValue below).
+const char* kFramesSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_color;
+layout(push_constant) uniform Push { vec4 value; uint frame; uint noise; uint pad0; uint pad1; } pc;
+uint pcg(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(out_color)))) return;
+    vec4 c = pc.value;
+    if (pc.noise != 0u)
+        for (int i = 0; i < 4; ++i)
+            c[i] = float(pcg(uint(p.x) * 7919u + uint(p.y) * 104729u + pc.frame * 1299709u + uint(i) * 15485863u) >> 8u) / 16777216.0;
+    imageStore(out_color, p, c);
+}
+)";
+
+uint32_t pcg(uint32_t v) {
+    const uint32_t state = v * 747796405u + 2891336453u;
+    const uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+double noiseValue(int x, int y, uint32_t frame, int channel) {
+    return (pcg(uint32_t(x) * 7919u + uint32_t(y) * 104729u + frame * 1299709u + uint32_t(channel) * 15485863u) >> 8u) /
+           16777216.0;
+}
+
+class Frames final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        if (ctx.params().getBool("half")) {
+            ImageDesc& out = ctx.output("color");
+            out.width = (ctx.frame().width + 1) / 2;
+            out.height = (ctx.frame().height + 1) / 2;
+        }
+        mPipeline = ctx.computePipelineSource("test/frames", kFramesSource);
+    }
+    void execute(ExecuteContext& ctx) override {
+        const Params& p = ctx.params();
+        const uint32_t f = ctx.frameIndex();
+        struct {
+            glm::vec4 value;
+            uint32_t frame, noise, pad0, pad1;
+        } push{};
+        const bool second = p.getBool("alternate") ? f % 2 == 1 : f > 0;
+        push.value = second ? p.getVec4("b") : p.getVec4("a");
+        push.frame = f;
+        push.noise = p.getBool("noise") ? 1u : 0u;
+        const ImageDesc& out = ctx.output("color").desc();
+        ctx.dispatch(mPipeline, &push, sizeof(push), out.width, out.height);
+    }
+
+private:
+    PipelineId mPipeline = 0;
+};
+
+NodeSchema framesSchema() {
+    NodeSchema s;
+    s.type = "test.frames";
+    s.doc = "test-only node of test_gpu";
+    OutputPort out;
+    out.name = "color";
+    out.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    out.doc = "test output";
+    s.outputs = {out};
+    s.params = {{"a", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "frame 0"},
+                {"b", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "later frames"},
+                {"alternate", ParamType::Bool, false, {}, {}, {}, "a on even frames, b on odd ones"},
+                {"noise", ParamType::Bool, false, {}, {}, {}, "per-pixel per-frame hash instead"},
+                {"half", ParamType::Bool, false, {}, {}, {}, "half the frame's size (rounded up)"}};
+    return s;
+}
+const NodeRegistration kFrames(framesSchema(), [] { return std::make_unique<Frames>(); });
+
+// test.downsample: half the input's size, each pixel the input texel under its centre (as temporal.accumulate reads the
+// G-buffer for a half-resolution input).
+const char* kDownsampleSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) uniform sampler2D in_color;
+layout(binding = 1) writeonly uniform image2D out_color;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(out_color);
+    if (any(greaterThanEqual(p, size))) return;
+    ivec2 full = textureSize(in_color, 0);
+    imageStore(out_color, p, texelFetch(in_color, min(ivec2((vec2(p) + 0.5) * vec2(full) / vec2(size)), full - 1), 0));
+}
+)";
+
+class Downsample final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        mPipeline = ctx.computePipelineSource("test/downsample", kDownsampleSource);
+    }
+    void execute(ExecuteContext& ctx) override {
+        const ImageDesc& out = ctx.output("color").desc();
+        ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);
+    }
+
+private:
+    PipelineId mPipeline = 0;
+};
+
+NodeSchema downsampleSchema() {
+    NodeSchema s;
+    s.type = "test.downsample";
+    s.doc = "test-only node of test_gpu";
+    s.inputs = {{"color", PortKind::Texture, {}, false, Usage::Sampled, "input"}};
+    OutputPort out;
+    out.name = "color";
+    out.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    out.size = SizeRule::ofInput("color", 0.5f);
+    out.doc = "test output";
+    s.outputs = {out};
+    return s;
+}
+const NodeRegistration kDownsample(downsampleSchema(), [] { return std::make_unique<Downsample>(); });
+
+json framesNode(glm::vec4 a, glm::vec4 b, bool half = false) {
+    return {{"type", "test.frames"}, {"params", {{"a", {a.x, a.y, a.z, a.w}}, {"b", {b.x, b.y, b.z, b.w}}, {"half", half}}}};
+}
+
+json accumulateNode(json params, json in) {
+    in["history"] = "acc.color@prev";
+    in["history_samples"] = "acc.samples@prev";
+    return {{"type", "temporal.accumulate"}, {"params", params}, {"in", in}};
+}
+
+class Temporal : public GpuTest {};
+
+// Per-pixel noise, different every frame (the jittered inputs of a static shot): after N frames with max_samples N the
+// output is their mean, and later the running blend (N - 1) / N of the history, both recomputed here from the same
+// hash. The sample count is min(frame + 1, N).
+TEST_F(Temporal, StaticInputConvergesToTheMeanOfTheFrames) {
+    const int w = 24, h = 16, n = 8;
+    for (int frames : {n, 3 * n}) {
+        json nodes = {{"src", {{"type", "test.frames"}, {"params", {{"noise", true}}}}},
+                      {"acc", accumulateNode({{"max_samples", n}}, {{"color", "src.color"}})}};
+        json g = graph(nodes, {{"out", "acc.color"}, {"samples", "acc.samples"}}, w, h);
+        g["frame"]["frames"] = frames;
+        auto out = runGraph(g);
+        double worst = 0.0, spread = 0.0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                for (int c = 0; c < 4; ++c) {
+                    double mean = 0.0;
+                    for (int f = 0; f < frames; ++f) {
+                        const double k = std::min(f, n - 1);
+                        mean = f == 0 ? noiseValue(x, y, 0, c) : (noiseValue(x, y, f, c) + k * mean) / (k + 1.0);
+                    }
+                    worst = std::max(worst, std::fabs(out.at("out").at(x, y)[c] - mean));
+                    spread = std::max(spread, std::fabs(noiseValue(x, y, frames - 1, c) - mean));
+                }
+                EXPECT_EQ(out.at("samples").at(x, y)[0], float(std::min(frames, n)));
+            }
+        std::printf("%d frames, max_samples %d: worst |output - CPU running mean| %.2e (last frame's input is up to %.2f "
+                    "from it)\n",
+                    frames, n, worst, spread);
+        EXPECT_LT(worst, 4e-3); // RGBA16F history, rounded every frame
+        EXPECT_GT(spread, 0.3);
+    }
+}
+
+// One blend step, frame 0 uniform a then frame 1 uniform b, with uniform velocity and depth images from test.frames:
+// the history holds one sample, cut by Sousa13's velocity difference and the luminance difference, restarted by a
+// depth change beyond the tolerance; the output is mix(b, a, n / (n + 1)) and the count n + 1, as the node documents.
+// The input is at half the velocity's resolution (the velocity is scaled to its pixels).
+TEST_F(Temporal, OneStepWeightsMatchTheirFormulas) {
+    const glm::vec4 a(0.1f, 0.2f, 0.6f, 1.0f), b(0.9f, 0.3f, 0.05f, 0.5f);
+    const double la = 0.2126 * a.x + 0.7152 * a.y + 0.0722 * a.z, lb = 0.2126 * b.x + 0.7152 * b.y + 0.0722 * b.z;
+    struct Case {
+        const char* name;
+        glm::vec2 v0, v1;
+        float d0, d1;
+        double velocityWeight, luminanceWeight;
+        double expectedN;
+    };
+    const double dv = glm::length(glm::vec2(1.0f, -2.0f) - glm::vec2(3.0f, 0.0f));
+    const Case cases[] = {
+        {"plain", {0, 0}, {0, 0}, 5.0f, 5.0f, 0.0, 0.0, 1.0},
+        {"velocity difference", {1, -2}, {3, 0}, 5.0f, 5.0f, 0.2, 0.0, 1.0 - 0.2 * dv},
+        {"velocity weight 0", {1, -2}, {3, 0}, 5.0f, 5.0f, 0.0, 0.0, 1.0},
+        {"large velocity difference", {1, -2}, {-6, 4}, 5.0f, 5.0f, 0.5, 0.0, 0.0},
+        {"luminance", {0, 0}, {0, 0}, 5.0f, 5.0f, 0.0, 0.6, 1.0 - 0.6 * std::fabs(lb - la) / std::max(la, lb)},
+        {"depth within tolerance", {0, 0}, {0, 0}, 5.0f, 5.2f, 0.0, 0.0, 1.0},
+        {"disocclusion", {0, 0}, {0, 0}, 5.0f, 5.4f, 0.0, 0.0, 0.0},
+    };
+    const int w = 32, h = 24;
+    for (const Case& k : cases) {
+        json nodes = {{"src", framesNode(a, b, true)},
+                      {"vel", framesNode(glm::vec4(k.v0, 0.0f, 0.0f), glm::vec4(k.v1, 0.0f, 0.0f))},
+                      {"depth", framesNode(glm::vec4(0.0f, 0.0f, k.d0, 0.0f), glm::vec4(0.0f, 0.0f, k.d1, 0.0f))},
+                      {"acc",
+                       accumulateNode({{"velocity_weight", k.velocityWeight},
+                                       {"luminance_weight", k.luminanceWeight},
+                                       {"depth_tolerance", 0.05}},
+                                      {{"color", "src.color"},
+                                       {"velocity", "vel.color"},
+                                       {"history_velocity", "vel.color@prev"},
+                                       {"depth", "depth.color"},
+                                       {"history_depth", "depth.color@prev"}})}};
+        json g = graph(nodes, {{"out", "acc.color"}, {"samples", "acc.samples"}}, w, h);
+        g["frame"]["frames"] = 2;
+        auto out = runGraph(g);
+        ASSERT_EQ(out.at("out").width, w / 2);
+        const double wHistory = k.expectedN / (k.expectedN + 1.0);
+        const glm::dvec4 expected = glm::mix(glm::dvec4(b), glm::dvec4(a), wHistory);
+        double worst = 0.0, worstN = 0.0;
+        for (int y = 4; y < h / 2 - 4; ++y) // away from the border, where the reprojected point may leave the screen
+            for (int x = 4; x < w / 2 - 4; ++x) {
+                for (int c = 0; c < 4; ++c) worst = std::max(worst, std::fabs(out.at("out").at(x, y)[c] - expected[c]));
+                worstN = std::max(worstN, std::fabs(out.at("samples").at(x, y)[0] - (k.expectedN + 1.0)));
+            }
+        std::printf("%s: history samples %.3f, worst |output - expected| %.2e, |samples - expected| %.2e\n", k.name,
+                    k.expectedN, worst, worstN);
+        EXPECT_LT(worst, 2e-3) << k.name;
+        EXPECT_LT(worstN, 2e-3) << k.name;
+    }
+}
+
+// A bright square sliding over a dark wall at ~4 px per frame, accumulated from the G-buffer's base colour (full
+// resolution, and half resolution through test.downsample). Trail: the summed |output - input| over the pixels the
+// square does not cover (nor covered on frame 0, see below), relative to the square's own energy (area x contrast),
+// after 9 frames. Bound: 1 % with the
+// velocity difference alone, the depth test alone, or both; without either the trail is the history's (> 20 %).
+// Where the square was last frame and is no longer (disoccluded background) the sample count restarts at 1.
+TEST_F(Temporal, MovingObjectLeavesNoGhostAndDisocclusionRestartsTheCount) {
+    SceneBuilder b("temporal_ghost");
+    std::vector<Tri> wall, square;
+    addQuad(wall, {0.0f, 0.0f, 0.0f}, {12.0f, 0.0f, 0.0f}, {0.0f, 12.0f, 0.0f}, {0.0f, 0.0f, 1.0f});
+    addQuad(square, {0.0f, 0.0f, 0.0f}, {0.5f, 0.0f, 0.0f}, {0.0f, 0.5f, 0.0f}, {0.0f, 0.0f, 1.0f});
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, b.material("dark", glm::vec3(0.05f), 0.0f, 0.3f))),
+           {0.0f, 0.0f, -5.0f});
+    b.node("square", static_cast<int32_t>(b.mesh("square", square, b.material("white", glm::vec3(1.0f), 0.0f, 0.3f))),
+           {-1.5f, 0.0f, -4.0f});
+    scene::Animation slide;
+    slide.name = "slide";
+    slide.samplers = {{scene::Interpolation::Linear, {0.0f, 1.0f},
+                       {glm::vec4(-1.5f, 0.0f, -4.0f, 0.0f), glm::vec4(3.5f, 0.0f, -4.0f, 0.0f)}}};
+    slide.channels = {{static_cast<uint32_t>(b.s.nodes.size() - 1), scene::AnimationPath::Translation, 0}};
+    b.s.animations.push_back(slide);
+    b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, 0.8f);
+    const auto glb = b.write();
+    const int w = 96, h = 64;
+
+    auto run = [&](bool half, bool velocity, bool depth, int frames) {
+        json in = {{"color", half ? "down.color" : "gbuffer.base_color"}, {"velocity", "gbuffer.velocity"}};
+        if (velocity) in["history_velocity"] = "gbuffer.velocity@prev";
+        if (depth) {
+            in["depth"] = "gbuffer.normal";
+            in["history_depth"] = "gbuffer.normal@prev";
+        }
+        json nodes = {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}, {"fps", 24.0}}}}},
+                      {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}},
+                      {"acc", accumulateNode({{"max_samples", 8}}, in)}};
+        json outputs = {{"out", "acc.color"}, {"samples", "acc.samples"}, {"in", "gbuffer.base_color"}};
+        if (half) {
+            nodes["down"] = {{"type", "test.downsample"}, {"in", {{"color", "gbuffer.base_color"}}}};
+            outputs["in"] = "down.color";
+        }
+        json g = graph(nodes, outputs, w, h);
+        g["frame"]["frames"] = frames;
+        return runGraph(g);
+    };
+    // Also the square's own pixels: their history must follow it (reprojected by its velocity), so the mean
+    // |output - input| over them stays small (returned in `inside`).
+    double inside = 0.0, insideSamples = 0.0; // and the mean sample count there
+    // Frame 0's velocity buffer has no motion yet (zero everywhere), so what the square covered on frame 0 is not
+    // rejected by the velocity difference on frame 1: those pixels are left out of the trail (`first`, per resolution).
+    Image first;
+    auto trail = [&inside, &insideSamples, &first](const std::map<std::string, Image>& out) {
+        const Image& o = out.at("out");
+        const Image& in = out.at("in");
+        double energy = 0.0, box = 0.0;
+        int covered = 0;
+        inside = insideSamples = 0.0;
+        for (int y = 0; y < in.height; ++y)
+            for (int x = 0; x < in.width; ++x) {
+                if (in.at(x, y)[0] > 0.5f) {
+                    box += in.at(x, y)[0] - 0.05;
+                    inside += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
+                    insideSamples += out.at("samples").at(x, y)[0];
+                    ++covered;
+                } else if (first.at(x, y)[0] <= 0.5f) {
+                    energy += std::fabs(o.at(x, y)[0] - in.at(x, y)[0]);
+                }
+            }
+        inside /= std::max(covered, 1);
+        insideSamples /= std::max(covered, 1);
+        return box > 0.0 ? energy / box : 1e9;
+    };
+    const int frames = 9;
+    for (bool half : {false, true}) {
+        first = run(half, true, true, 1).at("in");
+        const double both = trail(run(half, true, true, frames));
+        const double insideBoth = inside, samplesBoth = insideSamples;
+        const double velocityOnly = trail(run(half, true, false, frames));
+        const double depthOnly = trail(run(half, false, true, frames));
+        const double none = trail(run(half, false, false, frames));
+        std::printf("%s resolution: trail after %d frames: velocity + depth %.4f, velocity difference only %.4f, depth "
+                    "only %.4f, no rejection %.4f; on the square: mean |output - input| %.4f, mean samples %.2f\n",
+                    half ? "half" : "full", frames, both, velocityOnly, depthOnly, none, insideBoth, samplesBoth);
+        EXPECT_LT(insideBoth, 0.05);
+        // The square's history follows it (reprojected by its velocity, scaled to the input's pixels): its pixels keep
+        // their samples; without reprojection its leading band (a fifth of it) would restart every frame.
+        EXPECT_GT(samplesBoth, 7.5);
+        EXPECT_LT(both, 0.01);
+        EXPECT_LT(velocityOnly, 0.01);
+        EXPECT_LT(depthOnly, 0.01);
+        EXPECT_GT(none, 0.2);
+    }
+
+    // Disocclusion: frame 7 against frame 8 (a second run one frame shorter gives the square's last position).
+    auto before = run(false, true, true, frames - 1);
+    auto now = run(false, true, true, frames);
+    int disoccluded = 0, restarted = 0, background = 0, full = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool was = before.at("in").at(x, y)[0] > 0.5f, is = now.at("in").at(x, y)[0] > 0.5f;
+            const float n = now.at("samples").at(x, y)[0];
+            if (was && !is) {
+                ++disoccluded;
+                restarted += n == 1.0f;
+            }
+            if (!was && !is && (y < 16 || y >= h - 16)) { // rows the square never crosses
+                ++background;
+                full += n == 8.0f;
+            }
+        }
+    std::printf("disocclusion: count restarted at %d of %d pixels; static background at 8 samples: %d of %d\n",
+                restarted, disoccluded, full, background);
+    EXPECT_GT(disoccluded, 20);
+    EXPECT_EQ(restarted, disoccluded);
+    EXPECT_EQ(full, background);
+}
+
+// gbuffer.temporal_filter on a uniform G-buffer normal target alternating between two normals (static, no velocity):
+// the history is the running blend avg_k = mix(n_k, avg_k-1, feedback), the output's normal is avg / |avg| and its
+// shininess 1 - toksvigRoughness(1 - s, |avg|) of core/shading (the G-buffer's own Toksvig formula). A depth change
+// beyond the tolerance restarts the blend (the raw normal and shininess come back).
+TEST_F(Temporal, GbufferFilterBlendsNormalsAndReducesShininessLikeToksvig) {
+    const glm::vec3 na = glm::normalize(glm::vec3(0.3f, 1.0f, 0.1f)), nb = glm::normalize(glm::vec3(-0.4f, 1.0f, 0.5f));
+    const glm::vec2 ea = shading::octEncode(na), eb = shading::octEncode(nb);
+    const float shininess = 0.85f, depth = 6.0f;
+    const double feedback = 0.6;
+    const int w = 24, h = 16;
+    for (int frames : {1, 2, 5}) {
+        json nodes = {{"src",
+                       {{"type", "test.frames"},
+                        {"params",
+                         {{"a", {ea.x, ea.y, depth, shininess}}, {"b", {eb.x, eb.y, depth, shininess}}, {"alternate", true}}}}},
+                      {"filter",
+                       {{"type", "gbuffer.temporal_filter"},
+                        {"params", {{"feedback", feedback}}},
+                        {"in", {{"normal", "src.color"}, {"history", "filter.history@prev"}}}}}};
+        json g = graph(nodes, {{"out", "filter.normal"}, {"history", "filter.history"}}, w, h);
+        g["frame"]["frames"] = frames;
+        auto out = runGraph(g);
+        glm::dvec3 avg(na);
+        for (int f = 1; f < frames; ++f) avg = glm::mix(glm::dvec3(f % 2 ? nb : na), avg, feedback);
+        const double len = glm::length(avg);
+        const double expectedShininess = 1.0 - shading::toksvigRoughness(1.0f - shininess, static_cast<float>(len));
+        const glm::dvec3 expectedNormal = avg / len;
+        double worstN = 0.0, worstS = 0.0, worstH = 0.0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const float* o = out.at("out").at(x, y);
+                worstN = std::max(worstN, glm::length(glm::dvec3(shading::octDecode({o[0], o[1]})) - expectedNormal));
+                worstS = std::max(worstS, std::fabs(o[3] - expectedShininess));
+                EXPECT_EQ(o[2], depth);
+                const float* hh = out.at("history").at(x, y);
+                worstH = std::max(worstH, glm::length(glm::dvec3(hh[0], hh[1], hh[2]) - avg));
+            }
+        std::printf("%d frames: |avg| %.4f, shininess %.4f -> %.4f; worst normal error %.2e, shininess %.2e, history "
+                    "%.2e\n",
+                    frames, len, shininess, expectedShininess, worstN, worstS, worstH);
+        EXPECT_LT(worstN, 3e-3);
+        EXPECT_LT(worstS, 2e-3);
+        EXPECT_LT(worstH, 2e-3);
+        if (frames > 1) {
+            EXPECT_LT(expectedShininess, shininess - 0.05); // the reduction is visible to the test
+        }
+    }
+    // Depth 6 then 7 (17 % apart): another surface, so frame 1 is nb and the authored shininess.
+    json nodes = {{"src", framesNode(glm::vec4(ea, depth, shininess), glm::vec4(eb, 7.0f, shininess))},
+                  {"filter",
+                   {{"type", "gbuffer.temporal_filter"},
+                    {"params", {{"feedback", feedback}}},
+                    {"in", {{"normal", "src.color"}, {"history", "filter.history@prev"}}}}}};
+    json g = graph(nodes, {{"out", "filter.normal"}}, w, h);
+    g["frame"]["frames"] = 2;
+    auto out = runGraph(g);
+    const float* o = out.at("out").at(5, 5);
+    EXPECT_LT(glm::length(shading::octDecode({o[0], o[1]}) - nb), 2e-3f);
+    EXPECT_NEAR(o[3], shininess, 1e-3);
+}
+
+// The Museum's dolly shot (museum.json, 6 frames at 128x72): the filtered G-buffer's shininess is never above the
+// G-buffer's, somewhere clearly below it (the camera's motion changes what thin and normal-mapped geometry a pixel
+// sees), and depth passes through.
+TEST_F(Temporal, MuseumDollyFilterNeverIncreasesShininess) {
+    auto out = runGraphFile(std::string(VITRINE_SOURCE_DIR) + "/graphs/museum.json",
+                            {"frame.width=128", "frame.height=72", "frame.frames=6", "frame.write=[5]",
+                             "scene.params.camera=dolly", "outputs.raw=gbuffer.normal", "outputs.filtered=gfilter.normal"});
+    const Image& raw = out.at("raw");
+    const Image& filtered = out.at("filtered");
+    double increase = 0.0, decrease = 0.0;
+    int reduced = 0;
+    for (int y = 0; y < raw.height; ++y)
+        for (int x = 0; x < raw.width; ++x) {
+            increase = std::max(increase, double(filtered.at(x, y)[3] - raw.at(x, y)[3]));
+            decrease = std::max(decrease, double(raw.at(x, y)[3] - filtered.at(x, y)[3]));
+            reduced += raw.at(x, y)[3] - filtered.at(x, y)[3] > 0.01f;
+            EXPECT_EQ(filtered.at(x, y)[2], raw.at(x, y)[2]);
+        }
+    std::printf("museum dolly: shininess increased by at most %.2e, reduced by up to %.3f, by > 0.01 at %d of %d "
+                "pixels\n",
+                increase, decrease, reduced, raw.width * raw.height);
+    EXPECT_LE(increase, 0.0);
+    EXPECT_GT(reduced, 20);
+}
+
+} // namespace
+} // namespace vitrine::test
