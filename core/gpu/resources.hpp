@@ -17,6 +17,7 @@ struct ImageDesc {
     VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
     VkImageUsageFlags usage = 0;
     bool cube = false;
+    bool cubeArray = false; // with cube: the full view is a cube-map array even for 6 layers (one probe)
 
     VkImageCreateInfo createInfo() const;
     bool operator==(const ImageDesc&) const = default;

@@ -601,13 +601,15 @@ const GpuImage& Executor::image(const std::string& resource) const {
     return mPhysical[physicalOf(static_cast<uint32_t>(r), false)].image;
 }
 
-Image Executor::read(const std::string& resource) {
+Image Executor::read(const std::string& resource, uint32_t mip, uint32_t layer) {
     int r = mGraph.findResource(resource);
     if (r < 0) throw UserError("no resource '" + resource + "' in the graph");
     if (mGraph.resources[r].transient())
         throw UserError("resource '" + resource + "' is transient (its memory is reused within the frame); make it a graph output to read it");
     Physical& p = mPhysical[physicalOf(static_cast<uint32_t>(r), false)];
-    return readImage(mCtx, p.image, p.state.layout);
+    if (mip >= p.image.desc().mipLevels || layer >= p.image.desc().layers)
+        throw UserError("resource '" + resource + "' has no mip " + std::to_string(mip) + " / layer " + std::to_string(layer));
+    return readImage(mCtx, p.image, p.state.layout, mip, layer);
 }
 
 } // namespace vitrine

@@ -57,7 +57,9 @@ public:
     double pipelineMs() const { return mPipelineMs; }
     // The image a resource had in the last frame run (for tests and debugging).
     const GpuImage& image(const std::string& resource) const;
-    Image read(const std::string& resource);
+    // One mip / layer of a resource that is not transient, as it was after the last frame (tests read every face of a
+    // cube-map array this way).
+    Image read(const std::string& resource, uint32_t mip = 0, uint32_t layer = 0);
 
     struct Pipeline;
     struct Physical {

@@ -1,0 +1,508 @@
+// ibl.capture: every reflection probe's six faces rendered by the frame's own G-buffer and lighting nodes (an
+// inner graph run per face, nodes/ibl/capture_graph.hpp), prefiltered with GGX per mip (shaders/ibl/prefilter.comp)
+// into one cube-map array, plus the split-sum BRDF LUT (shaders/ibl/brdf_lut.comp). Cached in the bake cache.
+#include "nodes/bake/baked_lighting.hpp"
+#include "nodes/ibl/capture_graph.hpp"
+
+#include "core/bake/cache.hpp"
+#include "core/base/error.hpp"
+#include "core/base/log.hpp"
+#include "core/gpu/context.hpp"
+#include "core/gpu/transfer.hpp"
+#include "core/gpu/vk_check.hpp"
+#include "core/graph/executor.hpp"
+#include "core/scene/hash.hpp"
+#include "core/shader/compiler.hpp"
+#include "shaders/ibl/capture.h"
+
+#include <glm/gtc/packing.hpp>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cstring>
+
+namespace vitrine {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr uint32_t kCacheVersion = 1;
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "ibl.capture";
+    s.doc = "Localized reflection probes (MUSEUM_SPEC §4): each of the scene's probes sees the lit scene through six "
+            "90-degree faces rendered by gbuffer.layered, shadow.directional and lighting.deferred (an inner graph run "
+            "per face: sun, shadows, sky, lightmaps and irradiance volume as in the frame), then every mip is the "
+            "radiance convolved with the GGX lobe of roughness mip / (mips - 1) by filtered importance sampling "
+            "[Karis13]. Also the split-sum BRDF LUT. Captured on the first frame (with a progress bar) and cached on "
+            "disk by scene, probes, sky, baked lighting and params.";
+    auto tex = [](const char* name, const char* doc, bool optional = false) {
+        return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc, true};
+    };
+    s.inputs = {
+        {"scene", PortKind::Scene, {}, false, Usage::Sampled, "The scene; its `probes` are captured in order"},
+        tex("sky", "A sky node's cube map (as lighting.deferred's `sky`)"),
+        tex("sky_sh", "A sky node's `sh` (SH9 radiance, the sun)"),
+        tex("lightmap", "bake.lightmap's lightmap (with volume and baked)", true),
+        tex("volume", "bake.lightmap's irradiance volume (with lightmap and baked)", true),
+        {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's layout (with lightmap and volume)"},
+    };
+    OutputPort cubes;
+    cubes.name = "cubes";
+    cubes.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    cubes.size = SizeRule::absolute(32, 32);
+    cubes.persistent = true;
+    cubes.readBack = true;
+    cubes.doc = "Prefiltered radiance (cd/m²), a cube-map array: probe i is layers [6i, 6i + 6) (+X, -X, +Y, -Y, +Z, "
+                "-Z); mip m is GGX roughness m / (mips - 1) (shaders/ibl/ibl_common.glsl)";
+    OutputPort lut;
+    lut.name = "brdf_lut";
+    lut.format = VK_FORMAT_R32G32_SFLOAT;
+    lut.size = SizeRule::absolute(64, 64);
+    lut.persistent = true;
+    lut.doc = "Split-sum BRDF LUT: texel (NoV, roughness) = (A, B), specular albedo f0 A + B (ibl_common.glsl)";
+    s.outputs = {cubes, lut};
+    s.params = {
+        {"size", ParamType::Int, 32, 4.0, 2048.0, {}, "Face size in texels of mip 0 (the demo: 256)"},
+        {"mips", ParamType::Int, 0, 0.0, 12.0, {}, "Mip levels (roughness steps); 0: down to 1x1"},
+        {"samples", ParamType::Int, 512, 1.0, 4096.0, {}, "GGX samples per prefiltered texel"},
+        {"lut_size", ParamType::Int, 64, 8.0, 1024.0, {}, "BRDF LUT size (lut_size x lut_size)"},
+        {"lut_samples", ParamType::Int, 16384, 16.0, 16384.0, {}, "GGX samples per LUT texel"},
+        {"znear", ParamType::Float, 0.05, 1e-4, 100.0, {}, "Near plane of the face cameras (m)"},
+        {"sky_ambient", ParamType::Float, 0.15, 0.0, 1.0, {}, "lighting.deferred's sky_ambient in the capture"},
+        {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "lighting.deferred's sun_scale in the capture"},
+        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "lighting.deferred's emissive_scale in the capture"},
+        {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows in the capture (shadow.directional per face)"},
+        {"shadow_resolution", ParamType::Int, 512, 64.0, 8192.0, {}, "shadow.directional's resolution per face"},
+        {"shadow_cascades", ParamType::Int, 2, 1.0, 4.0, {}, "shadow.directional's cascades per face"},
+        {"shadow_distance", ParamType::Float, 30.0, 1.0, 10000.0, {}, "shadow.directional's distance per face (m)"},
+        {"cache", ParamType::Bool, true, {}, {}, {}, "Load and store the capture in the bake cache"},
+        {"recapture", ParamType::Bool, false, {}, {}, {}, "Capture even when the bake cache holds this capture (and replace it)"},
+    };
+    return s;
+}
+
+// Host copy of the whole cube-map array: mip m's layers in order, RGBA half floats (the output's format).
+struct CubeArrayData {
+    uint32_t size = 0, mips = 0, layers = 0;
+    std::vector<uint16_t> texels;
+    size_t mipOffset(uint32_t m) const {
+        size_t o = 0;
+        for (uint32_t i = 0; i < m; ++i) o += size_t(4) * layers * (size >> i) * (size >> i);
+        return o;
+    }
+};
+
+std::vector<uint8_t> serialize(const CubeArrayData& d) {
+    std::vector<uint8_t> out(16 + d.texels.size() * 2);
+    const uint32_t header[4] = {kCacheVersion, d.size, d.mips, d.layers};
+    std::memcpy(out.data(), header, 16);
+    std::memcpy(out.data() + 16, d.texels.data(), d.texels.size() * 2);
+    return out;
+}
+
+std::optional<CubeArrayData> deserialize(const std::vector<uint8_t>& bytes, uint32_t size, uint32_t mips, uint32_t layers) {
+    if (bytes.size() < 16) return std::nullopt;
+    uint32_t header[4];
+    std::memcpy(header, bytes.data(), 16);
+    if (header[0] != kCacheVersion || header[1] != size || header[2] != mips || header[3] != layers) return std::nullopt;
+    CubeArrayData d{size, mips, layers, {}};
+    d.texels.resize(d.mipOffset(mips));
+    if (bytes.size() != 16 + d.texels.size() * 2) return std::nullopt;
+    std::memcpy(d.texels.data(), bytes.data() + 16, d.texels.size() * 2);
+    return d;
+}
+
+// The 2x2 box-filtered mip chain of each face, the "mip-filtered source" of filtered importance sampling.
+std::vector<std::vector<Image>> boxMips(std::vector<Image> faces, uint32_t mips) {
+    std::vector<std::vector<Image>> chain(mips);
+    chain[0] = std::move(faces);
+    for (uint32_t m = 1; m < mips; ++m)
+        for (const Image& src : chain[m - 1]) {
+            Image dst(src.width / 2, src.height / 2);
+            for (int y = 0; y < dst.height; ++y)
+                for (int x = 0; x < dst.width; ++x)
+                    for (int c = 0; c < 4; ++c)
+                        dst.at(x, y)[c] = 0.25f * (src.at(2 * x, 2 * y)[c] + src.at(2 * x + 1, 2 * y)[c] +
+                                                   src.at(2 * x, 2 * y + 1)[c] + src.at(2 * x + 1, 2 * y + 1)[c]);
+            chain[m].push_back(std::move(dst));
+        }
+    return chain;
+}
+
+// Fills every mip and layer of `image` (RGBA32F, just created) from host data and leaves it ready to be sampled by
+// compute shaders. Outside the frame's command buffer: it waits for the GPU.
+void uploadAll(Context& ctx, const GpuImage& image, const std::vector<std::vector<Image>>& mips) {
+    const ImageDesc& d = image.desc();
+    size_t bytes = 0;
+    for (const auto& level : mips)
+        for (const Image& face : level) bytes += face.pixels.size() * sizeof(float);
+    GpuBuffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "ibl.capture.staging");
+    std::vector<VkBufferImageCopy> regions;
+    size_t offset = 0;
+    for (uint32_t m = 0; m < mips.size(); ++m)
+        for (uint32_t layer = 0; layer < mips[m].size(); ++layer) {
+            const Image& face = mips[m][layer];
+            std::memcpy(static_cast<uint8_t*>(staging.mapped()) + offset, face.pixels.data(), face.pixels.size() * 4);
+            VkBufferImageCopy r{};
+            r.bufferOffset = offset;
+            r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, m, layer, 1};
+            r.imageExtent = {static_cast<uint32_t>(face.width), static_cast<uint32_t>(face.height), 1};
+            regions.push_back(r);
+            offset += face.pixels.size() * 4;
+        }
+    ctx.immediate([&](VkCommandBuffer cmd) {
+        auto barrier = [&](VkImageLayout from, VkImageLayout to, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
+                           VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+            VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+            b.srcStageMask = srcStage;
+            b.srcAccessMask = srcAccess;
+            b.dstStageMask = dstStage;
+            b.dstAccessMask = dstAccess;
+            b.oldLayout = from;
+            b.newLayout = to;
+            b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            b.image = image.image();
+            b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, d.mipLevels, 0, d.layers};
+            VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+            dep.imageMemoryBarrierCount = 1;
+            dep.pImageMemoryBarriers = &b;
+            vkCmdPipelineBarrier2(cmd, &dep);
+        };
+        barrier(VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+        vkCmdCopyBufferToImage(cmd, staging.buffer(), image.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                               static_cast<uint32_t>(regions.size()), regions.data());
+        barrier(VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    });
+}
+
+class Capture final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        const Params& p = ctx.params();
+        mScene = ctx.objectAs<SceneObject>("scene");
+        const scene::Scene& scene = mScene->scene();
+        if (scene.probes.empty())
+            ctx.failParam("size", "scene '" + scene.name +
+                                      "' has no reflection probes (Scene::probes) to capture; place probes in the scene "
+                                      "or remove ibl.capture from the graph");
+        const bool lm = ctx.hasInput("lightmap"), vol = ctx.hasInput("volume"), baked = ctx.hasInput("baked");
+        if (lm != vol || vol != baked)
+            ctx.failParam("shadows", "connect lightmap, volume and baked (bake.lightmap's three outputs) together, or none");
+        if (baked) mBaked = ctx.objectAs<BakedLightingObject>("baked");
+        mSize = static_cast<uint32_t>(p.getInt("size"));
+        const uint32_t fullChain = std::bit_width(mSize);
+        mMips = p.getInt("mips") ? static_cast<uint32_t>(p.getInt("mips")) : fullChain;
+        if (mMips > fullChain)
+            ctx.failParam("mips", "at most " + std::to_string(fullChain) + " mips for faces of " + std::to_string(mSize) +
+                                      " texels, got " + std::to_string(mMips));
+        mLayers = static_cast<uint32_t>(6 * scene.probes.size());
+        ImageDesc& cubes = ctx.output("cubes");
+        cubes.width = cubes.height = mSize;
+        cubes.mipLevels = mMips;
+        cubes.layers = mLayers;
+        cubes.cube = true;
+        cubes.cubeArray = true;
+        mLutSize = static_cast<uint32_t>(p.getInt("lut_size"));
+        ImageDesc& lut = ctx.output("brdf_lut");
+        lut.width = lut.height = mLutSize;
+
+        mLighting.size = mSize;
+        mLighting.znear = p.getFloat("znear");
+        mLighting.skyAmbient = p.getFloat("sky_ambient");
+        mLighting.sunScale = p.getFloat("sun_scale");
+        mLighting.emissiveScale = p.getFloat("emissive_scale");
+        mLighting.shadows = p.getBool("shadows");
+        mLighting.shadowResolution = static_cast<uint32_t>(p.getInt("shadow_resolution"));
+        mLighting.shadowCascades = static_cast<uint32_t>(p.getInt("shadow_cascades"));
+        mLighting.shadowDistance = p.getFloat("shadow_distance");
+        mSamples = static_cast<uint32_t>(p.getInt("samples"));
+        mLutSamples = static_cast<uint32_t>(p.getInt("lut_samples"));
+        mUseCache = p.getBool("cache");
+        mRecapture = p.getBool("recapture");
+
+        mLutPipeline = ctx.computePipeline("ibl/brdf_lut.comp");
+        mPrefilterPipeline = ctx.computePipeline("ibl/prefilter.comp", {}, 1);
+        mCopyPipeline = ctx.computePipeline("ibl/copy_mip.comp", {}, 1);
+    }
+
+    void execute(ExecuteContext& ctx) override {
+        if (mDone) return; // persistent outputs: one capture serves every frame
+        gpu_types::IblBrdfLutPush lut{mLutSize, mLutSamples, 0, 0};
+        ctx.dispatch(mLutPipeline, &lut, sizeof(lut), mLutSize, mLutSize);
+
+        // Run what was recorded so far (sky, bake), so the inputs can be read back and hashed.
+        ctx.splitSubmission();
+        auto inputs = std::make_shared<CaptureInputs>();
+        inputs->scene = mScene->shared();
+        inputs->anisotropy = mScene->anisotropy;
+        inputs->time = mScene->time;
+        const GpuImage& sky = ctx.input("sky");
+        if (sky.desc().layers != 6) throw UserError("ibl.capture: input 'sky' must be a cube map (6 layers)");
+        for (uint32_t f = 0; f < 6; ++f) inputs->sky.push_back(readImage(ctx.gpu(), sky, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, f));
+        inputs->skySh = readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        if (mBaked) {
+            inputs->lightmap = readImage(ctx.gpu(), ctx.input("lightmap"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+            inputs->volume = readImage(ctx.gpu(), ctx.input("volume"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+            inputs->baked = mBaked;
+        }
+        const BakeKey key = cacheKey(ctx.params(), *inputs);
+        const BakeCache cache(defaultCacheDir());
+        const scene::Scene& scene = mScene->scene();
+
+        std::optional<CubeArrayData> data;
+        if (mUseCache && !mRecapture)
+            if (auto bytes = cache.get(key)) data = deserialize(*bytes, mSize, mMips, mLayers);
+        if (data) {
+            logInfo("scene '" + scene.name + "': " + std::to_string(scene.probes.size()) +
+                    " reflection probes loaded from the bake cache");
+            mFromCache = true;
+            writeCached(ctx, *data);
+        } else {
+            const auto start = Clock::now();
+            std::vector<Image> faces = captureFaces(ctx, inputs);
+            prefilter(ctx, std::move(faces));
+            mFromCache = false;
+            if (mUseCache) {
+                ctx.splitSubmission();
+                CubeArrayData out = readCubes(ctx);
+                if (!cache.put(key, serialize(out)))
+                    logWarning("scene '" + scene.name + "': could not write the probes to the bake cache under " +
+                               cache.dir().string());
+            }
+            mCaptureMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+            logInfo("scene '" + scene.name + "': " + std::to_string(scene.probes.size()) + " reflection probes (" +
+                    std::to_string(mSize) + "² faces, " + std::to_string(mMips) + " mips) captured and prefiltered in " +
+                    std::to_string(static_cast<int>(mCaptureMs)) + " ms");
+        }
+        mDone = true;
+    }
+
+    void releaseGpu() override {
+        mDone = false;
+        if (mCtx && mPool) {
+            Context* c = mCtx;
+            VkDescriptorPool pool = mPool;
+            VkDescriptorSetLayout layout = mSetLayout;
+            VkSampler sampler = mSampler;
+            c->destroyLater([c, pool, layout, sampler] {
+                vkDestroyDescriptorPool(c->device(), pool, nullptr);
+                vkDestroyDescriptorSetLayout(c->device(), layout, nullptr);
+                vkDestroySampler(c->device(), sampler, nullptr);
+            });
+        }
+        mPool = VK_NULL_HANDLE;
+        mSetLayout = VK_NULL_HANDLE;
+        mSampler = VK_NULL_HANDLE;
+        mSource = GpuImage();
+    }
+
+private:
+    BakeKey cacheKey(const Params& p, const CaptureInputs& in) const {
+        scene::Hasher h;
+        h.string("probes");
+        h.value(kCacheVersion);
+        h.value(in.scene->contentHash());
+        h.value(in.time);
+        for (const Image& f : in.sky) h.array(f.pixels);
+        h.array(in.skySh.pixels);
+        if (in.lightmap) h.array(in.lightmap->pixels);
+        if (in.volume) h.array(in.volume->pixels);
+        if (in.baked) {
+            h.array(in.baked->lightmapScaleOffset);
+            h.value(in.baked->volumeOrigin);
+            h.value(in.baked->volumeSpacing);
+            h.value(in.baked->volumeCounts);
+        }
+        h.value(mSize);
+        h.value(mMips);
+        h.value(mSamples);
+        h.value(mLighting.znear);
+        h.value(mLighting.skyAmbient);
+        h.value(mLighting.sunScale);
+        h.value(mLighting.emissiveScale);
+        h.value(mLighting.shadows);
+        h.value(mLighting.shadowResolution);
+        h.value(mLighting.shadowCascades);
+        h.value(mLighting.shadowDistance);
+        h.value(in.anisotropy);
+        (void)p;
+        return {"probes", h.result()};
+    }
+
+    // Runs the inner graph for 6 x probes frames; returns face f of probe i as image 6 i + f (texel order of the cube).
+    std::vector<Image> captureFaces(ExecuteContext& ctx, std::shared_ptr<CaptureInputs> inputs) {
+        std::unique_ptr<CaptureGraph> graph = buildCaptureGraph(inputs, mLighting);
+        std::vector<Image> faces(mLayers);
+        Progress progress("capturing " + std::to_string(mLayers / 6) + " reflection probes (" + std::to_string(mSize) +
+                              "² faces)",
+                          mLayers);
+        {
+            Executor inner(ctx.gpu(), graph->graph, ctx.shaders());
+            RunOptions options;
+            options.progress = false;
+            options.onOutput = [&](uint32_t frame, const std::string&, const Image& image) {
+                Image& face = faces.at(frame);
+                face = Image(image.width, image.height);
+                // The face camera is right-handed, so its image is the face mirrored left to right.
+                for (int y = 0; y < image.height; ++y)
+                    for (int x = 0; x < image.width; ++x)
+                        std::memcpy(face.at(x, y), image.at(image.width - 1 - x, y), 4 * sizeof(float));
+                progress.advance();
+            };
+            inner.run(options);
+        }
+        progress.finish();
+        return faces;
+    }
+
+    void ensureSets(Context& gpu) {
+        if (mPool) return;
+        mCtx = &gpu;
+        std::array<VkDescriptorSetLayoutBinding, 2> bindings{};
+        bindings[0] = {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+        bindings[1] = {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+        li.bindingCount = 2;
+        li.pBindings = bindings.data();
+        VK_CHECK(vkCreateDescriptorSetLayout(gpu.device(), &li, nullptr, &mSetLayout));
+        const std::array<VkDescriptorPoolSize, 2> sizes = {
+            VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16},
+            VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 16}};
+        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        pi.maxSets = 16;
+        pi.poolSizeCount = 2;
+        pi.pPoolSizes = sizes.data();
+        VK_CHECK(vkCreateDescriptorPool(gpu.device(), &pi, nullptr, &mPool));
+        VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+        si.magFilter = si.minFilter = VK_FILTER_LINEAR;
+        si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+        si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+        si.maxLod = VK_LOD_CLAMP_NONE;
+        VK_CHECK(vkCreateSampler(gpu.device(), &si, nullptr, &mSampler));
+    }
+
+    // One descriptor set per output mip: the source (its cube-array view, or mip m's array view) and mip m of cubes.
+    VkDescriptorSet mipSet(ExecuteContext& ctx, VkImageView source, uint32_t mip) {
+        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        ai.descriptorPool = mPool;
+        ai.descriptorSetCount = 1;
+        ai.pSetLayouts = &mSetLayout;
+        VkDescriptorSet set;
+        VK_CHECK(vkAllocateDescriptorSets(ctx.gpu().device(), &ai, &set));
+        VkDescriptorImageInfo src{mSampler, source, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+        VkDescriptorImageInfo dst{VK_NULL_HANDLE, ctx.output("cubes").mipView(mip), VK_IMAGE_LAYOUT_GENERAL};
+        std::array<VkWriteDescriptorSet, 2> w{};
+        for (uint32_t i = 0; i < 2; ++i) {
+            w[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+            w[i].dstSet = set;
+            w[i].dstBinding = i;
+            w[i].descriptorCount = 1;
+            w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+            w[i].pImageInfo = i == 0 ? &src : &dst;
+        }
+        vkUpdateDescriptorSets(ctx.gpu().device(), 2, w.data(), 0, nullptr);
+        return set;
+    }
+
+    void resetSets(Context& gpu) {
+        ensureSets(gpu);
+        VK_CHECK(vkResetDescriptorPool(gpu.device(), mPool, 0));
+    }
+
+    void prefilter(ExecuteContext& ctx, std::vector<Image> faces) {
+        const uint32_t sourceMips = std::bit_width(mSize);
+        ImageDesc d;
+        d.width = d.height = mSize;
+        d.mipLevels = sourceMips;
+        d.layers = mLayers;
+        d.cube = true;
+        d.cubeArray = true;
+        d.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+        d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+        mSource = GpuImage(ctx.gpu(), d, "ibl.capture.source");
+        uploadAll(ctx.gpu(), mSource, boxMips(std::move(faces), sourceMips));
+        resetSets(ctx.gpu());
+        const std::array<VkDescriptorSetLayout, 1> layouts = {mSetLayout};
+        for (uint32_t m = 0; m < mMips; ++m) {
+            const VkDescriptorSet set = mipSet(ctx, mSource.view(), m);
+            gpu_types::IblPrefilterPush push{};
+            push.size = mSize >> m;
+            push.layers = mLayers;
+            push.samples = mSamples;
+            push.sourceSize = mSize;
+            push.roughness = mMips > 1 ? float(m) / float(mMips - 1) : 0.0f;
+            push.sourceMips = float(sourceMips);
+            ctx.dispatchWithSets(mPrefilterPipeline, &push, sizeof(push), push.size, push.size * mLayers, layouts,
+                                 std::array<VkDescriptorSet, 1>{set});
+        }
+    }
+
+    void writeCached(ExecuteContext& ctx, const CubeArrayData& data) {
+        std::vector<std::vector<Image>> mips(mMips);
+        for (uint32_t m = 0; m < mMips; ++m) {
+            const uint32_t s = mSize >> m;
+            const uint16_t* src = data.texels.data() + data.mipOffset(m);
+            for (uint32_t layer = 0; layer < mLayers; ++layer) {
+                Image face(static_cast<int>(s), static_cast<int>(s));
+                for (size_t i = 0; i < face.pixels.size(); ++i) face.pixels[i] = glm::unpackHalf1x16(*src++);
+                mips[m].push_back(std::move(face));
+            }
+        }
+        ImageDesc d;
+        d.width = d.height = mSize;
+        d.mipLevels = mMips;
+        d.layers = mLayers;
+        d.cube = true;
+        d.cubeArray = true;
+        d.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+        d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+        mSource = GpuImage(ctx.gpu(), d, "ibl.capture.cached");
+        uploadAll(ctx.gpu(), mSource, mips);
+        resetSets(ctx.gpu());
+        const std::array<VkDescriptorSetLayout, 1> layouts = {mSetLayout};
+        for (uint32_t m = 0; m < mMips; ++m) {
+            const VkDescriptorSet set = mipSet(ctx, mSource.mipView(m), m);
+            gpu_types::IblPrefilterPush push{};
+            push.size = mSize >> m;
+            push.layers = mLayers;
+            ctx.dispatchWithSets(mCopyPipeline, &push, sizeof(push), push.size, push.size * mLayers, layouts,
+                                 std::array<VkDescriptorSet, 1>{set});
+        }
+    }
+
+    CubeArrayData readCubes(ExecuteContext& ctx) {
+        CubeArrayData d{mSize, mMips, mLayers, {}};
+        d.texels.reserve(d.mipOffset(mMips));
+        const GpuImage& cubes = ctx.output("cubes");
+        for (uint32_t m = 0; m < mMips; ++m)
+            for (uint32_t layer = 0; layer < mLayers; ++layer) {
+                const Image face = readImage(ctx.gpu(), cubes, VK_IMAGE_LAYOUT_GENERAL, m, layer);
+                for (float v : face.pixels) d.texels.push_back(glm::packHalf1x16(v));
+            }
+        return d;
+    }
+
+    std::shared_ptr<SceneObject> mScene;
+    std::shared_ptr<BakedLightingObject> mBaked;
+    CaptureLighting mLighting;
+    uint32_t mSize = 32, mMips = 6, mLayers = 6, mLutSize = 64, mSamples = 64, mLutSamples = 1024;
+    bool mUseCache = true, mRecapture = false, mDone = false, mFromCache = false;
+    double mCaptureMs = 0.0;
+    PipelineId mLutPipeline = 0, mPrefilterPipeline = 0, mCopyPipeline = 0;
+    Context* mCtx = nullptr;
+    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
+    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    VkSampler mSampler = VK_NULL_HANDLE;
+    GpuImage mSource;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Capture>(); });
+
+} // namespace
+} // namespace vitrine
