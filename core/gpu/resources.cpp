@@ -59,7 +59,8 @@ void GpuImage::createViews() {
     mCtx->setName(reinterpret_cast<uint64_t>(mImage), VK_OBJECT_TYPE_IMAGE, mName);
     VkImageViewCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     info.image = mImage;
-    info.viewType = mDesc.cube ? VK_IMAGE_VIEW_TYPE_CUBE
+    // A cube with more than 6 layers is a cube-map array (6 faces per cube, Vulkan face order).
+    info.viewType = mDesc.cube ? (mDesc.layers > 6 ? VK_IMAGE_VIEW_TYPE_CUBE_ARRAY : VK_IMAGE_VIEW_TYPE_CUBE)
                                : (mDesc.layers > 1 ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D);
     info.format = mDesc.format;
     info.subresourceRange = {aspectOf(mDesc.format), 0, mDesc.mipLevels, 0, mDesc.layers};
