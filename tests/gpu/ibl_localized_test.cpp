@@ -470,6 +470,21 @@ TEST_F(IblLocalized, ResolveAppliesTheSplitSumLutAndDiffuseAlbedo) {
             EXPECT_LT(relErr(rgb(out.at("diffuse"), x, y), *l * albedo), 0.01) << x << "," << y;
         }
     EXPECT_GT(checked, W * H / 5);
+
+    // Diffuse looks along the normal: with each face holding its texel coordinates, the floor's diffuse is the
+    // centre of face +Y (2, 8, 8) and the wall's that of face +Z (4, 8, 8), times the diffuse albedo.
+    auto texels = runGraph(graph(iblNodes(sc.glb, sc.probes, {{"ibl", {{"blend", "b"}}}}, "texels"),
+                                 {{"diffuse", "ibl.diffuse"}}, W, H));
+    int centred = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            auto p = sc.room.hit(cam.position, cam.ray(x, y));
+            if (!p || nearBorder(sc.probes, *p) || !cpuBlend(sc.probes, *p)) continue;
+            ++centred;
+            glm::dvec3 faceCentre(std::abs(p->y) < 1e-6 ? 2.0 : 4.0, 8.0, 8.0);
+            EXPECT_LT(relErr(rgb(texels.at("diffuse"), x, y), faceCentre * albedo), 0.01) << x << "," << y;
+        }
+    EXPECT_GT(centred, W * H / 5);
 }
 
 // lighting.deferred with ibl_specular: its specular_indirect is the IBL input (vertex AO and cavity are 1 here)
