@@ -246,7 +246,7 @@ Context::Context(const ContextOptions& options)
     features.features.shaderInt64 = supported.shaderInt64;
     features.features.depthClamp = supported.depthClamp;
     features.features.dualSrcBlend = supported.dualSrcBlend;
-    features.features.imageCubeArray = supported.imageCubeArray; // ibl.capture's probe array (samplerCubeArray)
+    features.features.imageCubeArray = supported.imageCubeArray; // probe cube-map arrays (ibl.capture, ibl.localized)
     mDualSourceBlend = supported.dualSrcBlend;
 
     float priority = 1.0f;

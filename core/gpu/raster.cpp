@@ -133,9 +133,10 @@ void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, const std::vector<At
     VkRenderingAttachmentInfo depthInfo{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
     if (depth) {
         depthInfo.imageView = depth->view;
-        depthInfo.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        depthInfo.imageLayout =
+            depth->readOnly ? VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
         depthInfo.loadOp = depth->clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
-        depthInfo.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        depthInfo.storeOp = depth->readOnly ? VK_ATTACHMENT_STORE_OP_NONE : VK_ATTACHMENT_STORE_OP_STORE;
         depthInfo.clearValue = depth->clearValue;
     }
     VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};

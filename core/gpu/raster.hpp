@@ -64,6 +64,7 @@ struct Attachment {
     VkImageView view = VK_NULL_HANDLE;
     bool clear = true; // else load
     VkClearValue clearValue{};
+    bool readOnly = false; // depth: a Usage::DepthRead port (DEPTH_STENCIL_READ_ONLY_OPTIMAL, sampled by the pass)
 };
 
 // vkCmdBeginRendering over `extent` with the attachments in the layouts the render graph put them in

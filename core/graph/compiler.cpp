@@ -32,7 +32,8 @@ VkImageUsageFlags usageFlags(Usage u) {
     case Usage::StorageWrite:
     case Usage::StorageReadWrite: return VK_IMAGE_USAGE_STORAGE_BIT;
     case Usage::ColorAttachment: return VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-    case Usage::DepthAttachment: return VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+    case Usage::DepthAttachment:
+    case Usage::DepthRead: return VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
     case Usage::TransferSrc: return VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     case Usage::TransferDst: return VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     }

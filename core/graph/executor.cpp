@@ -116,6 +116,20 @@ public:
         vkCmdPipelineBarrier2(mCmd, &dep);
     }
 
+    void changeUsage(const std::string& port, Usage usage) override {
+        const PassUse* u = findUse(port, true);
+        if (!u) throw InternalError("node " + pass().id + ": changeUsage of '" + port + "', which is not its output");
+        uint32_t phys = mEx.physicalOf(u->resource, u->previous);
+        Executor::Physical& p = mEx.mPhysical[phys];
+        if (auto b = requireAccess(p.state, phys, accessOf(usage, pass().schema->pass))) {
+            VkImageMemoryBarrier2 vb = toVulkan(*b, p.image.image(), aspectOf(p.image.desc().format));
+            VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+            dep.imageMemoryBarrierCount = 1;
+            dep.pImageMemoryBarriers = &vb;
+            vkCmdPipelineBarrier2(mCmd, &dep);
+        }
+    }
+
     void splitSubmission() override {
         VK_CHECK(vkEndCommandBuffer(mCmd));
         mEx.mCtx.waitSerial(mEx.mCtx.submit(mCmd));

@@ -122,6 +122,11 @@ public:
     // over several dispatches (render.pathtrace splits its samples so no invocation runs long).
     virtual void computeBarrier() = 0;
 
+    // Moves one of this pass's own outputs to another usage between two of its rendering scopes (a raster pass
+    // that samples in a later scope what an earlier one drew, e.g. ibl.localized's blend weights): records the
+    // barrier and layout transition and tracks the new state, so the graph's later barriers start from it.
+    virtual void changeUsage(const std::string& output, Usage usage) = 0;
+
     // Ends the frame's command buffer here, submits it and waits for the GPU, then goes on recording into a
     // fresh one (cmd() stays the same handle; bindings are gone). For long work done once (bakes), so that it
     // can show progress and read results back mid-frame; everything recorded before, this pass's inputs

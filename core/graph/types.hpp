@@ -14,8 +14,19 @@ enum class PortKind { Texture, Buffer, Scene, Camera };
 const char* toString(PortKind kind);
 
 // How a pass touches a resource. The compiler derives layouts, stages and access masks from it;
-// nodes never name layouts or issue barriers themselves.
-enum class Usage { Sampled, StorageRead, StorageWrite, StorageReadWrite, ColorAttachment, DepthAttachment, TransferSrc, TransferDst };
+// nodes never name layouts or issue barriers themselves. DepthRead: a read-only depth attachment that the same
+// pass also samples (DEPTH_STENCIL_READ_ONLY_OPTIMAL): light volumes depth-test against it and rebuild positions.
+enum class Usage {
+    Sampled,
+    StorageRead,
+    StorageWrite,
+    StorageReadWrite,
+    ColorAttachment,
+    DepthAttachment,
+    DepthRead,
+    TransferSrc,
+    TransferDst
+};
 enum class PassKind { Compute, Raster, Transfer };
 
 // Size of an output texture as data (after Granite): relative to the frame, relative to an

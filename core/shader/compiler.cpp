@@ -141,10 +141,12 @@ CompiledShader ShaderCompiler::compileSource(const std::string& name, const std:
     std::string preamble;
     for (const auto& [key, value] : defines) preamble += "#define " + key + " " + value + "\n";
 
+    // glslang keeps the pointers to these arrays until parse(): they must outlive makeShader (as locals of the
+    // lambda they dangled, which only an unoptimised build showed).
+    const char* text = source.c_str();
+    const int length = static_cast<int>(source.size());
+    const char* names = name.c_str();
     auto makeShader = [&](glslang::TShader& shader) {
-        const char* text = source.c_str();
-        const int length = static_cast<int>(source.size());
-        const char* names = name.c_str();
         shader.setStringsWithLengthsAndNames(&text, &length, &names, 1);
         shader.setPreamble(preamble.c_str());
         shader.setEnvInput(glslang::EShSourceGlsl, lang, glslang::EShClientVulkan, 460);

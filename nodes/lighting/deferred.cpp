@@ -15,8 +15,8 @@ NodeSchema schema() {
     s.doc = "Deferred lighting (MUSEUM_SPEC §1, §3): Cook-Torrance (GGX, Smith, Schlick) + Lambert for the sun "
             "with PCF-filtered cascaded shadows and cavity, the scene's point and spot lights unshadowed; indirect "
             "diffuse from the G-buffer's baked lightmap or bake.lightmap's irradiance volume (the sky's SH irradiance "
-            "scaled by sky_ambient where there is neither); indirect specular from the volume's SH radiance (else the "
-            "sky), until IBL; emissive added. Outputs HDR radiance (cd/m²).";
+            "scaled by sky_ambient where there is neither, or ibl.localized's diffuse); indirect specular from "
+            "ibl.localized when connected, else the volume's SH radiance (else the sky); emissive added. Outputs HDR radiance (cd/m²).";
     auto tex = [](const char* name, const char* doc, bool optional = false) {
         return InputPort{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
     };
@@ -37,6 +37,12 @@ NodeSchema schema() {
          "The scene, for its KHR_lights_punctual point and spot lights (unshadowed); without it only the sun"},
         tex("ao", "Ambient visibility in r (ao.alchemy, accumulated), any size: the indirect diffuse and specular "
                   "(baked or not) are multiplied by lerp(baseColor, 1, ao); none: 1", true),
+        tex("ibl_specular", "ibl.localized's specular: replaces the indirect specular stand-in (x vertex AO x cavity)",
+            true),
+        tex("ibl_diffuse",
+            "ibl.localized's diffuse: the indirect diffuse of pixels with neither lightmap nor irradiance volume "
+            "(x vertex AO x cavity)",
+            true),
     };
     OutputPort color;
     color.name = "color";
@@ -88,7 +94,8 @@ public:
             u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
             u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
         }
-        u.volumeCounts.w = ctx.hasInput("ao") ? 1u : 0u;
+        u.volumeCounts.w = (ctx.hasInput("ibl_specular") ? 1u : 0u) | (ctx.hasInput("ibl_diffuse") ? 2u : 0u) |
+                           (ctx.hasInput("ao") ? 4u : 0u);
         if (mScene) u.lights = packPunctualLights(*mScene);
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("color").desc();

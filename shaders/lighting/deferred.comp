@@ -12,8 +12,8 @@
 //   - lightmapped pixels (G-buffer emissive a = 1) carry their baked diffuse in the emissive channel;
 //   - others take diffuse from bake.lightmap's irradiance volume when it is connected;
 //   - without either, the open sky's SH irradiance scaled by `sky_ambient` stands in;
-// indirect specular: the volume's SH radiance along the mirror direction where there is a volume (the room's
-// own light, until IBL probes), else the sky blurred towards its SH by roughness. Cavity and vertex AO
+// indirect specular: ibl.localized's where connected, else the volume's SH radiance along the mirror direction
+// where there is a volume, else the sky blurred towards its SH by roughness. Cavity and vertex AO
 // darken the ambient terms; emissive is added.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_normal;
@@ -29,6 +29,8 @@ layout(binding = 9) writeonly uniform image2D out_specular_indirect;
 layout(binding = 10) uniform Uniforms { DeferredUniforms u; };
 layout(binding = 11) uniform sampler2D in_volume;
 layout(binding = 12) uniform sampler2D in_ao;
+layout(binding = 13) uniform sampler2D in_ibl_specular;
+layout(binding = 14) uniform sampler2D in_ibl_diffuse;
 #define VITRINE_LIGHTS u.lights
 #define VITRINE_SHADOW u.shadow
 #include "lighting/sun_shadow.glsl"
@@ -86,12 +88,17 @@ void main() {
     vec3 f0 = specularF0(baseColor, metallic);
     vec3 specular = (baked ? volumeSpecular(volume, n, v, f0, roughness) : skySpecular(in_sky, sh, n, v, f0, roughness)) *
                     occlusion;
+    // ibl.localized (when connected) replaces the stand-ins: its probes carry the room's own light and occlusion,
+    // so only the material's vertex AO and cavity darken it.
+    if ((u.volumeCounts.w & 1u) != 0u) specular = texelFetch(in_ibl_specular, p, 0).rgb * vertexAo * cavity;
+    if (!lightmapped && !baked && (u.volumeCounts.w & 2u) != 0u)
+        diffuse = texelFetch(in_ibl_diffuse, p, 0).rgb * vertexAo * cavity;
     // KHR_lights_punctual point and spot lights (unshadowed), with the cavity as the sun has it.
     direct += shadePunctual(world, n, v, diffuseAlbedo(baseColor, metallic), f0, roughness) * cavity;
 
     // Screen-space AO on the indirect terms only (MUSEUM_SPEC §5), tinted by the base colour like a little GI; a
     // lightmapped pixel's emissive channel is its baked diffuse (and any emission with it).
-    if (u.volumeCounts.w != 0u) {
+    if ((u.volumeCounts.w & 4u) != 0u) {
         vec3 tint = mix(baseColor, vec3(1.0), textureLod(in_ao, uv, 0.0).r);
         diffuse *= tint;
         specular *= tint;

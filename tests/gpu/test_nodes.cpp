@@ -2,6 +2,14 @@
 
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
+#include "core/scene/gltf.hpp"
+#include "core/scene/scene.hpp"
+#include "nodes/scene/scene_node.hpp"
+
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 
 #include <string>
 
@@ -155,6 +163,152 @@ const NodeRegistration
     kSample(testSchema("test.cube_sample", {{"cube", PortKind::Texture, {}, false, Usage::Sampled, "cube map"}},
                        floatOutput("faces", 6, 1)),
             [] { return std::make_unique<SourceNode>("test/cube_sample", kSampleSource, "faces", true); });
+
+} // namespace
+} // namespace vitrine::test
+
+// ---------------------------------------------------------------------------------------------
+// Stand-ins for ibl.localized's tests (tests/gpu/ibl_localized_test.cpp): ibl.capture's outputs and probes in a
+// glTF file (the other lanes' work) are replaced by these.
+
+namespace vitrine::test {
+namespace {
+
+// A cube-map array (RGBA16F, one mip, 6 layers per probe, at least 2 probes' worth so the view is always a cube
+// array) whose probe i holds `values[i]` everywhere ("constant"), or on face f texel (x, y) the colour
+// (f, x + 0.5, y + 0.5) ("texels": bilinear lookups inside a face read back the continuous texel coordinate).
+const char* kProbeCubesSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform imageCubeArray out_cubes;
+layout(binding = 1) uniform Uniforms { vec4 values[64]; ivec4 mode; } u;
+void main() {
+    ivec3 p = ivec3(gl_GlobalInvocationID);
+    ivec2 size = imageSize(out_cubes).xy;
+    if (p.x >= size.x || p.y >= size.y) return;
+    int probe = p.z / 6, face = p.z % 6;
+    vec4 c = u.mode.x == 0 ? u.values[min(probe, 63)] : vec4(float(face), vec2(p.xy) + 0.5, 1.0);
+    imageStore(out_cubes, p, c);
+}
+)";
+
+class ProbeCubes final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        const Params& p = ctx.params();
+        ImageDesc& out = ctx.output("cubes");
+        uint32_t size = static_cast<uint32_t>(p.getInt("size"));
+        out.width = out.height = size;
+        auto values = nlohmann::json::parse(p.getString("values"));
+        mUniforms.mode = {p.getString("mode") == "texels" ? 1 : 0, 0, 0, 0};
+        for (size_t i = 0; i < values.size() && i < 64; ++i)
+            mUniforms.values[i] = {values[i][0].get<float>(), values[i][1].get<float>(), values[i][2].get<float>(),
+                                   1.0f};
+        out.layers = 6 * std::max<uint32_t>(2, static_cast<uint32_t>(values.size()));
+        out.cube = true;
+        mPipeline = ctx.computePipelineSource("test/probe_cubes", kProbeCubesSource);
+    }
+    void execute(ExecuteContext& ctx) override {
+        const ImageDesc& out = ctx.output("cubes").desc();
+        ctx.setUniforms(mUniforms);
+        ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height, out.layers);
+    }
+
+private:
+    struct Uniforms {
+        glm::vec4 values[64];
+        glm::ivec4 mode;
+    } mUniforms{};
+    PipelineId mPipeline = 0;
+};
+
+// A stand-in BRDF LUT (RGBA16F, 32 x 32) linear in both coordinates, so that bilinear lookups at iblLutUv are
+// exact: A = 0.25 + 0.5 NoV, B = 0.2 roughness (kLutA / kLutB in test_nodes.hpp).
+const char* kLutSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_lut;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(out_lut);
+    if (p.x >= size.x || p.y >= size.y) return;
+    vec2 t = vec2(p) / vec2(size - 1);
+    imageStore(out_lut, p, vec4(0.25 + 0.5 * t.x, 0.2 * t.y, 0.0, 1.0));
+}
+)";
+
+NodeSchema probeCubesSchema() {
+    NodeSchema s;
+    s.type = "test.probe_cubes";
+    s.doc = "test-only node of test_gpu: a probe cube-map array of known content";
+    OutputPort out;
+    out.name = "cubes";
+    out.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    out.size = SizeRule::absolute(16, 16);
+    out.persistent = true;
+    out.doc = "cube-map array, 6 layers per probe";
+    s.outputs = {out};
+    s.params = {{"size", ParamType::Int, 16, 1.0, 1024.0, {}, "face size"},
+                {"mode", ParamType::Enum, "constant", {}, {}, {"constant", "texels"}, "content"},
+                {"values", ParamType::String, "[[1,1,1]]", {}, {}, {}, "JSON array of RGB, one per probe"}};
+    return s;
+}
+
+NodeSchema lutSchema() {
+    NodeSchema s;
+    s.type = "test.brdf_lut";
+    s.doc = "test-only node of test_gpu: a BRDF LUT linear in NoV and roughness";
+    OutputPort out;
+    out.name = "lut";
+    out.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    out.size = SizeRule::absolute(32, 32);
+    out.doc = "(A, B) = (0.25 + 0.5 NoV, 0.2 roughness)";
+    s.outputs = {out};
+    return s;
+}
+
+// scene.gltf plus reflection probes given as JSON (`probes`: [{"center": [x, y, z], "half": [x, y, z],
+// "rotation": [w, x, y, z], "position": [x, y, z], "sphere": bool, "fade": f, "priority": i}, ...]).
+class GltfProbes final : public SceneNode {
+public:
+    void setup(SetupContext& ctx) override {
+        auto s = std::make_shared<scene::Scene>(scene::loadGltf(ctx.resolvePath(ctx.params().getString("path"))));
+        for (const auto& j : nlohmann::json::parse(ctx.params().getString("probes"))) {
+            scene::ReflectionProbe p;
+            p.name = "probe" + std::to_string(s->probes.size());
+            auto v3 = [&](const char* key, glm::vec3 d) {
+                return j.contains(key)
+                           ? glm::vec3(j[key][0].get<float>(), j[key][1].get<float>(), j[key][2].get<float>())
+                           : d;
+            };
+            p.center = v3("center", glm::vec3(0.0f));
+            p.halfExtents = v3("half", glm::vec3(1.0f));
+            p.position = v3("position", p.center);
+            if (j.contains("rotation"))
+                p.rotation = glm::quat(j["rotation"][0].get<float>(), j["rotation"][1].get<float>(),
+                                       j["rotation"][2].get<float>(), j["rotation"][3].get<float>());
+            p.shape = j.value("sphere", false) ? scene::ProbeShape::Sphere : scene::ProbeShape::Box;
+            p.fade = j.value("fade", 0.5f);
+            p.priority = j.value("priority", 0);
+            s->probes.push_back(p);
+        }
+        publish(ctx, std::move(s));
+    }
+};
+
+NodeSchema gltfProbesSchema() {
+    NodeSchema s;
+    s.type = "test.gltf_probes";
+    s.doc = "test-only node of test_gpu: scene.gltf with reflection probes from a param";
+    s.pass = PassKind::Transfer;
+    s.params = {{"path", ParamType::Path, "", {}, {}, {}, "the .glb"},
+                {"probes", ParamType::String, "[]", {}, {}, {}, "JSON array of probes"}};
+    addSceneNodeSchema(s);
+    return s;
+}
+
+const NodeRegistration kProbeCubes(probeCubesSchema(), [] { return std::make_unique<ProbeCubes>(); });
+const NodeRegistration kLut(lutSchema(),
+                            [] { return std::make_unique<SourceNode>("test/brdf_lut", kLutSource, "lut", false); });
+const NodeRegistration kGltfProbes(gltfProbesSchema(), [] { return std::make_unique<GltfProbes>(); });
 
 } // namespace
 } // namespace vitrine::test

@@ -12,10 +12,14 @@
 //                        visible-normal samples), g = Lambert furnace (cosine-weighted samples)
 //   test.cube_unfold  <- "cube" (storage read) -> "faces" (6N x N): layer f at x offset f N
 //   test.cube_sample  <- "cube" (samplerCube)  -> "faces": textureLod at cubeTexelDirection
+//   test.probe_cubes  -> "cubes": a probe cube-map array, constant per probe or the texel coordinates per face
+//   test.brdf_lut     -> "lut" 32x32: (A, B) = (kLutA0 + kLutA1 NoV, kLutB roughness)
+//   test.gltf_probes  -> scene.gltf's outputs, with reflection probes from its `probes` param
 namespace vitrine::test {
 
 inline constexpr int kOctGrid = 128;
 inline constexpr int kFurnaceSamplesPerAxis = 64;
+inline constexpr double kLutA0 = 0.25, kLutA1 = 0.5, kLutB = 0.2;
 
 // Texel (x, y) of layer `face` in an unfolded cube.
 inline glm::dvec3 cubeTexel(const Image& faces, int face, int x, int y) {

@@ -48,6 +48,27 @@ TEST(GraphBarriers, AccessOfComputeUsages) {
     EXPECT_TRUE(upload.write);
 }
 
+// A depth map drawn by one raster pass, then depth-tested read-only and sampled by a later one (ibl.localized's
+// light volumes): one transition to DEPTH_STENCIL_READ_ONLY_OPTIMAL after the depth writes, visible to the depth tests and
+// the fragment shader; the read-only use writes nothing, so a later sampled read waits only for the layout change.
+TEST(GraphBarriers, DepthWriteThenDepthReadOnlyAndSampled) {
+    constexpr VkPipelineStageFlags2 kTests =
+        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+    constexpr VkPipelineStageFlags2 kFragment = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+    AccessInfo read = accessOf(Usage::DepthRead, PassKind::Raster);
+    EXPECT_EQ(read.layout, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+    EXPECT_EQ(read.stage, kTests | kFragment);
+    EXPECT_EQ(read.access, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | kSampledRead);
+    EXPECT_FALSE(read.write);
+
+    ImageSyncState s;
+    requireAccess(s, 0, accessOf(Usage::DepthAttachment, PassKind::Raster));
+    expectBarrier(requireAccess(s, 0, read), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                  VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL, kTests, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                  kTests | kFragment, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | kSampledRead);
+    EXPECT_FALSE(requireAccess(s, 0, read).has_value()); // read after read in the same layout
+}
+
 TEST(GraphBarriers, WriteSampleSampleWriteSequence) {
     ImageSyncState x;
     const AccessInfo write = accessOf(Usage::StorageWrite, PassKind::Compute);
