@@ -187,10 +187,12 @@ public:
         const Params& p = ctx.params();
         mScene = ctx.objectAs<SceneObject>("scene");
         const scene::Scene& scene = mScene->scene();
-        if (scene.probes.empty())
-            ctx.failParam("size", "scene '" + scene.name +
-                                      "' has no reflection probes (Scene::probes) to capture; place probes in the scene "
-                                      "or remove ibl.capture from the graph");
+        // A scene without probes (a glTF file viewed through the museum pipeline with --scene) gets one black cube:
+        // ibl.localized then shades nothing and every pixel takes its sky fallback.
+        mEmpty = scene.probes.empty();
+        if (mEmpty)
+            logWarning("ibl.capture: scene '" + scene.name +
+                       "' has no reflection probes (Scene::probes); its indirect specular falls back to the sky");
         const bool lm = ctx.hasInput("lightmap"), vol = ctx.hasInput("volume"), baked = ctx.hasInput("baked");
         if (lm != vol || vol != baked)
             ctx.failParam("shadows", "connect lightmap, volume and baked (bake.lightmap's three outputs) together, or none");
@@ -201,7 +203,7 @@ public:
         if (mMips > fullChain)
             ctx.failParam("mips", "at most " + std::to_string(fullChain) + " mips for faces of " + std::to_string(mSize) +
                                       " texels, got " + std::to_string(mMips));
-        mLayers = static_cast<uint32_t>(6 * scene.probes.size());
+        mLayers = static_cast<uint32_t>(6 * std::max<size_t>(scene.probes.size(), 1));
         ImageDesc& cubes = ctx.output("cubes");
         cubes.width = cubes.height = mSize;
         cubes.mipLevels = mMips;
@@ -236,6 +238,13 @@ public:
         gpu_types::IblBrdfLutPush lut{mLutSize, mLutSamples, 0, 0};
         ctx.dispatch(mLutPipeline, &lut, sizeof(lut), mLutSize, mLutSize);
 
+        if (mEmpty) {
+            CubeArrayData black{mSize, mMips, mLayers, {}};
+            black.texels.assign(black.mipOffset(mMips), 0);
+            writeCached(ctx, black);
+            mDone = true;
+            return;
+        }
         // Run what was recorded so far (sky, bake), so the inputs can be read back and hashed.
         ctx.splitSubmission();
         auto inputs = std::make_shared<CaptureInputs>();
@@ -491,6 +500,7 @@ private:
     std::shared_ptr<SceneObject> mScene;
     std::shared_ptr<BakedLightingObject> mBaked;
     CaptureLighting mLighting;
+    bool mEmpty = false; // no probes: one black cube
     uint32_t mSize = 32, mMips = 6, mLayers = 6, mLutSize = 64, mSamples = 64, mLutSamples = 1024;
     bool mUseCache = true, mRecapture = false, mDone = false, mFromCache = false;
     double mCaptureMs = 0.0;

@@ -89,7 +89,7 @@ json iblNodes(const std::filesystem::path& glb, const std::vector<Probe>& probes
               const std::string& mode = "constant", int cubeSize = 16) {
     json nodes = baseNodes(glb);
     nodes["scene"] = {{"type", "test.gltf_probes"},
-                      {"params", {{"path", glb.string()}, {"probes", probesJson(probes).dump()}}}};
+                      {"params", {{"path", glb.string()}, {"probe_list", probesJson(probes).dump()}}}};
     nodes["cubes"] = {{"type", "test.probe_cubes"},
                       {"params", {{"size", cubeSize}, {"mode", mode}, {"values", cubeValues(probes).dump()}}}};
     nodes["lut"] = {{"type", "test.brdf_lut"}};

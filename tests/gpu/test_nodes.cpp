@@ -265,13 +265,13 @@ NodeSchema lutSchema() {
     return s;
 }
 
-// scene.gltf plus reflection probes given as JSON (`probes`: [{"center": [x, y, z], "half": [x, y, z],
+// scene.gltf plus reflection probes given as JSON (`probe_list`: [{"center": [x, y, z], "half": [x, y, z],
 // "rotation": [w, x, y, z], "position": [x, y, z], "sphere": bool, "fade": f, "priority": i}, ...]).
 class GltfProbes final : public SceneNode {
 public:
     void setup(SetupContext& ctx) override {
         auto s = std::make_shared<scene::Scene>(scene::loadGltf(ctx.resolvePath(ctx.params().getString("path"))));
-        for (const auto& j : nlohmann::json::parse(ctx.params().getString("probes"))) {
+        for (const auto& j : nlohmann::json::parse(ctx.params().getString("probe_list"))) {
             scene::ReflectionProbe p;
             p.name = "probe" + std::to_string(s->probes.size());
             auto v3 = [&](const char* key, glm::vec3 d) {
@@ -300,7 +300,7 @@ NodeSchema gltfProbesSchema() {
     s.doc = "test-only node of test_gpu: scene.gltf with reflection probes from a param";
     s.pass = PassKind::Transfer;
     s.params = {{"path", ParamType::Path, "", {}, {}, {}, "the .glb"},
-                {"probes", ParamType::String, "[]", {}, {}, {}, "JSON array of probes"}};
+                {"probe_list", ParamType::String, "[]", {}, {}, {}, "JSON array of probes"}};
     addSceneNodeSchema(s);
     return s;
 }
