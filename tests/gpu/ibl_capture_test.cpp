@@ -316,6 +316,29 @@ TEST_F(IblCapture, ProbeInARedBoxSeesItsWallsOnTheRightFaces) {
     EXPECT_TRUE(dominant(meanOf(faces[0], 4, size - 4, size - 2, size), 1)) << "+X face: floor at the bottom";
 }
 
+TEST_F(IblCapture, EveryProbePrefiltersItsOwnFaces) {
+    // Two probes that see different rooms: one inside the red box, one 8 m above it in the open. Each probe's
+    // prefiltered mips must come from its own faces (probe i reads source layers [6i, 6i + 6)).
+    scene::Scene s = redBox({0, 1.2f, 0}, {0.3f, 1.0f, 0.2f});
+    addProbe(s, {0, 8.0f, 0}, {0, 8.0f, 0}, {1, 1, 1});
+    registerScene("two_probes", std::move(s));
+    const int size = 8;
+    const Capture c = runCapture(captureGraph("two_probes", proceduralSky(), {{"size", size}, {"cache", false}}));
+    ASSERT_GE(c.mips.size(), 2u);
+    ASSERT_EQ(c.mips[1].size(), 12u);
+    for (int mip : {0, 1}) {
+        const int n = size >> mip;
+        const glm::dvec3 inside = meanOf(c.mips[mip][0], n / 4, n - n / 4, n / 4, n - n / 4);
+        const glm::dvec3 above = meanOf(c.mips[mip][6], 0, n, 0, n);
+        std::printf("mip %d +X: box probe %.1f %.1f %.1f, probe above %.1f %.1f %.1f\n", mip, inside.x, inside.y, inside.z,
+                    above.x, above.y, above.z);
+        // Red leads inside the box (its +X wall; the green floor bleeds into the rougher mip); sky and ground above.
+        EXPECT_GT(inside.x, 1.3 * inside.y) << "mip " << mip << ": the box's probe sees its red +X wall";
+        EXPECT_GT(inside.x, 2.0 * inside.z) << "mip " << mip << ": the box's probe sees its red +X wall";
+        EXPECT_GT(above.z, above.x) << "mip " << mip << ": the probe above the box sees sky and ground on +X";
+    }
+}
+
 void expectSame(const Capture& a, const Capture& b) {
     ASSERT_EQ(a.mips.size(), b.mips.size());
     for (size_t m = 0; m < a.mips.size(); ++m)
