@@ -1,0 +1,54 @@
+#pragma once
+// The physical camera's state for one frame: what `camera.physical` hands the post stack on its `state`
+// port (a Buffer-kind object, like shadow.directional's `cascades`). Consumers (post.tonemap, post.dof,
+// post.airy, post.lens, post.streaks, post.flare, post.grain, post.motion_blur) take an optional `camera_state`
+// input; connected, its values replace the node's own lens/exposure params, so that changing the light
+// changes aperture, bokeh shape and streaks by itself (MUSEUM_SPEC §7). Filled in camera.physical's
+// execute(), which runs before its consumers' (topological order), and read by them in their execute().
+#include "core/graph/node.hpp"
+
+namespace vitrine {
+
+struct CameraState {
+    // Exposure. ev100: the exposure value at ISO 100 the camera settled on (metered scene EV after
+    // compensation and eye adaptation). exposure: the linear scale post.tonemap multiplies HDR radiance
+    // (cd/m²) by before its curve, 1 / (1.2 · 2^ev100) (saturation-based sensitivity, Lagarde & de Rousiers 2014).
+    float ev100 = 13.0f;
+    float exposure = 1.0f / (1.2f * 8192.0f);
+    // The exposure triangle chosen (program mode) or set (manual mode).
+    float fNumber = 4.0f;
+    float shutterSeconds = 1.0f / 125.0f;
+    float iso = 100.0f;
+    // Optics. focalLengthMm: after focus breathing. sensor: the film back (mm); the vertical field of view
+    // the scene camera renders with is the consumer's business (it comes from the camera port).
+    float focalLengthMm = 50.0f;
+    float focusDistanceM = 5.0f;
+    float sensorWidthMm = 36.0f;
+    float sensorHeightMm = 24.0f;
+    // Aperture shape: bladeCount blades (0: a circle), bladeRoundness 0 (straight blades: a polygon) .. 1
+    // (a circle); rotation of the first blade in radians. wideOpenFNumber: the lens's maximum aperture at this
+    // focal length; at fNumber == wideOpenFNumber the aperture is round (the blades are out of the way).
+    int bladeCount = 9;
+    float bladeRoundness = 0.5f;
+    float bladeRotation = 0.0f;
+    float wideOpenFNumber = 1.8f;
+    float minFNumber = 22.0f; // the smallest aperture (largest f-number) the lens stops down to
+    // Residual lens aberrations after the lens's own correction (data/lenses/*.json), for post.lens:
+    // radial distortion r_d = r (1 + k1 r² + k2 r⁴), r normalised to the half-diagonal; lateral chromatic
+    // aberration as the red and blue channels' radial scale relative to green (1 = none).
+    float distortionK1 = 0.0f;
+    float distortionK2 = 0.0f;
+    float caRedScale = 1.0f;
+    float caBlueScale = 1.0f;
+    // Mechanical vignetting strength of this lens at this aperture (0: none); natural cos⁴ falloff follows
+    // from the focal length and sensor.
+    float mechanicalVignetting = 0.0f;
+};
+
+class CameraStateObject final : public PortObject {
+public:
+    CameraState state;
+    uint32_t frame = 0; // the frame state was last written for
+};
+
+} // namespace vitrine
