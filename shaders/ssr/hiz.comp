@@ -64,8 +64,8 @@ float cellExit(vec3 o, vec3 d, int level, ivec2 cell) {
     return min(tt.x, tt.y);
 }
 
-// Radiance along world ray (origin, r) and its confidence (a).
-vec4 traceRay(vec3 origin, vec3 o, vec3 r, float coneTan) {
+// Radiance along world ray (origin, r) from a surface of normal n and its confidence (a).
+vec4 traceRay(vec3 origin, vec3 n, vec3 o, vec3 r, float coneTan) {
     // End point: max_distance along r, or short of the near plane when the ray comes towards the camera.
     float len = u.params.y;
     float towards = dot(r, u.cameraFwd.xyz);
@@ -104,6 +104,18 @@ vec4 traceRay(vec3 origin, vec3 o, vec3 r, float coneTan) {
         if (dp.z < 0.0 && za > range.y) t = max(t, (range.y - op.z) / dp.z);
         else if (dp.z > 0.0 && za < zBehind) t = max(t, (zBehind - op.z) / dp.z);
         if (level == 0) {
+            // A level-0 texel holds one depth: a ray leaving a surface at a low angle lies within the slab behind a
+            // neighbouring texel's depth while it stays in front of the surface itself. A candidate on the ray's own
+            // surface (its texel on the origin's tangent plane) that faces away from the ray is such a self-hit:
+            // march on. Other back faces stay hits, for the back-face test below.
+            ivec2 tc = clamp(ivec2(floor((op + dp * t).xy)), ivec2(0), u.size.xy - 1);
+            if (dot(octDecode(texelFetch(in_normal, tc, 0).xy), r) >= 0.0) {
+                vec3 s = unproject((vec2(tc) + 0.5) / size, texelFetch(in_depth, tc, 0).r) - origin;
+                if (abs(dot(s, n)) < 0.05 * length(s)) {
+                    t = tExit + nudge;
+                    continue;
+                }
+            }
             found = true;
             break;
         }
@@ -185,7 +197,7 @@ void main() {
         vec3 h = roughness > 0.0 ? frame * sampleGgxVndf(vLocal, alpha, rngNext2(seed)) : n;
         vec3 r = reflect(-v, h);
         if (dot(r, n) <= 0.0) continue; // below the surface: no light from there
-        vec4 hit = traceRay(world, vec3(uv, z), r, coneTan);
+        vec4 hit = traceRay(world, n, vec3(uv, z), r, coneTan);
         radiance += hit.rgb * hit.a;
         confidence += hit.a;
     }

@@ -569,5 +569,40 @@ TEST_F(IblLocalized, DISABLED_Bench1080p) {
                 count.width * count.height);
 }
 
+// Not a test: the museum's mean probes per covered pixel (the demo aimed at about 1.5), from ibl.localized's count
+// output at 640x360 at four times of the walkthrough. Run with --gtest_also_run_disabled_tests
+// --gtest_filter='*MuseumProbesPerPixel*' (bakes and captures on first use: minutes on lavapipe).
+TEST_F(IblLocalized, DISABLED_MuseumProbesPerPixel) {
+    double total = 0.0;
+    long coveredAll = 0, pixelsAll = 0;
+    for (const char* start : {"0", "6", "12", "18"}) {
+        auto out = runGraphFile(std::string(VITRINE_SOURCE_DIR) + "/graphs/museum.json",
+                                {"frame.width=640", "frame.height=360", "outputs.count=ibl.count",
+                                 std::string("scene.params.start=") + start});
+        const Image& count = out.at("count");
+        double sum = 0.0;
+        long covered = 0;
+        int histogram[5] = {};
+        for (int y = 0; y < count.height; ++y)
+            for (int x = 0; x < count.width; ++x) {
+                float c = count.at(x, y)[0];
+                ++histogram[std::min(static_cast<int>(std::lround(c)), 4)];
+                if (c > 0.0f) {
+                    sum += c;
+                    ++covered;
+                }
+            }
+        std::printf("walkthrough t = %s s: mean probes per covered pixel %.3f (%ld of %d pixels covered; 0: %d, 1: %d, "
+                    "2: %d, 3: %d, 4+: %d)\n",
+                    start, sum / std::max(covered, 1L), covered, count.width * count.height, histogram[0], histogram[1],
+                    histogram[2], histogram[3], histogram[4]);
+        total += sum;
+        coveredAll += covered;
+        pixelsAll += count.width * count.height;
+    }
+    std::printf("all four: mean probes per covered pixel %.3f, %.1f %% of pixels covered\n", total / std::max(coveredAll, 1L),
+                100.0 * coveredAll / std::max(pixelsAll, 1L));
+}
+
 } // namespace
 } // namespace vitrine::test
