@@ -272,6 +272,10 @@ def main():
           r.getheader("X-Vitrine-Output") == "preview", "render of a node output (pattern.color)")
     r, png4 = render({"graph": "graphs/variants/no_fxaa.json", "width": 160, "height": 90})
     check(r.status == 200 and png_size(png4) == (160, 90) and png4 != png1, "render of a variant")
+    with open(os.path.join(gdir, "variants", "no_fxaa.json")) as f:
+        variant = json.load(f)
+    r, payload = render({"document": variant, "base": "graphs/variants/no_fxaa.json", "width": 160, "height": 90})
+    check(r.status == 200 and payload == png4, "an inline variant (extends resolved from its base) renders as the file")
     doc = json.loads(zoneplate_bytes)
     doc["nodes"]["fxaa"]["params"] = {"subpix": 0.0}
     r, png5 = render({"document": doc, "base": "graphs/fxaa_zoneplate.json", "width": 160, "height": 90})

@@ -180,6 +180,9 @@ void Api::install(httplib::Server& server) {
                                                      : "request refused";
         replyError(res, res.status, what);
     });
+    server.set_logger([](const httplib::Request& req, const httplib::Response& res) {
+        logDebug("serve: " + req.method + " " + req.path + " -> " + std::to_string(res.status));
+    });
     auto bind = [this](void (Api::*route)(const httplib::Request&, httplib::Response&)) {
         return guarded([this, route](const httplib::Request& req, httplib::Response& res) { (this->*route)(req, res); });
     };
