@@ -21,7 +21,9 @@ namespace {
 
 std::atomic<int> gStopSignal{0};
 
-void onStopSignal(int signal) { gStopSignal = signal; }
+void onStopSignal(int signal) {
+    gStopSignal = signal;
+}
 
 // The names that need no token. Any other address, even another 127.x.y.z, counts as opening the server: a user who
 // chose one may have forwarded it.
@@ -34,7 +36,8 @@ std::string newToken() {
     std::random_device random;
     std::string token;
     const char* hex = "0123456789abcdef";
-    for (int i = 0; i < 48; ++i) token += hex[random() & 15u];
+    for (int i = 0; i < 48; ++i)
+        token += hex[random() & 15u];
     return token;
 }
 
@@ -68,7 +71,8 @@ int serveCommand(const Args& args) {
     server.new_task_queue = [] { return new httplib::ThreadPool(16); };
     api.install(server);
 
-    const int bound = port == 0 ? server.bind_to_any_port(host) : (server.bind_to_port(host, static_cast<int>(port)) ? static_cast<int>(port) : -1);
+    const int bound = port == 0 ? server.bind_to_any_port(host)
+                                : (server.bind_to_port(host, static_cast<int>(port)) ? static_cast<int>(port) : -1);
     if (bound < 0) throw UserError("serve: cannot listen on " + host + ":" + std::to_string(port) + " (in use?)");
     const std::string shownHost = host.find(':') != std::string::npos && host[0] != '[' ? "[" + host + "]" : host;
     const std::string url = "http://" + shownHost + ":" + std::to_string(bound) + "/";
@@ -82,7 +86,8 @@ int serveCommand(const Args& args) {
     auto previousInt = std::signal(SIGINT, onStopSignal);
     auto previousTerm = std::signal(SIGTERM, onStopSignal);
     std::thread watcher([&] {
-        while (!gStopSignal && !events.closed()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        while (!gStopSignal && !events.closed())
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
         events.close(); // ends the events streams, so the server's threads can finish
         server.stop();
     });

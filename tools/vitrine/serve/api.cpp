@@ -45,13 +45,16 @@ std::optional<ImageStore::Entry> ImageStore::get(const std::string& id) const {
 Api::Api(const ServeOptions& options, GpuWorker& gpu, EventHub& events)
     : mOptions(options), mSandbox(options.dir), mGpu(gpu), mEvents(events) {}
 
-std::string Api::newJobId() { return std::to_string(++mJobs); }
+std::string Api::newJobId() {
+    return std::to_string(++mJobs);
+}
 
 nlohmann::json Api::userErrorBody(const std::string& raw) const {
     // Messages name files by the paths the server opened (absolute, under the served directory): shown relative.
     std::string message = raw;
     const std::string prefix = mSandbox.root().string() + "/";
-    for (size_t at; (at = message.find(prefix)) != std::string::npos;) message.erase(at, prefix.size());
+    for (size_t at; (at = message.find(prefix)) != std::string::npos;)
+        message.erase(at, prefix.size());
     nlohmann::json body = {{"error", message}};
     // "FILE: /json/pointer: what was expected" (the format of every graph error; `vitrine validate` prints it).
     const size_t colon = message.find(": ");
@@ -94,7 +97,8 @@ std::string hostName(const std::string& header) {
 bool constantTimeEqual(const std::string& a, const std::string& b) {
     if (a.size() != b.size()) return false;
     unsigned char diff = 0;
-    for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+    for (size_t i = 0; i < a.size(); ++i)
+        diff |= static_cast<unsigned char>(a[i] ^ b[i]);
     return diff == 0;
 }
 
@@ -184,16 +188,17 @@ void Api::install(httplib::Server& server) {
         logDebug("serve: " + req.method + " " + req.path + " -> " + std::to_string(res.status));
     });
     auto bind = [this](void (Api::*route)(const httplib::Request&, httplib::Response&)) {
-        return guarded([this, route](const httplib::Request& req, httplib::Response& res) { (this->*route)(req, res); });
+        return guarded(
+            [this, route](const httplib::Request& req, httplib::Response& res) { (this->*route)(req, res); });
     };
     server.Get("/api/status", bind(&Api::status));
     server.Get("/api/nodes", guarded([](const httplib::Request&, httplib::Response& res) {
-        // Byte for byte what `vitrine nodes --json` prints.
-        res.set_content(NodeRegistry::global().toJson().dump(2) + "\n", "application/json");
-    }));
+                   // Byte for byte what `vitrine nodes --json` prints.
+                   res.set_content(NodeRegistry::global().toJson().dump(2) + "\n", "application/json");
+               }));
     server.Get("/api/schema", guarded([](const httplib::Request&, httplib::Response& res) {
-        res.set_content(graphJsonSchema(NodeRegistry::global()).dump(2) + "\n", "application/json");
-    }));
+                   res.set_content(graphJsonSchema(NodeRegistry::global()).dump(2) + "\n", "application/json");
+               }));
     server.Get("/api/graphs", bind(&Api::listGraphs));
     server.Get("/api/graphs/(.+)", bind(&Api::getGraph));
     server.Put("/api/graphs/(.+)", bind(&Api::putGraph));

@@ -36,11 +36,18 @@ bool skippedDirectory(const fs::path& dir) {
 }
 
 const char* contentType(const std::string& extension) {
-    static const std::pair<const char*, const char*> kTypes[] = {
-        {".html", "text/html; charset=utf-8"}, {".js", "text/javascript"},   {".mjs", "text/javascript"},
-        {".css", "text/css"},                  {".json", "application/json"}, {".svg", "image/svg+xml"},
-        {".png", "image/png"},                 {".ico", "image/x-icon"},      {".woff2", "font/woff2"},
-        {".map", "application/json"},          {".txt", "text/plain"},        {".wasm", "application/wasm"}};
+    static const std::pair<const char*, const char*> kTypes[] = {{".html", "text/html; charset=utf-8"},
+                                                                 {".js", "text/javascript"},
+                                                                 {".mjs", "text/javascript"},
+                                                                 {".css", "text/css"},
+                                                                 {".json", "application/json"},
+                                                                 {".svg", "image/svg+xml"},
+                                                                 {".png", "image/png"},
+                                                                 {".ico", "image/x-icon"},
+                                                                 {".woff2", "font/woff2"},
+                                                                 {".map", "application/json"},
+                                                                 {".txt", "text/plain"},
+                                                                 {".wasm", "application/wasm"}};
     for (const auto& [ext, type] : kTypes)
         if (extension == ext) return type;
     return "application/octet-stream";
@@ -112,8 +119,7 @@ void Api::getGraph(const httplib::Request& req, httplib::Response& res) {
 void Api::putGraph(const httplib::Request& req, httplib::Response& res) {
     const std::string relative = req.matches[1];
     const fs::path path = mSandbox.resolve(relative);
-    if (path.extension() != ".json")
-        throw HttpError(403, relative + ": refused: only graph files (.json) are written");
+    if (path.extension() != ".json") throw HttpError(403, relative + ": refused: only graph files (.json) are written");
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw HttpError(409, relative + ": is a directory");
     // The body must be a JSON object (a graph or a variant); it is written as sent, so that a file read and written

@@ -38,7 +38,8 @@ double msSince(std::chrono::steady_clock::time_point start) {
 nlohmann::json specOf(const nlohmann::json& value, const std::string& pointer) {
     if (value.is_string()) return {{"graph", value}};
     if (!value.is_object())
-        throw HttpError(400, "request body: " + pointer + ": expected a graph path or an object", {{"pointer", pointer}});
+        throw HttpError(400, "request body: " + pointer + ": expected a graph path or an object",
+                        {{"pointer", pointer}});
     return value;
 }
 
@@ -79,7 +80,8 @@ PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointe
     if (spec.contains("set")) {
         const nlohmann::json& s = spec["set"];
         const std::string at = pointer + "/set";
-        if (!s.is_array()) throw HttpError(400, "request body: " + at + ": expected an array of \"KEY=VALUE\"", {{"pointer", at}});
+        if (!s.is_array())
+            throw HttpError(400, "request body: " + at + ": expected an array of \"KEY=VALUE\"", {{"pointer", at}});
         for (size_t i = 0; i < s.size(); ++i) {
             if (!s[i].is_string())
                 throw HttpError(400, "request body: " + at + "/" + std::to_string(i) + ": expected \"KEY=VALUE\"",
@@ -132,8 +134,8 @@ PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointe
 RenderResult Api::renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph) {
     const std::string file = graph.desc.file;
     auto progress = [&, job, kind, file](const std::string& stage, uint32_t done, uint32_t total) {
-        mEvents.publish("job", {{"job", job}, {"kind", kind}, {"graph", file}, {"stage", stage}, {"done", done},
-                                {"total", total}});
+        mEvents.publish(
+            "job", {{"job", job}, {"kind", kind}, {"graph", file}, {"stage", stage}, {"done", done}, {"total", total}});
     };
     return mGpu.render(graph, progress);
 }
@@ -182,12 +184,20 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
             try {
                 const std::string file = shared->desc.file;
                 RenderResult r = mGpu.renderNow(*shared, [&](const std::string& stage, uint32_t done, uint32_t total) {
-                    mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"graph", file}, {"stage", stage},
-                                            {"done", done}, {"total", total}});
+                    mEvents.publish("job", {{"job", job},
+                                            {"kind", "render"},
+                                            {"graph", file},
+                                            {"stage", stage},
+                                            {"done", done},
+                                            {"total", total}});
                 });
                 mImages.fulfil(id, pngString(r.image), r.image.width, r.image.height);
-                mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "done"}, {"image", id},
-                                        {"ms", msSince(start)}, {"warm", r.warm}});
+                mEvents.publish("job", {{"job", job},
+                                        {"kind", "render"},
+                                        {"stage", "done"},
+                                        {"image", id},
+                                        {"ms", msSince(start)},
+                                        {"warm", r.warm}});
             } catch (const UserError& e) {
                 mImages.fail(id, 422, userErrorBody(e.what()));
                 mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
@@ -278,8 +288,12 @@ void Api::image(const httplib::Request& req, httplib::Response& res) {
     std::optional<ImageStore::Entry> entry = mImages.get(id);
     if (!entry) throw HttpError(404, "no image " + id + " (unknown, or dropped: the server keeps the latest 64)");
     switch (entry->state) {
-    case ImageStore::Entry::State::Pending: replyJson(res, 202, {{"image", id}, {"state", "pending"}}); return;
-    case ImageStore::Entry::State::Failed: replyError(res, entry->status, entry->error.value("error", ""), entry->error); return;
+    case ImageStore::Entry::State::Pending:
+        replyJson(res, 202, {{"image", id}, {"state", "pending"}});
+        return;
+    case ImageStore::Entry::State::Failed:
+        replyError(res, entry->status, entry->error.value("error", ""), entry->error);
+        return;
     case ImageStore::Entry::State::Done:
         res.set_header("X-Vitrine-Width", std::to_string(entry->width));
         res.set_header("X-Vitrine-Height", std::to_string(entry->height));

@@ -6,7 +6,8 @@ void EventHub::publish(const std::string& type, nlohmann::json data) {
     {
         std::lock_guard lock(mMutex);
         mEvents.push_back({mNext++, type, std::move(data)});
-        while (mEvents.size() > mKeep) mEvents.pop_front();
+        while (mEvents.size() > mKeep)
+            mEvents.pop_front();
     }
     mChanged.notify_all();
 }

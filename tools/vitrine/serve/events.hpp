@@ -16,8 +16,8 @@
 namespace vitrine::serve {
 
 struct Event {
-    uint64_t id = 0;   // increasing from 1; the SSE `id:` field, so a reconnecting client resumes (Last-Event-ID)
-    std::string type;  // the SSE `event:` field: "job" or "hello"
+    uint64_t id = 0;  // increasing from 1; the SSE `id:` field, so a reconnecting client resumes (Last-Event-ID)
+    std::string type; // the SSE `event:` field: "job" or "hello"
     nlohmann::json data;
 };
 

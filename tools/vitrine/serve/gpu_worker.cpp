@@ -14,7 +14,9 @@ struct WarmGraphs::Entry {
 
 WarmGraphs::WarmGraphs(size_t capacity) : mCapacity(capacity) {}
 
-WarmGraphs::~WarmGraphs() { clear(); }
+WarmGraphs::~WarmGraphs() {
+    clear();
+}
 
 WarmGraphs::Entry& WarmGraphs::get(Context& ctx, ShaderCompiler& shaders, const PreparedGraph& prepared,
                                    bool& compiled) {
@@ -31,12 +33,15 @@ WarmGraphs::Entry& WarmGraphs::get(Context& ctx, ShaderCompiler& shaders, const 
     entry->graph = compileGraph(desc);
     entry->executor = std::make_unique<Executor>(ctx, entry->graph, shaders);
     mEntries.push_front(std::move(entry));
-    while (mEntries.size() > mCapacity) mEntries.pop_back();
+    while (mEntries.size() > mCapacity)
+        mEntries.pop_back();
     compiled = true;
     return *mEntries.front();
 }
 
-Executor& WarmGraphs::executor(Entry& entry) { return *entry.executor; }
+Executor& WarmGraphs::executor(Entry& entry) {
+    return *entry.executor;
+}
 
 void WarmGraphs::drop(const Entry& entry) {
     mEntries.remove_if([&](const std::unique_ptr<Entry>& e) { return e.get() == &entry; });
@@ -72,7 +77,9 @@ GpuWorker::GpuWorker(const ContextOptions& options, size_t warmGraphs) : mOption
     }
 }
 
-GpuWorker::~GpuWorker() { stop(); }
+GpuWorker::~GpuWorker() {
+    stop();
+}
 
 void GpuWorker::stop() {
     {

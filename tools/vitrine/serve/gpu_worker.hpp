@@ -29,8 +29,8 @@ namespace vitrine::serve {
 // A graph ready to render: the document merged (extends), edited for the preview (size, frames, the one output
 // kept) and validated. WarmGraphs is keyed on its document, directory and file.
 struct PreparedGraph {
-    GraphDesc desc;          // validated, its paths checked against the served directory
-    std::string output;      // the one graph output left in it
+    GraphDesc desc;     // validated, its paths checked against the served directory
+    std::string output; // the one graph output left in it
 };
 
 // Compiled graphs with their executors (pipelines, images, uploaded scenes, baked resources) kept between requests,
@@ -57,7 +57,7 @@ using ProgressFn = std::function<void(const std::string& stage, uint32_t done, u
 
 struct RenderResult {
     Image image;
-    bool warm = false;           // the compiled graph was kept from an earlier request
+    bool warm = false;             // the compiled graph was kept from an earlier request
     size_t validationMessages = 0; // Vulkan validation messages during this job (with --validate)
 };
 

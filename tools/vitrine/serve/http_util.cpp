@@ -9,8 +9,9 @@ nlohmann::json parseRequestBody(const std::string& body) {
     JsonTextError error;
     std::optional<nlohmann::json> parsed = parseJsonText(body, error);
     if (!parsed)
-        throw HttpError(400, "request body:" + std::to_string(error.line) + ":" + std::to_string(error.column) + ": " +
-                                 error.describe(),
+        throw HttpError(400,
+                        "request body:" + std::to_string(error.line) + ":" + std::to_string(error.column) + ": " +
+                            error.describe(),
                         {{"line", error.line}, {"column", error.column}, {"byte", error.byte}, {"pointer", ""}});
     if (!parsed->is_object())
         throw HttpError(400, "request body: /: expected a JSON object, got " + brief(*parsed), {{"pointer", ""}});

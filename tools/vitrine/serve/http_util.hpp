@@ -32,7 +32,8 @@ inline void replyJson(httplib::Response& res, int status, const nlohmann::json& 
 inline void replyError(httplib::Response& res, int status, const std::string& message,
                        const nlohmann::json& detail = nlohmann::json::object()) {
     nlohmann::json body = {{"error", message}, {"status", status}};
-    for (const auto& [key, value] : detail.items()) body[key] = value;
+    for (const auto& [key, value] : detail.items())
+        body[key] = value;
     replyJson(res, status, body);
 }
 
@@ -44,6 +45,7 @@ nlohmann::json parseRequestBody(const std::string& body);
 std::string optionalString(const nlohmann::json& request, const std::string& key, const std::string& pointer = "");
 uint32_t optionalUint(const nlohmann::json& request, const std::string& key, uint32_t min, uint32_t max,
                       uint32_t fallback, const std::string& pointer = "");
-bool optionalBool(const nlohmann::json& request, const std::string& key, bool fallback, const std::string& pointer = "");
+bool optionalBool(const nlohmann::json& request, const std::string& key, bool fallback,
+                  const std::string& pointer = "");
 
 } // namespace vitrine::serve

@@ -56,7 +56,9 @@ Sandbox::Sandbox(const fs::path& root) {
     mRoot = fs::canonical(root);
 }
 
-bool Sandbox::contains(const fs::path& path) const { return isInside(mRoot, canonicalOf(path)); }
+bool Sandbox::contains(const fs::path& path) const {
+    return isInside(mRoot, canonicalOf(path));
+}
 
 fs::path Sandbox::resolve(const std::string& relative) const {
     const std::string shown = "'" + relative + "'";
