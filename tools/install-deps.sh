@@ -14,6 +14,7 @@ packages=(
     libopenexr-dev libimath-dev libopencolorio-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     python3-jsonschema
+    libcpp-httplib-dev
 )
 if [ "${1:-}" = "--fuzz" ]; then
     packages+=(clang libclang-rt-dev)

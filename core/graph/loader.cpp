@@ -13,7 +13,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+nlohmann::json mergeWithBases(nlohmann::json doc, const fs::path& file, std::vector<fs::path>& chain);
+
 nlohmann::json loadWithBases(const fs::path& file, std::vector<fs::path>& chain) {
+    return mergeWithBases(readJsonFile(file), file, chain);
+}
+
+nlohmann::json mergeWithBases(nlohmann::json doc, const fs::path& file, std::vector<fs::path>& chain) {
     std::error_code ec;
     fs::path canonical = fs::weakly_canonical(file, ec);
     if (ec) canonical = file.lexically_normal();
@@ -23,7 +29,6 @@ nlohmann::json loadWithBases(const fs::path& file, std::vector<fs::path>& chain)
         throw UserError(file.string() + ": /extends: `extends` forms a cycle: " + cycle + file.filename().string());
     }
     chain.push_back(canonical);
-    nlohmann::json doc = readJsonFile(file);
     if (!doc.is_object()) throw UserError(file.string() + ": /: expected a JSON object (a vitrine graph)");
     auto it = doc.find("extends");
     if (it == doc.end()) return doc;
@@ -40,8 +45,12 @@ nlohmann::json loadWithBases(const fs::path& file, std::vector<fs::path>& chain)
 } // namespace
 
 nlohmann::json loadGraphDocument(const fs::path& file, const std::vector<std::string>& sets) {
+    return mergeGraphDocument(readJsonFile(file), file, sets);
+}
+
+nlohmann::json mergeGraphDocument(nlohmann::json document, const fs::path& file, const std::vector<std::string>& sets) {
     std::vector<fs::path> chain;
-    nlohmann::json doc = loadWithBases(file, chain);
+    nlohmann::json doc = mergeWithBases(std::move(document), file, chain);
     for (const auto& s : sets) {
         try {
             applySet(doc, s);

@@ -15,6 +15,11 @@ class NodeRegistry;
 // its base, then applies the `--set` assignments in order.
 nlohmann::json loadGraphDocument(const std::filesystem::path& file, const std::vector<std::string>& sets = {});
 
+// loadGraphDocument() of a document already read, standing for `file` (which need not exist): its `extends` resolves
+// from file's directory and errors name `file`. `vitrine serve` renders documents the editor sends this way.
+nlohmann::json mergeGraphDocument(nlohmann::json document, const std::filesystem::path& file,
+                                  const std::vector<std::string>& sets = {});
+
 // `node.params.key=value`, `frame.width=640` or `outputs.name=node.port`. The value is JSON
 // when it parses as JSON, else a string.
 void applySet(nlohmann::json& document, const std::string& assignment);

@@ -37,5 +37,6 @@ int compareCommand(const Args& args);
 int goldenCommand(const Args& args);
 int exportSceneCommand(const Args& args);
 int jitterCommand(const Args& args);
+int serveCommand(const Args& args);
 
 } // namespace vitrine::cli

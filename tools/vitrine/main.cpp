@@ -44,6 +44,12 @@ commands:
   jitter [PATTERN]... [--out DIR] [--frames N]
       Plot the camera jitter patterns (halton, ordered, rotated, improved, stratified) as SVG:
       the first 16 samples numbered in order, later frames (sub-grid shifts) as dots.
+  serve [DIR] [--port N] [--host ADDR] [--token T] [--editor DIR] [--max-body BYTES] [--warm N]
+      HTTP server for the graph editor: the editor at /, a JSON API under /api/ (nodes, graphs under DIR,
+      validate, render previews, compare, progress events). One Vulkan device and the last N (--warm,
+      default 4) compiled graphs stay warm between requests. Binds 127.0.0.1:8420 by default (--port 0: any
+      free port; the URL is printed); another --host needs the access token printed at start-up (or
+      --token). Reads and writes files under DIR only (default: the current directory).
   devices                           List Vulkan devices.
 
 common options:
@@ -63,7 +69,7 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene"},
+                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm"},
                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
@@ -82,6 +88,7 @@ int main(int argc, char** argv) {
         if (args.command == "golden") return cli::goldenCommand(args);
         if (args.command == "export-scene") return cli::exportSceneCommand(args);
         if (args.command == "jitter") return cli::jitterCommand(args);
+        if (args.command == "serve") return cli::serveCommand(args);
         throw UserError("unknown command '" + args.command + "'; run `vitrine help`");
     } catch (const UserError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

@@ -1,0 +1,97 @@
+#pragma once
+
+#include "tools/vitrine/serve/events.hpp"
+#include "tools/vitrine/serve/gpu_worker.hpp"
+#include "tools/vitrine/serve/sandbox.hpp"
+
+#include <httplib.h>
+
+#include <atomic>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+
+// The HTTP side of `vitrine serve`: the JSON API under /api/ and the editor's static files at /. Routes read and
+// write files through the Sandbox only, and hand every render to the GpuWorker.
+namespace vitrine::serve {
+
+struct ServeOptions {
+    std::filesystem::path dir;        // the served directory
+    std::filesystem::path editorDist; // the editor's built bundle (editor/dist); a placeholder page when absent
+    std::string token;                // required on every request when not empty
+    bool loopbackOnly = true;         // the Host header must name the loopback (against DNS rebinding)
+    size_t maxBodyBytes = 16u << 20;  // larger request bodies get 413
+};
+
+// PNGs of finished renders and compares, fetched with GET /api/images/ID; the oldest go first past `capacity`.
+class ImageStore {
+public:
+    explicit ImageStore(size_t capacity = 64) : mCapacity(capacity) {}
+    struct Entry {
+        enum class State { Pending, Done, Failed } state = State::Pending;
+        std::string png;
+        int width = 0;
+        int height = 0;
+        nlohmann::json error; // Failed: the error body
+        int status = 0;       // Failed: the HTTP status the error had
+    };
+    std::string reserve();
+    void fulfil(const std::string& id, std::string png, int width, int height);
+    void fail(const std::string& id, int status, nlohmann::json error);
+    std::optional<Entry> get(const std::string& id) const;
+
+private:
+    mutable std::mutex mMutex;
+    std::map<uint64_t, Entry> mEntries;
+    uint64_t mNext = 1;
+    size_t mCapacity;
+};
+
+class Api {
+public:
+    Api(const ServeOptions& options, GpuWorker& gpu, EventHub& events);
+    void install(httplib::Server& server);
+
+private:
+    using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
+    // Maps what a route throws to a status and a JSON error body (HttpError, PathRefused 403, UserError 422 with the
+    // file and JSON pointer of the culprit, anything else 500).
+    Handler guarded(Handler handler);
+    httplib::Server::HandlerResponse checkAccess(const httplib::Request& req, httplib::Response& res);
+
+    // api_files.cpp
+    void listGraphs(const httplib::Request& req, httplib::Response& res);
+    void getGraph(const httplib::Request& req, httplib::Response& res);
+    void putGraph(const httplib::Request& req, httplib::Response& res);
+    void staticFile(const httplib::Request& req, httplib::Response& res);
+
+    // api_render.cpp
+    struct Defaults {
+        uint32_t width = 0, height = 0, frames = 0; // 0: the graph's own
+        std::string output;
+    };
+    PreparedGraph prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
+    RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph);
+    void validate(const httplib::Request& req, httplib::Response& res);
+    void render(const httplib::Request& req, httplib::Response& res);
+    void compare(const httplib::Request& req, httplib::Response& res);
+    void image(const httplib::Request& req, httplib::Response& res);
+    void events(const httplib::Request& req, httplib::Response& res);
+    void status(const httplib::Request& req, httplib::Response& res);
+
+    // The JSON error body of a UserError: the message (paths inside the served directory made relative), and the
+    // file and JSON pointer it names.
+    nlohmann::json userErrorBody(const std::string& message) const;
+    std::string newJobId();
+
+    ServeOptions mOptions;
+    Sandbox mSandbox;
+    GpuWorker& mGpu;
+    EventHub& mEvents;
+    ImageStore mImages;
+    std::atomic<uint64_t> mJobs{0};
+};
+
+} // namespace vitrine::serve

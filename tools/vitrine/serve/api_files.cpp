@@ -1,0 +1,154 @@
+// Files under the served directory: the list of graphs, reading and writing one, and the editor's static bundle.
+#include "tools/vitrine/serve/api.hpp"
+
+#include "core/base/atomic_file.hpp"
+#include "core/base/error.hpp"
+#include "core/base/json_text.hpp"
+#include "tools/vitrine/serve/http_util.hpp"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace vitrine::serve {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// How many files GET /api/graphs looks at before it stops (a DIR like / must not hang the server).
+constexpr size_t kMaxListedFiles = 20000;
+constexpr uintmax_t kMaxGraphBytes = 4u << 20;
+
+std::string readFile(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw HttpError(404, path.filename().string() + ": cannot be read");
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    return bytes.str();
+}
+
+bool skippedDirectory(const fs::path& dir) {
+    const std::string name = dir.filename().string();
+    std::error_code ec;
+    return (!name.empty() && name[0] == '.') || name == "node_modules" ||
+           fs::exists(dir / "CMakeCache.txt", ec); // a build tree
+}
+
+const char* contentType(const std::string& extension) {
+    static const std::pair<const char*, const char*> kTypes[] = {{".html", "text/html; charset=utf-8"},
+                                                                 {".js", "text/javascript"},
+                                                                 {".mjs", "text/javascript"},
+                                                                 {".css", "text/css"},
+                                                                 {".json", "application/json"},
+                                                                 {".svg", "image/svg+xml"},
+                                                                 {".png", "image/png"},
+                                                                 {".ico", "image/x-icon"},
+                                                                 {".woff2", "font/woff2"},
+                                                                 {".map", "application/json"},
+                                                                 {".txt", "text/plain"},
+                                                                 {".wasm", "application/wasm"}};
+    for (const auto& [ext, type] : kTypes)
+        if (extension == ext) return type;
+    return "application/octet-stream";
+}
+
+const char* kPlaceholder = R"(<!doctype html>
+<html><head><meta charset="utf-8"><title>vitrine serve</title>
+<style>body{font:15px/1.5 system-ui,sans-serif;max-width:46em;margin:3em auto;padding:0 1em}code{background:#eee;padding:0 .3em}</style>
+</head><body>
+<h1>vitrine serve</h1>
+<p>The server is running, but the graph editor is not built: <code>editor/dist/</code> does not exist.</p>
+<p>Build it (Node.js and npm from Debian: <code>tools/install-deps.sh</code>), then reload this page:</p>
+<pre><code>npm --prefix editor ci
+npm --prefix editor run build</code></pre>
+<p>or start the server with <code>--editor DIR</code> pointing at a built bundle.</p>
+<p>The JSON API works without it: <a href="api/nodes">/api/nodes</a>, <a href="api/graphs">/api/graphs</a>,
+<a href="api/status">/api/status</a> (see the README, "Serving graphs: vitrine serve").</p>
+</body></html>
+)";
+
+} // namespace
+
+void Api::listGraphs(const httplib::Request&, httplib::Response& res) {
+    nlohmann::json graphs = nlohmann::json::array();
+    std::error_code ec;
+    size_t seen = 0;
+    bool truncated = false;
+    fs::recursive_directory_iterator it(mSandbox.root(), fs::directory_options::skip_permission_denied, ec), end;
+    for (; !ec && it != end; it.increment(ec)) {
+        if (++seen > kMaxListedFiles) {
+            truncated = true;
+            break;
+        }
+        const fs::directory_entry& entry = *it;
+        if (entry.is_directory(ec)) {
+            if (skippedDirectory(entry.path())) it.disable_recursion_pending();
+            continue;
+        }
+        if (entry.path().extension() != ".json" || !entry.is_regular_file(ec)) continue;
+        if (entry.file_size(ec) > kMaxGraphBytes || !mSandbox.contains(entry.path())) continue;
+        JsonTextError error;
+        std::optional<nlohmann::json> doc = parseJsonText(readFile(entry.path()), error);
+        // Graphs have nodes, variants extend a graph; other JSON (the schema, glTF, metrics) is not listed.
+        if (!doc || !doc->is_object() || !(doc->contains("nodes") || doc->contains("extends"))) continue;
+        const bool variant = doc->contains("extends");
+        nlohmann::json item = {{"path", mSandbox.relative(fs::weakly_canonical(entry.path()))},
+                               {"kind", variant ? "variant" : "graph"}};
+        if (variant && (*doc)["extends"].is_string()) item["extends"] = (*doc)["extends"];
+        if (doc->contains("description") && (*doc)["description"].is_string())
+            item["description"] = (*doc)["description"];
+        graphs.push_back(std::move(item));
+    }
+    std::sort(graphs.begin(), graphs.end(),
+              [](const nlohmann::json& a, const nlohmann::json& b) { return a["path"] < b["path"]; });
+    nlohmann::json body = {{"graphs", graphs}};
+    if (truncated) body["truncated"] = true;
+    replyJson(res, 200, body);
+}
+
+void Api::getGraph(const httplib::Request& req, httplib::Response& res) {
+    const std::string relative = req.matches[1];
+    const fs::path path = mSandbox.resolve(relative);
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw HttpError(404, relative + ": no such file under the served directory");
+    if (path.extension() != ".json") throw HttpError(403, relative + ": refused: only graph files (.json) are served");
+    res.set_content(readFile(path), "application/json");
+}
+
+void Api::putGraph(const httplib::Request& req, httplib::Response& res) {
+    const std::string relative = req.matches[1];
+    const fs::path path = mSandbox.resolve(relative);
+    if (path.extension() != ".json") throw HttpError(403, relative + ": refused: only graph files (.json) are written");
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw HttpError(409, relative + ": is a directory");
+    // The body must be a JSON object (a graph or a variant); it is written as sent, so that a file read and written
+    // back unchanged stays byte for byte the same.
+    parseRequestBody(req.body);
+    fs::create_directories(path.parent_path(), ec);
+    if (ec) throw HttpError(500, relative + ": cannot create its directory: " + ec.message());
+    const bool existed = fs::exists(path, ec);
+    writeFileAtomically(path, req.body);
+    replyJson(res, existed ? 200 : 201, {{"path", mSandbox.relative(path)}, {"bytes", req.body.size()}});
+}
+
+void Api::staticFile(const httplib::Request& req, httplib::Response& res) {
+    const std::string relative = req.matches[1];
+    if (relative.rfind("api/", 0) == 0 || relative == "api")
+        throw HttpError(404, "no such route: " + req.method + " " + req.path);
+    std::error_code ec;
+    if (!fs::is_directory(mOptions.editorDist, ec)) {
+        if (!relative.empty() && relative != "index.html")
+            throw HttpError(404, req.path + ": not found (the editor is not built)");
+        res.set_content(kPlaceholder, "text/html; charset=utf-8");
+        return;
+    }
+    Sandbox dist(mOptions.editorDist);
+    fs::path path = dist.resolve(relative.empty() ? "index.html" : relative);
+    // Paths without an extension are the single-page app's own routes: its index page answers them.
+    if (!fs::is_regular_file(path, ec) && fs::path(relative).extension().empty()) path = dist.resolve("index.html");
+    if (!fs::is_regular_file(path, ec)) throw HttpError(404, req.path + ": not found");
+    res.set_content(readFile(path), contentType(path.extension().string()));
+}
+
+} // namespace vitrine::serve

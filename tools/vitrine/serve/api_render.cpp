@@ -1,0 +1,337 @@
+// Routes that compile or render graphs: validate, render, compare, the rendered images and the progress events.
+#include "tools/vitrine/serve/api.hpp"
+
+#include "core/base/error.hpp"
+#include "core/compare/report.hpp"
+#include "core/graph/compiler.hpp"
+#include "core/graph/json_util.hpp"
+#include "core/graph/loader.hpp"
+#include "core/graph/registry.hpp"
+#include "core/image/io.hpp"
+#include "tools/vitrine/render_output.hpp"
+#include "tools/vitrine/serve/http_util.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <future>
+
+namespace vitrine::serve {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr uint32_t kMaxSide = 8192;
+constexpr uint64_t kMaxPixels = 4096ull * 4096ull;
+constexpr uint32_t kMaxFrames = 4096;
+
+std::string pngString(const Image& image) {
+    std::vector<unsigned char> png = encodePng(image);
+    return std::string(reinterpret_cast<const char*>(png.data()), png.size());
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A side of a compare request: "graphs/x.json" stands for {"graph": "graphs/x.json"}.
+nlohmann::json specOf(const nlohmann::json& value, const std::string& pointer) {
+    if (value.is_string()) return {{"graph", value}};
+    if (!value.is_object())
+        throw HttpError(400, "request body: " + pointer + ": expected a graph path or an object",
+                        {{"pointer", pointer}});
+    return value;
+}
+
+} // namespace
+
+PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults) {
+    // Where the document comes from: a file under the served directory, or the request itself (the editor's unsaved
+    // graph; `base` is the file it stands for, from whose directory its relative paths and `extends` resolve).
+    nlohmann::json document;
+    fs::path file;
+    std::string label;
+    if (spec.contains("graph")) {
+        label = optionalString(spec, "graph", pointer);
+        file = mSandbox.resolve(label);
+        std::error_code ec;
+        if (!fs::is_regular_file(file, ec))
+            throw HttpError(404, label + ": no such graph file under the served directory",
+                            {{"pointer", pointer + "/graph"}});
+        document = readJsonFile(file);
+    } else if (spec.contains("document")) {
+        document = spec["document"];
+        if (!document.is_object())
+            throw HttpError(400, "request body: " + pointer + "/document: expected a graph (a JSON object)",
+                            {{"pointer", pointer + "/document"}});
+        const std::string base = optionalString(spec, "base", pointer);
+        file = base.empty() ? mSandbox.root() / "request.json" : mSandbox.resolve(base);
+        label = base.empty() ? "request.json" : base;
+    } else {
+        throw HttpError(400,
+                        "request body: " + pointer +
+                            ": expected \"graph\" (a graph or variant file under the served directory) or "
+                            "\"document\" (a graph as JSON)",
+                        {{"pointer", pointer.empty() ? "" : pointer}});
+    }
+    mSandbox.checkExtends(document, file.parent_path(), label);
+
+    std::vector<std::string> sets;
+    if (spec.contains("set")) {
+        const nlohmann::json& s = spec["set"];
+        const std::string at = pointer + "/set";
+        if (!s.is_array())
+            throw HttpError(400, "request body: " + at + ": expected an array of \"KEY=VALUE\"", {{"pointer", at}});
+        for (size_t i = 0; i < s.size(); ++i) {
+            if (!s[i].is_string())
+                throw HttpError(400, "request body: " + at + "/" + std::to_string(i) + ": expected \"KEY=VALUE\"",
+                                {{"pointer", at + "/" + std::to_string(i)}});
+            sets.push_back(s[i].get<std::string>());
+        }
+    }
+    document = mergeGraphDocument(std::move(document), file, sets);
+
+    // The preview: size, frame count and the one output rendered, written into the document before it is validated
+    // (so a frame.write beyond a shortened run is not an error, and the warm-graph key is the document).
+    const uint32_t width = optionalUint(spec, "width", 1, kMaxSide, defaults.width, pointer);
+    const uint32_t height = optionalUint(spec, "height", 1, kMaxSide, defaults.height, pointer);
+    const uint32_t frames = optionalUint(spec, "frames", 1, kMaxFrames, defaults.frames, pointer);
+    std::string output = optionalString(spec, "output", pointer);
+    if (output.empty()) output = defaults.output;
+    if (document.contains("frame") && !document["frame"].is_object())
+        throw UserError(label + ": /frame: expected an object with width, height, frames");
+    if (width) document["frame"]["width"] = width;
+    if (height) document["frame"]["height"] = height;
+    if (frames) {
+        document["frame"]["frames"] = frames;
+        document["frame"]["write"] = {frames - 1};
+    }
+    // "node.port" that is not a graph output: any node's texture output as a preview.
+    if (!output.empty() && output.find('.') != std::string::npos && document.contains("outputs") &&
+        document["outputs"].is_object() && !document["outputs"].contains(output)) {
+        document["outputs"] = {{"preview", output}};
+        output = "preview";
+    }
+
+    PreparedGraph prepared;
+    prepared.desc = validateGraph(document, label, NodeRegistry::global());
+    prepared.desc.directory = file.parent_path();
+    const FrameSettings& frame = prepared.desc.frame;
+    if (static_cast<uint64_t>(frame.width) * frame.height > kMaxPixels)
+        throw HttpError(400,
+                        label + ": " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+                            " is larger than vitrine serve renders (at most 4096x4096 pixels); ask for a preview "
+                            "size with \"width\" and \"height\"",
+                        {{"pointer", pointer + "/width"}});
+    prepared.output = cli::pickOutput(prepared.desc, output);
+    std::erase_if(prepared.desc.outputs, [&](const OutputDecl& o) { return o.name != prepared.output; });
+    nlohmann::json kept = {{prepared.output, prepared.desc.document["outputs"][prepared.output]}};
+    prepared.desc.document["outputs"] = kept;
+    mSandbox.checkPathParams(prepared.desc);
+    return prepared;
+}
+
+RenderResult Api::renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph) {
+    const std::string file = graph.desc.file;
+    auto progress = [&, job, kind, file](const std::string& stage, uint32_t done, uint32_t total) {
+        mEvents.publish(
+            "job", {{"job", job}, {"kind", kind}, {"graph", file}, {"stage", stage}, {"done", done}, {"total", total}});
+    };
+    return mGpu.render(graph, progress);
+}
+
+void Api::validate(const httplib::Request& req, httplib::Response& res) {
+    const nlohmann::json request = parseRequestBody(req.body);
+    // As `vitrine validate`: the graph is loaded and compiled (every node's setup runs), nothing is rendered. The
+    // compile runs on the GPU thread, after the jobs before it, because node setups build scenes and load files.
+    try {
+        Defaults defaults;
+        PreparedGraph prepared = prepare(request, "", defaults);
+        std::promise<nlohmann::json> done;
+        std::future<nlohmann::json> result = done.get_future();
+        mGpu.post([&] {
+            try {
+                CompiledGraph graph = compileGraph(prepared.desc);
+                done.set_value({{"ok", true},
+                                {"passes", graph.passes.size()},
+                                {"textures", graph.resources.size()},
+                                {"culled", graph.culled}});
+            } catch (...) {
+                done.set_exception(std::current_exception());
+            }
+        });
+        replyJson(res, 200, result.get());
+    } catch (const PathRefused& e) {
+        replyJson(res, 200, {{"ok", false}, {"errors", {userErrorBody(e.what())}}});
+    } catch (const UserError& e) {
+        replyJson(res, 200, {{"ok", false}, {"errors", {userErrorBody(e.what())}}});
+    }
+}
+
+void Api::render(const httplib::Request& req, httplib::Response& res) {
+    const auto start = std::chrono::steady_clock::now();
+    const nlohmann::json request = parseRequestBody(req.body);
+    const bool async = optionalBool(request, "async", false);
+    PreparedGraph prepared = prepare(request, "", Defaults{});
+    const std::string job = newJobId();
+    mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"graph", prepared.desc.file}, {"stage", "queued"}});
+
+    if (async) {
+        // The job runs on the GPU thread after the queue; the client fetches /api/images/ID (202 until it is done).
+        const std::string id = mImages.reserve();
+        auto shared = std::make_shared<PreparedGraph>(std::move(prepared));
+        mGpu.post([this, shared, job, id, start] {
+            try {
+                const std::string file = shared->desc.file;
+                RenderResult r = mGpu.renderNow(*shared, [&](const std::string& stage, uint32_t done, uint32_t total) {
+                    mEvents.publish("job", {{"job", job},
+                                            {"kind", "render"},
+                                            {"graph", file},
+                                            {"stage", stage},
+                                            {"done", done},
+                                            {"total", total}});
+                });
+                mImages.fulfil(id, pngString(r.image), r.image.width, r.image.height);
+                mEvents.publish("job", {{"job", job},
+                                        {"kind", "render"},
+                                        {"stage", "done"},
+                                        {"image", id},
+                                        {"ms", msSince(start)},
+                                        {"warm", r.warm}});
+            } catch (const UserError& e) {
+                mImages.fail(id, 422, userErrorBody(e.what()));
+                mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
+            } catch (const std::exception& e) {
+                mImages.fail(id, 500, {{"error", std::string("internal error: ") + e.what()}});
+                mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
+            }
+        });
+        replyJson(res, 202, {{"job", job}, {"image", id}, {"url", "/api/images/" + id}});
+        return;
+    }
+
+    try {
+        RenderResult r = renderJob(job, "render", prepared);
+        const double ms = msSince(start);
+        mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "done"}, {"ms", ms}, {"warm", r.warm}});
+        res.set_header("X-Vitrine-Job", job);
+        res.set_header("X-Vitrine-Output", prepared.output);
+        res.set_header("X-Vitrine-Width", std::to_string(r.image.width));
+        res.set_header("X-Vitrine-Height", std::to_string(r.image.height));
+        res.set_header("X-Vitrine-Warm", r.warm ? "1" : "0");
+        res.set_header("X-Vitrine-Ms", std::to_string(ms));
+        res.set_header("X-Vitrine-Validation-Messages", std::to_string(r.validationMessages));
+        res.set_content(pngString(r.image), "image/png");
+    } catch (const std::exception& e) {
+        mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
+        throw;
+    }
+}
+
+void Api::compare(const httplib::Request& req, httplib::Response& res) {
+    const nlohmann::json request = parseRequestBody(req.body);
+    for (const char* side : {"a", "b"})
+        if (!request.contains(side))
+            throw HttpError(400, std::string("request body: /") + side + ": missing; expected a graph path or object",
+                            {{"pointer", std::string("/") + side}});
+    Defaults defaults;
+    defaults.width = optionalUint(request, "width", 1, kMaxSide, 0);
+    defaults.height = optionalUint(request, "height", 1, kMaxSide, 0);
+    defaults.frames = optionalUint(request, "frames", 1, kMaxFrames, 0);
+    defaults.output = optionalString(request, "output");
+    compare::PairOptions options;
+    options.hdr = optionalBool(request, "hdr", false);
+    PreparedGraph a = prepare(specOf(request["a"], "/a"), "/a", defaults);
+    PreparedGraph b = prepare(specOf(request["b"], "/b"), "/b", defaults);
+
+    const std::string job = newJobId();
+    mEvents.publish("job", {{"job", job}, {"kind", "compare"}, {"stage", "queued"}});
+    Image imageA, imageB;
+    try {
+        imageA = renderJob(job, "compare", a).image;
+        imageB = renderJob(job, "compare", b).image;
+    } catch (const std::exception& e) {
+        mEvents.publish("job", {{"job", job}, {"kind", "compare"}, {"stage", "error"}, {"error", e.what()}});
+        throw;
+    }
+    if (imageA.width != imageB.width || imageA.height != imageB.height)
+        throw HttpError(422, "compare: A (" + a.desc.file + ") is " + std::to_string(imageA.width) + "x" +
+                                 std::to_string(imageA.height) + " but B (" + b.desc.file + ") is " +
+                                 std::to_string(imageB.width) + "x" + std::to_string(imageB.height) +
+                                 "; expected the same size (give \"width\" and \"height\")");
+
+    // The metrics and maps of `vitrine compare`, from the same core/compare functions.
+    compare::PairComparison pair = compare::comparePair("A", imageA, "B", imageB, options);
+    compare::ReportInput report;
+    report.title = a.desc.file + " vs " + b.desc.file;
+    report.a = {"A: " + a.desc.file + " → " + a.output, {}, imageA.width, imageA.height};
+    report.b = {"B: " + b.desc.file + " → " + b.output, {}, imageB.width, imageB.height};
+    report.metrics.push_back(pair.metrics);
+    report.graphA = a.desc.document;
+    report.graphB = b.desc.document;
+    nlohmann::json images;
+    auto store = [&](const std::string& name, const Image& image) {
+        const std::string id = mImages.reserve();
+        mImages.fulfil(id, pngString(image), image.width, image.height);
+        images[name] = "/api/images/" + id;
+    };
+    store("a", imageA);
+    store("b", imageB);
+    store("diff", compare::falseColor(compare::absoluteDifference(imageA, imageB), 1.0));
+    store("flip", compare::flipColorMap(pair.flipErrorMap));
+    mEvents.publish("job", {{"job", job}, {"kind", "compare"}, {"stage", "done"}});
+    replyJson(res, 200, {{"job", job}, {"metrics", compare::metricsJson(report)}, {"images", images}});
+}
+
+void Api::image(const httplib::Request& req, httplib::Response& res) {
+    const std::string id = req.matches[1];
+    std::optional<ImageStore::Entry> entry = mImages.get(id);
+    if (!entry) throw HttpError(404, "no image " + id + " (unknown, or dropped: the server keeps the latest 64)");
+    switch (entry->state) {
+    case ImageStore::Entry::State::Pending:
+        replyJson(res, 202, {{"image", id}, {"state", "pending"}});
+        return;
+    case ImageStore::Entry::State::Failed:
+        replyError(res, entry->status, entry->error.value("error", ""), entry->error);
+        return;
+    case ImageStore::Entry::State::Done:
+        res.set_header("X-Vitrine-Width", std::to_string(entry->width));
+        res.set_header("X-Vitrine-Height", std::to_string(entry->height));
+        res.set_content(entry->png, "image/png");
+        return;
+    }
+}
+
+void Api::events(const httplib::Request& req, httplib::Response& res) {
+    // A reconnecting EventSource sends the last id it saw and gets what it missed (of the kept events).
+    uint64_t after = mEvents.lastId();
+    if (req.has_header("Last-Event-ID")) {
+        const std::string last = req.get_header_value("Last-Event-ID");
+        if (!last.empty() && last.size() < 19 && last.find_first_not_of("0123456789") == std::string::npos)
+            after = std::stoull(last);
+    }
+    res.set_header("Cache-Control", "no-cache");
+    EventHub* hub = &mEvents;
+    auto first = std::make_shared<bool>(true);
+    res.set_chunked_content_provider("text/event-stream", [hub, after, first](size_t, httplib::DataSink& sink) mutable {
+        if (*first) {
+            *first = false;
+            const std::string hello = "retry: 2000\nevent: hello\ndata: {}\n\n";
+            return sink.write(hello.data(), hello.size());
+        }
+        std::vector<Event> events = hub->waitAfter(after, std::chrono::seconds(15));
+        if (hub->closed()) {
+            sink.done();
+            return true;
+        }
+        // A comment line every 15 s without events: a client that went away shows up as a failed write.
+        std::string text = events.empty() ? std::string(": keep-alive\n\n") : std::string();
+        for (const Event& e : events) {
+            text += EventHub::format(e);
+            after = e.id;
+        }
+        return sink.write(text.data(), text.size()) && sink.is_writable();
+    });
+}
+
+} // namespace vitrine::serve

@@ -1,0 +1,182 @@
+#include "tools/vitrine/serve/gpu_worker.hpp"
+
+#include "core/base/error.hpp"
+#include "core/base/log.hpp"
+#include "core/graph/executor.hpp"
+
+namespace vitrine::serve {
+
+struct WarmGraphs::Entry {
+    std::string key;
+    CompiledGraph graph;
+    std::unique_ptr<Executor> executor; // refers to `graph`, so the entry never moves (held by unique_ptr)
+};
+
+WarmGraphs::WarmGraphs(size_t capacity) : mCapacity(capacity) {}
+
+WarmGraphs::~WarmGraphs() {
+    clear();
+}
+
+WarmGraphs::Entry& WarmGraphs::get(Context& ctx, ShaderCompiler& shaders, const PreparedGraph& prepared,
+                                   bool& compiled) {
+    const GraphDesc& desc = prepared.desc;
+    const std::string key = desc.file + '\n' + desc.directory.string() + '\n' + desc.document.dump();
+    for (auto it = mEntries.begin(); it != mEntries.end(); ++it)
+        if ((*it)->key == key) {
+            mEntries.splice(mEntries.begin(), mEntries, it);
+            compiled = false;
+            return *mEntries.front();
+        }
+    auto entry = std::make_unique<Entry>();
+    entry->key = key;
+    entry->graph = compileGraph(desc);
+    entry->executor = std::make_unique<Executor>(ctx, entry->graph, shaders);
+    mEntries.push_front(std::move(entry));
+    while (mEntries.size() > mCapacity)
+        mEntries.pop_back();
+    compiled = true;
+    return *mEntries.front();
+}
+
+Executor& WarmGraphs::executor(Entry& entry) {
+    return *entry.executor;
+}
+
+void WarmGraphs::drop(const Entry& entry) {
+    mEntries.remove_if([&](const std::unique_ptr<Entry>& e) { return e.get() == &entry; });
+}
+
+void WarmGraphs::clear() {
+    // Executors first (they free GPU objects), most recent last: the order does not matter to Vulkan, only that
+    // every executor goes before the context does, which the owner guarantees.
+    mEntries.clear();
+}
+
+GpuWorker::GpuWorker(const ContextOptions& options, size_t warmGraphs) : mOptions(options), mWarmCapacity(warmGraphs) {
+    std::promise<void> ready;
+    std::future<void> started = ready.get_future();
+    mThread = std::thread([this, &ready] {
+        try {
+            mCtx = std::make_unique<Context>(mOptions);
+            mShaders = std::make_unique<ShaderCompiler>();
+            mWarm = std::make_unique<WarmGraphs>(mWarmCapacity);
+            mDeviceName = mCtx->deviceInfo().name;
+        } catch (...) {
+            ready.set_exception(std::current_exception());
+            return;
+        }
+        ready.set_value();
+        loop();
+    });
+    try {
+        started.get();
+    } catch (...) {
+        mThread.join();
+        throw;
+    }
+}
+
+GpuWorker::~GpuWorker() {
+    stop();
+}
+
+void GpuWorker::stop() {
+    {
+        std::lock_guard lock(mMutex);
+        mStopping = true;
+    }
+    mWake.notify_all();
+    if (mThread.joinable()) mThread.join();
+}
+
+size_t GpuWorker::queued() const {
+    std::lock_guard lock(mMutex);
+    return mJobs.size();
+}
+
+void GpuWorker::post(std::function<void()> job) {
+    {
+        std::lock_guard lock(mMutex);
+        if (mStopping) throw InternalError("vitrine serve is stopping; the GPU queue takes no more work");
+        mJobs.push_back(std::move(job));
+    }
+    mWake.notify_one();
+}
+
+void GpuWorker::loop() {
+    for (;;) {
+        std::function<void()> job;
+        {
+            std::unique_lock lock(mMutex);
+            mWake.wait(lock, [&] { return mStopping || !mJobs.empty(); });
+            if (mJobs.empty()) break; // stopping, and every job posted before has run
+            job = std::move(mJobs.front());
+            mJobs.pop_front();
+        }
+        job();
+    }
+    mWarm.reset();
+    mShaders.reset();
+    mCtx.reset();
+}
+
+RenderResult GpuWorker::render(const PreparedGraph& graph, const ProgressFn& progress) {
+    std::promise<RenderResult> promise;
+    std::future<RenderResult> result = promise.get_future();
+    // The caller waits for the future, so the job may refer to its arguments.
+    post([&] {
+        try {
+            promise.set_value(renderNow(graph, progress));
+        } catch (...) {
+            promise.set_exception(std::current_exception());
+        }
+    });
+    return result.get();
+}
+
+RenderResult GpuWorker::renderNow(const PreparedGraph& graph, const ProgressFn& progress) {
+    RenderResult out;
+    WarmGraphs::Entry* entry = nullptr;
+    try {
+        if (!mCtx) mCtx = std::make_unique<Context>(mOptions);
+        const size_t before = mCtx->validationMessageCount();
+        progress("compiling", 0, 0);
+        bool compiled = false;
+        entry = &mWarm->get(*mCtx, *mShaders, graph, compiled);
+        mWarmCount = mWarm->size();
+        out.warm = !compiled;
+        const uint32_t frames = graph.desc.frame.frames;
+        RunOptions options;
+        options.frames = frames;
+        options.write = {frames - 1};
+        options.progress = false;
+        options.onOutput = [&](uint32_t, const std::string&, const Image& image) { out.image = image; };
+        uint32_t done = 0;
+        options.stop = [&] {
+            progress("rendering", ++done, frames);
+            return false;
+        };
+        mWarm->executor(*entry).run(options);
+        out.validationMessages = mCtx->validationMessageCount() - before;
+        return out;
+    } catch (const UserError&) {
+        if (entry) mWarm->drop(*entry);
+        mWarmCount = mWarm->size();
+        throw;
+    } catch (...) {
+        // A Vulkan failure may have lost the device: start afresh so that the next request gets a working one.
+        mWarm->clear();
+        mWarmCount = 0;
+        try {
+            mCtx.reset();
+            mCtx = std::make_unique<Context>(mOptions);
+            logWarning("vitrine serve: a render failed on the GPU; the Vulkan device was created anew");
+        } catch (const std::exception& e) {
+            logWarning(std::string("vitrine serve: the Vulkan device could not be created anew: ") + e.what());
+        }
+        throw;
+    }
+}
+
+} // namespace vitrine::serve

@@ -1,0 +1,104 @@
+#pragma once
+
+#include "core/gpu/context.hpp"
+#include "core/graph/compiler.hpp"
+#include "core/image/image.hpp"
+#include "core/shader/compiler.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <future>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace vitrine {
+class Executor;
+}
+
+// The GPU side of `vitrine serve`: one thread owns the Vulkan device, the shader compiler and the graphs compiled
+// for earlier requests, and runs the requests' GPU work one at a time in the order they came (the queue is the one
+// place GPU work is serialised). A request that fails (a UserError from a node's setup, a Vulkan error) fails alone;
+// the thread goes on with the next one.
+namespace vitrine::serve {
+
+// A graph ready to render: the document merged (extends), edited for the preview (size, frames, the one output
+// kept) and validated. WarmGraphs is keyed on its document, directory and file.
+struct PreparedGraph {
+    GraphDesc desc;     // validated, its paths checked against the served directory
+    std::string output; // the one graph output left in it
+};
+
+// Compiled graphs with their executors (pipelines, images, uploaded scenes, baked resources) kept between requests,
+// so that rendering the same document again runs frames only. Least recently used first out.
+class WarmGraphs {
+public:
+    explicit WarmGraphs(size_t capacity);
+    ~WarmGraphs();
+    struct Entry;
+    // The entry for `graph`, compiled (and its executor created) when not kept; `compiled` says whether it was.
+    Entry& get(Context& ctx, ShaderCompiler& shaders, const PreparedGraph& graph, bool& compiled);
+    Executor& executor(Entry& entry);
+    void drop(const Entry& entry);
+    void clear();
+    size_t size() const { return mEntries.size(); }
+
+private:
+    size_t mCapacity;
+    std::list<std::unique_ptr<Entry>> mEntries; // front: most recently used
+};
+
+// What a render job reports while it runs, on the GPU thread: "compiling", then "rendering" with frames done/total.
+using ProgressFn = std::function<void(const std::string& stage, uint32_t done, uint32_t total)>;
+
+struct RenderResult {
+    Image image;
+    bool warm = false;             // the compiled graph was kept from an earlier request
+    size_t validationMessages = 0; // Vulkan validation messages during this job (with --validate)
+};
+
+class GpuWorker {
+public:
+    // Starts the thread and creates the device on it; rethrows when that fails (no Vulkan device).
+    GpuWorker(const ContextOptions& options, size_t warmGraphs);
+    ~GpuWorker();
+    GpuWorker(const GpuWorker&) = delete;
+    GpuWorker& operator=(const GpuWorker&) = delete;
+
+    // Renders the frames of `graph` and returns its one output at the last frame. Blocks the calling thread until
+    // the job has run on the GPU thread; rethrows what it threw.
+    RenderResult render(const PreparedGraph& graph, const ProgressFn& progress);
+    // Runs `job` on the GPU thread after the jobs before it (fire and forget: `job` handles its own errors).
+    void post(std::function<void()> job);
+    // render() for a job already on the GPU thread.
+    RenderResult renderNow(const PreparedGraph& graph, const ProgressFn& progress);
+    // Runs the jobs already posted, then frees the device and ends the thread; later posts throw. Idempotent.
+    void stop();
+
+    std::string deviceName() const { return mDeviceName; }
+    size_t queued() const;
+    size_t warmGraphs() const { return mWarmCount; }
+
+private:
+    void loop();
+
+    ContextOptions mOptions;
+    size_t mWarmCapacity;
+    std::unique_ptr<Context> mCtx;
+    std::unique_ptr<ShaderCompiler> mShaders;
+    std::unique_ptr<WarmGraphs> mWarm;
+    std::string mDeviceName;
+    std::atomic<size_t> mWarmCount{0};
+
+    mutable std::mutex mMutex;
+    std::condition_variable mWake;
+    std::deque<std::function<void()>> mJobs;
+    bool mStopping = false;
+    std::thread mThread;
+};
+
+} // namespace vitrine::serve

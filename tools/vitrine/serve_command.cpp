@@ -1,0 +1,105 @@
+// `vitrine serve [DIR] [--port N] [--host ADDR]`: the graph editor's server (tools/vitrine/serve/).
+#include "core/base/error.hpp"
+#include "core/base/log.hpp"
+#include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/render_output.hpp"
+#include "tools/vitrine/serve/api.hpp"
+
+#include <httplib.h>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <random>
+#include <thread>
+
+namespace vitrine::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::atomic<int> gStopSignal{0};
+
+void onStopSignal(int signal) {
+    gStopSignal = signal;
+}
+
+// The names that need no token. Any other address, even another 127.x.y.z, counts as opening the server: a user who
+// chose one may have forwarded it.
+bool isLoopback(const std::string& host) {
+    return host == "127.0.0.1" || host == "localhost" || host == "::1" || host == "[::1]";
+}
+
+// 192 random bits as hex, as Jupyter's token.
+std::string newToken() {
+    std::random_device random;
+    std::string token;
+    const char* hex = "0123456789abcdef";
+    for (int i = 0; i < 48; ++i)
+        token += hex[random() & 15u];
+    return token;
+}
+
+} // namespace
+
+int serveCommand(const Args& args) {
+    if (args.positional.size() > 1) throw UserError("serve: expected at most one DIR argument (default: .)");
+    serve::ServeOptions options;
+    options.dir = args.positional.empty() ? fs::path(".") : fs::path(args.positional[0]);
+    options.editorDist = args.get("editor", (fs::path(VITRINE_SOURCE_DIR) / "editor" / "dist").string());
+    const std::string host = args.get("host", "127.0.0.1");
+    const uint32_t port = args.getUint("port", 8420);
+    if (port > 65535) throw UserError("--port: expected 0..65535 (0: any free port), got " + std::to_string(port));
+    options.maxBodyBytes = args.getUint("max-body", 16u << 20);
+    if (options.maxBodyBytes == 0) throw UserError("--max-body: expected at least 1 byte");
+    options.loopbackOnly = isLoopback(host);
+    options.token = args.get("token");
+    if (!options.loopbackOnly) {
+        logWarning("serve: --host " + host + " opens the server to other machines: anyone who can reach it and has " +
+                   "the token can read and write the graphs under the served directory and use the GPU");
+        if (options.token.empty()) options.token = newToken();
+    }
+    const uint32_t warm = args.getUint("warm", 4);
+
+    serve::EventHub events;
+    logInfo("serve: creating the Vulkan device");
+    serve::GpuWorker gpu(contextOptions(args), std::max(1u, warm));
+    serve::Api api(options, gpu, events);
+    httplib::Server server;
+    // Events streams hold a thread each while open.
+    server.new_task_queue = [] { return new httplib::ThreadPool(16); };
+    api.install(server);
+
+    const int bound = port == 0 ? server.bind_to_any_port(host)
+                                : (server.bind_to_port(host, static_cast<int>(port)) ? static_cast<int>(port) : -1);
+    if (bound < 0) throw UserError("serve: cannot listen on " + host + ":" + std::to_string(port) + " (in use?)");
+    const std::string shownHost = host.find(':') != std::string::npos && host[0] != '[' ? "[" + host + "]" : host;
+    const std::string url = "http://" + shownHost + ":" + std::to_string(bound) + "/";
+    std::printf("vitrine serve: %s on %s\n", fs::canonical(options.dir).string().c_str(), gpu.deviceName().c_str());
+    std::printf("vitrine serve: listening on %s%s\n", url.c_str(),
+                options.token.empty() ? "" : ("?token=" + options.token).c_str());
+    std::printf("vitrine serve: Ctrl-C stops it\n");
+    std::fflush(stdout);
+
+    std::signal(SIGPIPE, SIG_IGN);
+    auto previousInt = std::signal(SIGINT, onStopSignal);
+    auto previousTerm = std::signal(SIGTERM, onStopSignal);
+    std::thread watcher([&] {
+        while (!gStopSignal && !events.closed())
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        events.close(); // ends the events streams, so the server's threads can finish
+        server.stop();
+    });
+    const bool listened = server.listen_after_bind();
+    events.close();
+    watcher.join();
+    gpu.stop(); // runs what is queued (async renders refer to the API), then frees the device
+    std::signal(SIGINT, previousInt);
+    std::signal(SIGTERM, previousTerm);
+    logInfo("serve: stopped");
+    if (!listened && !gStopSignal) throw InternalError("serve: the server stopped unexpectedly");
+    return 0;
+}
+
+} // namespace vitrine::cli
