@@ -64,7 +64,7 @@ TEST_F(Lens, DistortionMovesGridDotsToTheRadialModel) {
             dots.push_back(p);
             addDot(grid, p.x, p.y, 1.5, glm::vec3(1.0f));
         }
-    for (auto [k1, k2] : {std::pair{-0.08, 0.02}, std::pair{0.06, 0.0}}) {
+    for (auto [k1, k2] : {std::pair{-0.2, 0.05}, std::pair{0.15, 0.0}}) {
         json params = {{"distortion", true}, {"k1", k1}, {"k2", k2}, {"chromatic_aberration", false},
                        {"vignetting", false}, {"mechanical_vignetting", 0.0}};
         Image out = runLens(grid, "grid", params).at("out");
