@@ -45,10 +45,10 @@ NodeSchema schema() {
          "Scales of ghosts 0..3 about the centre (0: none; negative: mirrored through the centre)"},
         {"ghost_scales2", ParamType::Vec4, nlohmann::json::array({-1.6, 0.0, 0.0, 0.0}), -8.0, 8.0, {},
          "Scales of ghosts 4..7"},
-        {"ghost_intensity", ParamType::Float, 0.004, 0.0, 10.0, {},
+        {"ghost_intensity", ParamType::Float, 0.05, 0.0, 10.0, {},
          "Each ghost's energy relative to the source's bright energy (times its tint)"},
         {"halo_radius", ParamType::Float, 0.45, 0.0, 2.0, {}, "Ring ghost radius, fraction of the half-diagonal"},
-        {"halo_intensity", ParamType::Float, 0.01, 0.0, 10.0, {}, "Ring ghost energy relative to the source's"},
+        {"halo_intensity", ParamType::Float, 0.05, 0.0, 10.0, {}, "Ring ghost energy relative to the source's"},
         {"halo_taps", ParamType::Int, 48, 1.0, 256.0, {}, "Taps on the ring"},
     };
     return s;

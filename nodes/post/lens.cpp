@@ -57,6 +57,13 @@ public:
         if (p.getFloat("f_number") < p.getFloat("wide_open"))
             ctx.failParam("f_number", "must be >= wide_open (" + std::to_string(p.getFloat("wide_open")) +
                                           "): a lens does not open wider than its maximum aperture");
+        // The distortion must be invertible over the frame (and a little beyond, for the CA scales): r_d(r) increasing.
+        const float k1 = p.getFloat("k1"), k2 = p.getFloat("k2");
+        for (float r = 0.0f; r <= 1.2f; r += 0.01f)
+            if (1.0f + 3.0f * k1 * r * r + 5.0f * k2 * r * r * r * r <= 0.0f)
+                ctx.failParam("k1", "k1 = " + std::to_string(k1) + ", k2 = " + std::to_string(k2) +
+                                        " fold the image over itself (r (1 + k1 r^2 + k2 r^4) stops increasing at r = " +
+                                        std::to_string(r) + " half-diagonals); expected a monotonic distortion");
         mPipeline = ctx.computePipeline("post/lens.comp");
     }
     void execute(ExecuteContext& ctx) override {

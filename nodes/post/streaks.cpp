@@ -48,7 +48,7 @@ NodeSchema schema() {
         {"rotation", ParamType::Float, 0.0, -360.0, 360.0, {}, "Angle of the first spike in degrees"},
         {"f_number", ParamType::Float, 8.0, 0.5, 64.0, {}, "Aperture: spike length and energy grow with it"},
         {"length", ParamType::Float, 0.08, 0.0, 2.0, {}, "3 e-folding lengths of a spike at f/8, fraction of the frame height"},
-        {"strength", ParamType::Float, 0.02, 0.0, 10.0, {}, "Streak energy / the source's bright energy at f/8"},
+        {"strength", ParamType::Float, 0.3, 0.0, 10.0, {}, "Streak energy / the source's bright energy at f/8"},
         {"max_samples", ParamType::Int, 48, 1.0, 256.0, {}, "Most taps per spike (one per bright-pass pixel up to it)"},
     };
     return s;

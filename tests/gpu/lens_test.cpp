@@ -141,6 +141,13 @@ TEST_F(Lens, VignettingFollowsCos4AndThePupilClippedByTheBarrel) {
     EXPECT_LT(corner, 0.5);
     EXPECT_LT(worst, 1e-4);
 
+    // The same from a camera state (focal length 20 mm, 36 mm sensor, no residual distortion or CA, no mechanical
+    // vignetting): it replaces the params, whose defaults (barrel distortion, CA, 35 mm, mechanical 0.6) would differ.
+    json fromState = {{"in", loadNode(writeInput(white, "white_state"))},
+                      {"camera", {{"type", "test.camera_state"}, {"params", {{"focal_length", focal}}}}},
+                      {"lens", {{"type", "post.lens"}, {"in", {{"color", "in.color"}, {"camera_state", "camera.state"}}}}}};
+    EXPECT_LT(maxAbsDiff(runGraph(graph(fromState, {{"out", "lens.color"}}, kW, kH)).at("out"), out), 1e-6);
+
     // Mechanical: wide open (pupil 1) and one stop down (pupil 1/sqrt 2), the opening offset 0.8 radii at the corner.
     for (double fNumber : {2.0, 2.0 * std::sqrt(2.0)}) {
         json mech = {{"distortion", false}, {"chromatic_aberration", false}, {"vignetting", false},
