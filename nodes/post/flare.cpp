@@ -1,8 +1,8 @@
 // post.flare: lens-flare ghosts of bright sources, mirrored and scaled through the optical centre, and a ring ghost.
+#include "shaders/post/flare.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "nodes/camera/camera_state.hpp"
-#include "shaders/post/flare.h"
 
 #include <cmath>
 
@@ -19,7 +19,11 @@ NodeSchema schema() {
             "source's mirror image 2c - q with energy halo_intensity x the source's. Added to the colour.";
     s.inputs = {
         {"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"},
-        {"camera_state", PortKind::Buffer, {}, true, Usage::Sampled,
+        {"camera_state",
+         PortKind::Buffer,
+         {},
+         true,
+         Usage::Sampled,
          "camera.physical's state: its exposure replaces the `exposure` param"},
     };
     OutputPort color;
@@ -37,15 +41,35 @@ NodeSchema schema() {
     flare.doc = "The flare alone (HDR), at the bright pass's size";
     s.outputs = {color, bright, flare};
     s.params = {
-        {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {},
+        {"exposure",
+         ParamType::Float,
+         0.0,
+         -24.0,
+         24.0,
+         {},
          "Exposure in stops (as post.tonemap's) that makes the threshold display-referred; camera_state replaces it"},
         {"threshold", ParamType::Float, 1.0, 0.0, 1e4, {}, "Exposed luminance above which light flares"},
         {"downsample", ParamType::Int, 4, 1.0, 16.0, {}, "Bright-pass downsampling factor"},
-        {"ghost_scales", ParamType::Vec4, nlohmann::json::array({-0.4, -0.75, -1.1, 0.5}), -8.0, 8.0, {},
+        {"ghost_scales",
+         ParamType::Vec4,
+         nlohmann::json::array({-0.4, -0.75, -1.1, 0.5}),
+         -8.0,
+         8.0,
+         {},
          "Scales of ghosts 0..3 about the centre (0: none; negative: mirrored through the centre)"},
-        {"ghost_scales2", ParamType::Vec4, nlohmann::json::array({-1.6, 0.0, 0.0, 0.0}), -8.0, 8.0, {},
+        {"ghost_scales2",
+         ParamType::Vec4,
+         nlohmann::json::array({-1.6, 0.0, 0.0, 0.0}),
+         -8.0,
+         8.0,
+         {},
          "Scales of ghosts 4..7"},
-        {"ghost_intensity", ParamType::Float, 0.05, 0.0, 10.0, {},
+        {"ghost_intensity",
+         ParamType::Float,
+         0.05,
+         0.0,
+         10.0,
+         {},
          "Each ghost's energy relative to the source's bright energy (times its tint)"},
         {"halo_radius", ParamType::Float, 0.45, 0.0, 2.0, {}, "Ring ghost radius, fraction of the half-diagonal"},
         {"halo_intensity", ParamType::Float, 0.05, 0.0, 10.0, {}, "Ring ghost energy relative to the source's"},

@@ -1,8 +1,8 @@
 // post.lens: radial distortion, lateral chromatic aberration, natural and mechanical vignetting.
+#include "shaders/post/lens.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "nodes/camera/camera_state.hpp"
-#include "shaders/post/lens.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +22,11 @@ NodeSchema schema() {
             "connected, supplies k1, k2, the CA scales, focal length, sensor, f-numbers and the mechanical strength.";
     s.inputs = {
         {"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"},
-        {"camera_state", PortKind::Buffer, {}, true, Usage::Sampled,
+        {"camera_state",
+         PortKind::Buffer,
+         {},
+         true,
+         Usage::Sampled,
          "camera.physical's state: replaces the lens params (distortion, CA, focal length, sensor, aperture)"},
     };
     OutputPort out;
@@ -41,10 +45,20 @@ NodeSchema schema() {
         {"vignetting", ParamType::Bool, true, {}, {}, {}, "Natural vignetting: cos^4 of the field angle"},
         {"focal_length", ParamType::Float, 35.0, 1.0, 2000.0, {}, "Focal length in mm (natural vignetting)"},
         {"sensor_width", ParamType::Float, 36.0, 1.0, 200.0, {}, "Sensor width in mm; it spans the image's width"},
-        {"mechanical_vignetting", ParamType::Float, 0.6, 0.0, 2.0, {},
+        {"mechanical_vignetting",
+         ParamType::Float,
+         0.6,
+         0.0,
+         2.0,
+         {},
          "Offset of the barrel's opening at the frame corner, in its radii (0: off)"},
         {"f_number", ParamType::Float, 2.8, 0.5, 64.0, {}, "Aperture (mechanical vignetting)"},
-        {"wide_open", ParamType::Float, 1.8, 0.5, 64.0, {},
+        {"wide_open",
+         ParamType::Float,
+         1.8,
+         0.5,
+         64.0,
+         {},
          "The lens's maximum aperture: its pupil fills the barrel's opening (mechanical vignetting)"},
     };
     return s;
@@ -61,9 +75,10 @@ public:
         const float k1 = p.getFloat("k1"), k2 = p.getFloat("k2");
         for (float r = 0.0f; r <= 1.2f; r += 0.01f)
             if (1.0f + 3.0f * k1 * r * r + 5.0f * k2 * r * r * r * r <= 0.0f)
-                ctx.failParam("k1", "k1 = " + std::to_string(k1) + ", k2 = " + std::to_string(k2) +
-                                        " fold the image over itself (r (1 + k1 r^2 + k2 r^4) stops increasing at r = " +
-                                        std::to_string(r) + " half-diagonals); expected a monotonic distortion");
+                ctx.failParam("k1",
+                              "k1 = " + std::to_string(k1) + ", k2 = " + std::to_string(k2) +
+                                  " fold the image over itself (r (1 + k1 r^2 + k2 r^4) stops increasing at r = " +
+                                  std::to_string(r) + " half-diagonals); expected a monotonic distortion");
         mPipeline = ctx.computePipeline("post/lens.comp");
     }
     void execute(ExecuteContext& ctx) override {

@@ -1,8 +1,8 @@
 // post.motion_blur: reconstruction-filter motion blur from the velocity buffer (McGuire et al. 2012).
+#include "shaders/post/motion_blur.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "nodes/camera/camera_state.hpp"
-#include "shaders/post/motion_blur.h"
 
 #include <algorithm>
 
@@ -25,7 +25,11 @@ NodeSchema schema() {
         tex("color", "Linear HDR colour"),
         tex("velocity", "Screen motion in pixels, this frame minus last (gbuffer.velocity), the colour's size"),
         tex("depth", "Linear view depth in z, 0 where empty (gbuffer.normal), the colour's size"),
-        {"camera_state", PortKind::Buffer, {}, true, Usage::Sampled,
+        {"camera_state",
+         PortKind::Buffer,
+         {},
+         true,
+         Usage::Sampled,
          "camera.physical's state: its shutter time replaces the `shutter` param (with shutter_driven)"},
     };
     OutputPort color;
@@ -43,20 +47,50 @@ NodeSchema schema() {
     neighborMax.doc = "Per tile, the largest tile_max of its 3 x 3 neighbourhood";
     s.outputs = {color, tileMax, neighborMax};
     s.params = {
-        {"scale", ParamType::Float, 0.5, 0.0, 4.0, {},
+        {"scale",
+         ParamType::Float,
+         0.5,
+         0.0,
+         4.0,
+         {},
          "Blur length / velocity: the fraction of a frame interval the shutter is open (0.5: a 180-degree shutter); "
          "unused with shutter_driven"},
-        {"shutter_driven", ParamType::Bool, false, {}, {},{},
+        {"shutter_driven",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
          "Blur length = velocity x shutter time x fps (the camera's shutter from camera_state, else `shutter`)"},
-        {"shutter", ParamType::Float, 1.0 / 48.0, 1e-5, 10.0, {},
+        {"shutter",
+         ParamType::Float,
+         1.0 / 48.0,
+         1e-5,
+         10.0,
+         {},
          "Shutter time in seconds (shutter_driven without camera_state)"},
         {"fps", ParamType::Float, 24.0, 1.0, 1000.0, {}, "Frame rate of the velocity buffer (the scene's fps)"},
-        {"tile_size", ParamType::Int, 20, 2.0, 64.0, {},
+        {"tile_size",
+         ParamType::Int,
+         20,
+         2.0,
+         64.0,
+         {},
          "K: tile side in pixels; also the largest half-length of a blur (longer ones are clamped)"},
         {"samples", ParamType::Int, 15, 1.0, 64.0, {}, "S: taps per pixel along the neighbourhood's velocity"},
-        {"soft_z", ParamType::Float, 0.1, 1e-4, 100.0, {},
+        {"soft_z",
+         ParamType::Float,
+         0.1,
+         1e-4,
+         100.0,
+         {},
          "Metres of depth over which a tap turns from 'same layer' to 'in front'"},
-        {"dither", ParamType::Bool, true, {}, {}, {},
+        {"dither",
+         ParamType::Bool,
+         true,
+         {},
+         {},
+         {},
          "Jitter the taps per pixel and frame (noise instead of banding; off for exact tests)"},
     };
     return s;

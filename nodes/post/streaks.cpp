@@ -1,8 +1,8 @@
 // post.streaks: star streaks (diffraction spikes) of bright sources, from the aperture's blade count and f-number.
+#include "shaders/post/streaks.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "nodes/camera/camera_state.hpp"
-#include "shaders/post/streaks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +22,11 @@ NodeSchema schema() {
             "no star wide open (the blades are out of the way), full one stop down.";
     s.inputs = {
         {"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"},
-        {"camera_state", PortKind::Buffer, {}, true, Usage::Sampled,
+        {"camera_state",
+         PortKind::Buffer,
+         {},
+         true,
+         Usage::Sampled,
          "camera.physical's state: replaces blades, rotation, f_number and exposure"},
     };
     OutputPort color;
@@ -40,14 +44,25 @@ NodeSchema schema() {
     streaks.doc = "The streaks alone (HDR), at the bright pass's size";
     s.outputs = {color, bright, streaks};
     s.params = {
-        {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {},
+        {"exposure",
+         ParamType::Float,
+         0.0,
+         -24.0,
+         24.0,
+         {},
          "Exposure in stops (as post.tonemap's) that makes the threshold display-referred; camera_state replaces it"},
         {"threshold", ParamType::Float, 1.0, 0.0, 1e4, {}, "Exposed luminance above which light streaks"},
         {"downsample", ParamType::Int, 4, 1.0, 16.0, {}, "Bright-pass downsampling factor"},
         {"blades", ParamType::Int, 6, 0.0, 32.0, {}, "Aperture blades (0: a round aperture, no streaks)"},
         {"rotation", ParamType::Float, 0.0, -360.0, 360.0, {}, "Angle of the first spike in degrees"},
         {"f_number", ParamType::Float, 8.0, 0.5, 64.0, {}, "Aperture: spike length and energy grow with it"},
-        {"length", ParamType::Float, 0.08, 0.0, 2.0, {}, "3 e-folding lengths of a spike at f/8, fraction of the frame height"},
+        {"length",
+         ParamType::Float,
+         0.08,
+         0.0,
+         2.0,
+         {},
+         "3 e-folding lengths of a spike at f/8, fraction of the frame height"},
         {"strength", ParamType::Float, 0.3, 0.0, 10.0, {}, "Streak energy / the source's bright energy at f/8"},
         {"max_samples", ParamType::Int, 48, 1.0, 256.0, {}, "Most taps per spike (one per bright-pass pixel up to it)"},
     };
@@ -92,9 +107,11 @@ public:
         push.factor = static_cast<int>(mFactor);
         push.count = blades <= 0 ? 0u : static_cast<uint32_t>(blades % 2 == 0 ? blades : 2 * blades);
         push.rotation = rotation;
-        push.spikeLength = p.getFloat("length") * static_cast<float>(out.height) / static_cast<float>(mFactor) * fNumber / 8.0f;
+        push.spikeLength =
+            p.getFloat("length") * static_cast<float>(out.height) / static_cast<float>(mFactor) * fNumber / 8.0f;
         push.strength = p.getFloat("strength") * fNumber / 8.0f * gate;
-        push.samples = static_cast<uint32_t>(std::clamp(static_cast<int>(std::ceil(push.spikeLength)), 1, p.getInt("max_samples")));
+        push.samples = static_cast<uint32_t>(
+            std::clamp(static_cast<int>(std::ceil(push.spikeLength)), 1, p.getInt("max_samples")));
         ctx.dispatch(mBright, push, low.width, low.height);
         ctx.computeBarrier();
         ctx.dispatch(mSpikes, push, low.width, low.height);

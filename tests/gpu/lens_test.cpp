@@ -36,13 +36,15 @@ void addDot(Image& img, double cx, double cy, double sigma, glm::vec3 value) {
         for (int x = std::max(0, int(cx) - r); x <= std::min(img.width - 1, int(cx) + r); ++x) {
             double dx = x + 0.5 - cx, dy = y + 0.5 - cy;
             double g = std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma));
-            for (int c = 0; c < 3; ++c) img.at(x, y)[c] += static_cast<float>(value[c] * g);
+            for (int c = 0; c < 3; ++c)
+                img.at(x, y)[c] += static_cast<float>(value[c] * g);
         }
 }
 
 Image blank(int w, int h, float value = 0.0f) {
     Image img(w, h);
-    for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = (i % 4 == 3) ? 1.0f : value;
+    for (size_t i = 0; i < img.pixels.size(); ++i)
+        img.pixels[i] = (i % 4 == 3) ? 1.0f : value;
     return img;
 }
 
@@ -65,8 +67,12 @@ TEST_F(Lens, DistortionMovesGridDotsToTheRadialModel) {
             addDot(grid, p.x, p.y, 1.5, glm::vec3(1.0f));
         }
     for (auto [k1, k2] : {std::pair{-0.2, 0.05}, std::pair{0.15, 0.0}}) {
-        json params = {{"distortion", true}, {"k1", k1}, {"k2", k2}, {"chromatic_aberration", false},
-                       {"vignetting", false}, {"mechanical_vignetting", 0.0}};
+        json params = {{"distortion", true},
+                       {"k1", k1},
+                       {"k2", k2},
+                       {"chromatic_aberration", false},
+                       {"vignetting", false},
+                       {"mechanical_vignetting", 0.0}};
         Image out = runLens(grid, "grid", params).at("out");
         double worst = 0.0;
         int measured = 0;
@@ -90,9 +96,10 @@ TEST_F(Lens, ChromaticAberrationScalesRedAndBlueRadially) {
     const double red = 1.01, blue = 0.985;
     Image img = blank(kW, kH);
     std::vector<glm::dvec2> dots = {{40.3, 30.2}, {280.6, 150.1}, {100.0, 160.0}, {250.0, 40.0}, {160.0, 90.0}};
-    for (glm::dvec2 p : dots) addDot(img, p.x, p.y, 1.5, glm::vec3(1.0f));
-    json params = {{"distortion", false}, {"chromatic_aberration", true}, {"ca_red", red}, {"ca_blue", blue},
-                   {"vignetting", false}, {"mechanical_vignetting", 0.0}};
+    for (glm::dvec2 p : dots)
+        addDot(img, p.x, p.y, 1.5, glm::vec3(1.0f));
+    json params = {{"distortion", false}, {"chromatic_aberration", true}, {"ca_red", red},
+                   {"ca_blue", blue},     {"vignetting", false},          {"mechanical_vignetting", 0.0}};
     Image out = runLens(img, "ca", params).at("out");
     double worst = 0.0, largest = 0.0;
     for (glm::dvec2 p : dots) {
@@ -126,8 +133,8 @@ double pupilInsideOpening(double pupil, double d) {
 TEST_F(Lens, VignettingFollowsCos4AndThePupilClippedByTheBarrel) {
     const double focal = 20.0, sensor = 36.0, hd = 0.5 * std::hypot(kW, kH);
     Image white = blank(kW, kH, 1.0f);
-    json natural = {{"distortion", false}, {"chromatic_aberration", false}, {"vignetting", true},
-                    {"focal_length", focal}, {"sensor_width", sensor}, {"mechanical_vignetting", 0.0}};
+    json natural = {{"distortion", false},   {"chromatic_aberration", false}, {"vignetting", true},
+                    {"focal_length", focal}, {"sensor_width", sensor},        {"mechanical_vignetting", 0.0}};
     Image out = runLens(white, "white", natural).at("out");
     double worst = 0.0, corner = 1.0;
     for (int y = 0; y < kH; ++y)
@@ -135,7 +142,8 @@ TEST_F(Lens, VignettingFollowsCos4AndThePupilClippedByTheBarrel) {
             double r = std::hypot(x + 0.5 - kW / 2.0, y + 0.5 - kH / 2.0) * sensor / kW;
             double expected = std::pow(std::cos(std::atan(r / focal)), 4.0);
             corner = std::min(corner, expected);
-            for (int c = 0; c < 3; ++c) worst = std::max(worst, std::fabs(out.at(x, y)[c] - expected));
+            for (int c = 0; c < 3; ++c)
+                worst = std::max(worst, std::fabs(out.at(x, y)[c] - expected));
         }
     std::printf("natural vignetting (f %.0f mm): corner %.3f, worst error %.2e\n", focal, corner, worst);
     EXPECT_LT(corner, 0.5);
@@ -143,15 +151,16 @@ TEST_F(Lens, VignettingFollowsCos4AndThePupilClippedByTheBarrel) {
 
     // The same from a camera state (focal length 20 mm, 36 mm sensor, no residual distortion or CA, no mechanical
     // vignetting): it replaces the params, whose defaults (barrel distortion, CA, 35 mm, mechanical 0.6) would differ.
-    json fromState = {{"in", loadNode(writeInput(white, "white_state"))},
-                      {"camera", {{"type", "test.camera_state"}, {"params", {{"focal_length", focal}}}}},
-                      {"lens", {{"type", "post.lens"}, {"in", {{"color", "in.color"}, {"camera_state", "camera.state"}}}}}};
+    json fromState = {
+        {"in", loadNode(writeInput(white, "white_state"))},
+        {"camera", {{"type", "test.camera_state"}, {"params", {{"focal_length", focal}}}}},
+        {"lens", {{"type", "post.lens"}, {"in", {{"color", "in.color"}, {"camera_state", "camera.state"}}}}}};
     EXPECT_LT(maxAbsDiff(runGraph(graph(fromState, {{"out", "lens.color"}}, kW, kH)).at("out"), out), 1e-6);
 
     // Mechanical: wide open (pupil 1) and one stop down (pupil 1/sqrt 2), the opening offset 0.8 radii at the corner.
     for (double fNumber : {2.0, 2.0 * std::sqrt(2.0)}) {
-        json mech = {{"distortion", false}, {"chromatic_aberration", false}, {"vignetting", false},
-                     {"mechanical_vignetting", 0.8}, {"f_number", fNumber}, {"wide_open", 2.0}};
+        json mech = {{"distortion", false},          {"chromatic_aberration", false}, {"vignetting", false},
+                     {"mechanical_vignetting", 0.8}, {"f_number", fNumber},           {"wide_open", 2.0}};
         Image m = runLens(white, "white", mech).at("out");
         double err = 0.0, darkest = 1.0;
         for (int y = 0; y < kH; y += 6)
@@ -172,12 +181,13 @@ TEST_F(Lens, VignettingFollowsCos4AndThePupilClippedByTheBarrel) {
 
 constexpr int kFW = 640, kFH = 360, kFactor = 4;
 // shaders/post/flare_ghosts.comp's tints (documented there).
-const glm::dvec3 kTints[8] = {{1.0, 0.75, 0.5}, {0.5, 0.8, 1.0},  {0.6, 1.0, 0.6},  {1.0, 0.6, 0.9},
+const glm::dvec3 kTints[8] = {{1.0, 0.75, 0.5}, {0.5, 0.8, 1.0},   {0.6, 1.0, 0.6},  {1.0, 0.6, 0.9},
                               {0.9, 0.9, 0.6},  {0.55, 0.65, 1.0}, {1.0, 0.85, 0.7}, {0.7, 1.0, 0.9}};
 
 double channelSum(const Image& img, int c) {
     double s = 0.0;
-    for (int i = 0; i < img.width * img.height; ++i) s += img.pixels[4 * i + c];
+    for (int i = 0; i < img.width * img.height; ++i)
+        s += img.pixels[4 * i + c];
     return s;
 }
 
@@ -189,12 +199,16 @@ TEST_F(Lens, FlareGhostsLieOnTheLineThroughTheCentreWithTheirEnergy) {
     addDot(img, q.x, q.y, 8.0, glm::vec3(60.0f, 50.0f, 40.0f));
     const double scales[4] = {-0.3, -0.8, 0.55, -1.3};
     const double ghostIntensity = 0.05, threshold = 1.0;
-    json params = {{"threshold", threshold}, {"downsample", kFactor}, {"ghost_intensity", ghostIntensity},
-                   {"ghost_scales", {scales[0], scales[1], scales[2], scales[3]}}, {"ghost_scales2", {0, 0, 0, 0}},
+    json params = {{"threshold", threshold},
+                   {"downsample", kFactor},
+                   {"ghost_intensity", ghostIntensity},
+                   {"ghost_scales", {scales[0], scales[1], scales[2], scales[3]}},
+                   {"ghost_scales2", {0, 0, 0, 0}},
                    {"halo_intensity", 0.0}};
     json nodes = {{"in", loadNode(writeInput(img, "flare_dot"))},
                   {"flare", {{"type", "post.flare"}, {"params", params}, {"in", {{"color", "in.color"}}}}}};
-    auto out = runGraph(graph(nodes, {{"out", "flare.color"}, {"flare", "flare.flare"}, {"bright", "flare.bright"}}, kFW, kFH));
+    auto out = runGraph(
+        graph(nodes, {{"out", "flare.color"}, {"flare", "flare.flare"}, {"bright", "flare.bright"}}, kFW, kFH));
 
     // The bright pass against one computed here.
     const Image& bright = out.at("bright");
@@ -211,7 +225,8 @@ TEST_F(Lens, FlareGhostsLieOnTheLineThroughTheCentreWithTheirEnergy) {
                 }
             sum /= kFactor * kFactor;
             energy += sum;
-            for (int c = 0; c < 3; ++c) brightErr = std::max(brightErr, std::fabs(bright.at(x, y)[c] - sum[c]) / (1.0 + sum[c]));
+            for (int c = 0; c < 3; ++c)
+                brightErr = std::max(brightErr, std::fabs(bright.at(x, y)[c] - sum[c]) / (1.0 + sum[c]));
         }
     std::printf("flare bright pass: energy (%.1f %.1f %.1f), worst relative error %.2e\n", energy.r, energy.g, energy.b,
                 brightErr);
@@ -239,13 +254,16 @@ TEST_F(Lens, FlareGhostsLieOnTheLineThroughTheCentreWithTheirEnergy) {
                     i, scales[i], b.x, b.y, g.x, g.y, off, along, e.r / expected.r, e.g / expected.g, e.b / expected.b);
         EXPECT_LT(off, 0.25);
         EXPECT_NEAR(along, scales[i], 0.25 / glm::length(dLow));
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(e[c] / expected[c], 1.0, 0.03) << "ghost " << i << " channel " << c;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(e[c] / expected[c], 1.0, 0.03) << "ghost " << i << " channel " << c;
     }
     // Nothing but the ghosts: the whole flare image holds their energy.
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(channelSum(flare, c) / ghostTotal[c], 1.0, 0.01);
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(channelSum(flare, c) / ghostTotal[c], 1.0, 0.01);
     // The composite adds the flare, upsampled: downsample^2 its energy.
     Image diff = out.at("out");
-    for (size_t i = 0; i < diff.pixels.size(); ++i) diff.pixels[i] -= img.pixels[i];
+    for (size_t i = 0; i < diff.pixels.size(); ++i)
+        diff.pixels[i] -= img.pixels[i];
     for (int c = 0; c < 3; ++c)
         EXPECT_NEAR(channelSum(diff, c) / (kFactor * kFactor * channelSum(flare, c)), 1.0, 0.01) << "channel " << c;
 }
@@ -256,8 +274,11 @@ TEST_F(Lens, FlareRingGhostSurroundsTheMirroredSource) {
     Image img = blank(kFW, kFH);
     addDot(img, q.x, q.y, 4.0, glm::vec3(80.0f));
     const double radius = 0.3, halo = 0.02;
-    json params = {{"downsample", kFactor}, {"ghost_intensity", 0.0}, {"halo_intensity", halo},
-                   {"halo_radius", radius}, {"halo_taps", 96}};
+    json params = {{"downsample", kFactor},
+                   {"ghost_intensity", 0.0},
+                   {"halo_intensity", halo},
+                   {"halo_radius", radius},
+                   {"halo_taps", 96}};
     json nodes = {{"in", loadNode(writeInput(img, "halo_dot"))},
                   {"flare", {{"type", "post.flare"}, {"params", params}, {"in", {{"color", "in.color"}}}}}};
     auto out = runGraph(graph(nodes, {{"flare", "flare.flare"}, {"bright", "flare.bright"}}, kFW, kFH));
@@ -291,8 +312,8 @@ std::map<std::string, Image> runStreaks(const Image& img, json params, json stat
         nodes["camera"] = {{"type", "test.camera_state"}, {"params", state}};
         nodes["streaks"]["in"]["camera_state"] = "camera.state";
     }
-    return runGraph(graph(nodes, {{"out", "streaks.color"}, {"streaks", "streaks.streaks"}, {"bright", "streaks.bright"}},
-                          kFW, kFH));
+    return runGraph(graph(
+        nodes, {{"out", "streaks.color"}, {"streaks", "streaks.streaks"}, {"bright", "streaks.bright"}}, kFW, kFH));
 }
 
 double bilinear(const Image& img, double x, double y, int c) {
@@ -335,7 +356,8 @@ TEST_F(Lens, StreakCountFollowsTheBladesAndLengthTheFNumber) {
     // downsample^2 times it.
     const double streakEnergy = channelSum(run6.at("streaks"), 1), brightEnergy = channelSum(run6.at("bright"), 1);
     Image added = run6.at("out");
-    for (size_t i = 0; i < added.pixels.size(); ++i) added.pixels[i] -= img.pixels[i];
+    for (size_t i = 0; i < added.pixels.size(); ++i)
+        added.pixels[i] -= img.pixels[i];
     std::printf("streak energy / (strength x bright energy) %.4f; composite / (16 x streaks) %.4f\n",
                 streakEnergy / (0.2 * brightEnergy), channelSum(added, 1) / (kFactor * kFactor * streakEnergy));
     EXPECT_NEAR(streakEnergy / (0.2 * brightEnergy), 1.0, 0.01);
@@ -349,7 +371,8 @@ TEST_F(Lens, StreakCountFollowsTheBladesAndLengthTheFNumber) {
     EXPECT_EQ(spikes7, 14);
     // Wide open the aperture is round: no streaks.
     double wideOpen = channelSum(
-        runStreaks(img, base, {{"blades", 7}, {"f_number", 1.8}, {"wide_open", 1.8}, {"exposure", 1.0}}).at("streaks"), 1);
+        runStreaks(img, base, {{"blades", 7}, {"f_number", 1.8}, {"wide_open", 1.8}, {"exposure", 1.0}}).at("streaks"),
+        1);
     EXPECT_EQ(wideOpen, 0.0);
 
     // Extent of a spike: its intensity-weighted mean distance from the source along it (rotation 0: along +x).

@@ -88,7 +88,9 @@ RampError rampError(const Image& out, double length) {
 
 // 15 taps over a ramp put a tap every L/15 pixels, each rounded to a pixel: the staircase departs from the ramp by
 // at most one tap's share (1/15); on average its steps straddle the ramp, so the mean error stays far below that.
-double rampBound(double) { return 1.0 / 15.0 + 1e-3; }
+double rampBound(double) {
+    return 1.0 / 15.0 + 1e-3;
+}
 constexpr double kMeanBound = 0.004;
 
 TEST_F(MotionBlur, ConstantVelocityTurnsAStepIntoALinearRamp) {
@@ -105,8 +107,16 @@ TEST_F(MotionBlur, ConstantVelocityTurnsAStepIntoALinearRamp) {
         {"scale 0.5", {{"scale", 0.5}}, false, 0.0, 6.0},
         // Half-lengths are clamped to the tile size: 4 px tiles make any ramp 8 px long.
         {"scale 1, clamped by 4 px tiles", {{"scale", 1.0}, {"tile_size", 4}}, false, 0.0, 8.0},
-        {"shutter param 1/32 s at 24 fps", {{"shutter_driven", true}, {"shutter", 1.0 / 32.0}, {"fps", 24.0}}, false, 0.0, 9.0},
-        {"camera state 1/24 s at 24 fps", {{"shutter_driven", true}, {"fps", 24.0}, {"shutter", 1.0}}, true, 1.0 / 24.0, 12.0},
+        {"shutter param 1/32 s at 24 fps",
+         {{"shutter_driven", true}, {"shutter", 1.0 / 32.0}, {"fps", 24.0}},
+         false,
+         0.0,
+         9.0},
+        {"camera state 1/24 s at 24 fps",
+         {{"shutter_driven", true}, {"fps", 24.0}, {"shutter", 1.0}},
+         true,
+         1.0 / 24.0,
+         12.0},
     };
     for (const Case& c : cases) {
         json params = exact;
@@ -178,23 +188,28 @@ std::filesystem::path movingCardsScene() {
     const uint32_t white = b.material("white", glm::vec3(1.0f), 0.0f, 0.5f);
     auto colored = [](std::vector<Tri> tris, glm::vec3 c) {
         for (Tri& t : tris)
-            for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->color = glm::vec4(c, 1.0f);
+            for (scene::Vertex* v : {&t.a, &t.b, &t.c})
+                v->color = glm::vec4(c, 1.0f);
         return tris;
     };
     std::vector<Tri> wall;
     for (int i = -8; i < 8; ++i)
         for (int j = -5; j < 5; ++j) {
             std::vector<Tri> q;
-            addQuad(q, glm::vec3(i + 0.5f, j + 0.5f, -10.0f), glm::vec3(0.5f, 0, 0), glm::vec3(0, 0.5f, 0), glm::vec3(0, 0, 1));
+            addQuad(q, glm::vec3(i + 0.5f, j + 0.5f, -10.0f), glm::vec3(0.5f, 0, 0), glm::vec3(0, 0.5f, 0),
+                    glm::vec3(0, 0, 1));
             glm::vec3 c = (i + j) % 2 == 0 ? glm::vec3(0.2f, 0.25f, 0.3f) : glm::vec3(0.45f, 0.4f, 0.35f);
-            for (const Tri& t : colored(q, c)) wall.push_back(t);
+            for (const Tri& t : colored(q, c))
+                wall.push_back(t);
         }
     b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, white)));
     std::vector<Tri> card;
     for (int k = 0; k < 8; ++k) {
         std::vector<Tri> q;
-        addQuad(q, glm::vec3(-1.05f + 0.3f * k, 0.0f, 0.0f), glm::vec3(0.15f, 0, 0), glm::vec3(0, 0.6f, 0), glm::vec3(0, 0, 1));
-        for (const Tri& t : colored(q, k % 2 ? glm::vec3(0.95f, 0.55f, 0.1f) : glm::vec3(0.1f, 0.3f, 0.9f))) card.push_back(t);
+        addQuad(q, glm::vec3(-1.05f + 0.3f * k, 0.0f, 0.0f), glm::vec3(0.15f, 0, 0), glm::vec3(0, 0.6f, 0),
+                glm::vec3(0, 0, 1));
+        for (const Tri& t : colored(q, k % 2 ? glm::vec3(0.95f, 0.55f, 0.1f) : glm::vec3(0.1f, 0.3f, 0.9f)))
+            card.push_back(t);
     }
     b.node("card", static_cast<int32_t>(b.mesh("card", card, white)), glm::vec3(0.0f, 0.0f, -4.0f));
     const uint32_t cardNode = static_cast<uint32_t>(b.s.nodes.size() - 1);
@@ -231,18 +246,21 @@ TEST_F(MotionBlur, MatchesSubFrameAccumulation) {
     auto reference = runGraph(graph(ref, {{"ref", "accumulate.color"}}, kSW, kSH, kSubFrames)).at("ref");
 
     json blur = sceneNodes(glb, kFps, kT);
-    blur["blur"] = {{"type", "post.motion_blur"},
-                    {"params", {{"scale", scale}}},
-                    {"in", {{"color", "gbuffer.base_color"}, {"velocity", "gbuffer.velocity"}, {"depth", "gbuffer.normal"}}}};
-    auto out = runGraph(graph(blur, {{"blur", "blur.color"}, {"sharp", "gbuffer.base_color"}, {"velocity", "gbuffer.velocity"}},
-                              kSW, kSH));
+    blur["blur"] = {
+        {"type", "post.motion_blur"},
+        {"params", {{"scale", scale}}},
+        {"in", {{"color", "gbuffer.base_color"}, {"velocity", "gbuffer.velocity"}, {"depth", "gbuffer.normal"}}}};
+    auto out = runGraph(graph(
+        blur, {{"blur", "blur.color"}, {"sharp", "gbuffer.base_color"}, {"velocity", "gbuffer.velocity"}}, kSW, kSH));
     double maxSpeed = 0.0;
     for (int i = 0; i < kSW * kSH; ++i)
-        maxSpeed = std::max(maxSpeed, double(std::hypot(out.at("velocity").pixels[4 * i], out.at("velocity").pixels[4 * i + 1])));
+        maxSpeed = std::max(maxSpeed,
+                            double(std::hypot(out.at("velocity").pixels[4 * i], out.at("velocity").pixels[4 * i + 1])));
     const double flipBlur = compare::ldrFlip(reference, out.at("blur")).mean;
     const double flipSharp = compare::ldrFlip(reference, out.at("sharp")).mean;
     std::printf("moving cards: max speed %.1f px/frame; LDR-FLIP mean vs the 16-sub-frame accumulation: motion blur "
-                "%.4f, no blur %.4f\n", maxSpeed, flipBlur, flipSharp);
+                "%.4f, no blur %.4f\n",
+                maxSpeed, flipBlur, flipSharp);
     if (const char* dir = std::getenv("VITRINE_TEST_IMAGES")) {
         // Side by side: reference, motion blur, no blur (alpha is the G-buffer's metallic: made opaque).
         Image strip(3 * kSW, kSH);
@@ -250,7 +268,8 @@ TEST_F(MotionBlur, MatchesSubFrameAccumulation) {
         for (int k = 0; k < 3; ++k)
             for (int y = 0; y < kSH; ++y)
                 for (int x = 0; x < kSW; ++x) {
-                    for (int c = 0; c < 3; ++c) strip.at(k * kSW + x, y)[c] = parts[k]->at(x, y)[c];
+                    for (int c = 0; c < 3; ++c)
+                        strip.at(k * kSW + x, y)[c] = parts[k]->at(x, y)[c];
                     strip.at(k * kSW + x, y)[3] = 1.0f;
                 }
         writePng(std::filesystem::path(dir) / "motion_blur_ref_blur_sharp.png", strip);
