@@ -1,0 +1,130 @@
+// post.streaks: star streaks (diffraction spikes) of bright sources, from the aperture's blade count and f-number.
+#include "shaders/post/streaks.h"
+#include "core/graph/node.hpp"
+#include "core/graph/registry.hpp"
+#include "nodes/camera/camera_state.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace vitrine {
+namespace {
+
+NodeSchema schema() {
+    NodeSchema s;
+    s.type = "post.streaks";
+    s.doc = "Star streaks on a bright pass downsampled by `downsample` (light above `threshold` after exposure): an "
+            "aperture of n straight blades diffracts light into n spikes when n is even (opposite edges share a "
+            "direction) and 2n when n is odd. Each spike fades as exp(-3 t / L); L = length x frame height x N / 8 and "
+            "the energy strength x N / 8 (N the f-number): stopping down lengthens the star without changing its "
+            "brightness next to the source. With camera_state: blades, rotation, f-number and exposure from it, and "
+            "no star wide open (the blades are out of the way), full one stop down.";
+    s.inputs = {
+        {"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"},
+        {"camera_state",
+         PortKind::Buffer,
+         {},
+         true,
+         Usage::Sampled,
+         "camera.physical's state: replaces blades, rotation, f_number and exposure"},
+    };
+    OutputPort color;
+    color.name = "color";
+    color.formatFrom = "color";
+    color.size = SizeRule::ofInput("color");
+    color.doc = "Colour plus streaks";
+    OutputPort bright;
+    bright.name = "bright";
+    bright.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+    bright.usage = Usage::StorageReadWrite;
+    bright.doc = "The bright pass (HDR), downsampled";
+    OutputPort streaks = bright;
+    streaks.name = "streaks";
+    streaks.doc = "The streaks alone (HDR), at the bright pass's size";
+    s.outputs = {color, bright, streaks};
+    s.params = {
+        {"exposure",
+         ParamType::Float,
+         0.0,
+         -24.0,
+         24.0,
+         {},
+         "Exposure in stops (as post.tonemap's) that makes the threshold display-referred; camera_state replaces it"},
+        {"threshold", ParamType::Float, 1.0, 0.0, 1e4, {}, "Exposed luminance above which light streaks"},
+        {"downsample", ParamType::Int, 4, 1.0, 16.0, {}, "Bright-pass downsampling factor"},
+        {"blades", ParamType::Int, 6, 0.0, 32.0, {}, "Aperture blades (0: a round aperture, no streaks)"},
+        {"rotation", ParamType::Float, 0.0, -360.0, 360.0, {}, "Angle of the first spike in degrees"},
+        {"f_number", ParamType::Float, 8.0, 0.5, 64.0, {}, "Aperture: spike length and energy grow with it"},
+        {"length",
+         ParamType::Float,
+         0.08,
+         0.0,
+         2.0,
+         {},
+         "3 e-folding lengths of a spike at f/8, fraction of the frame height"},
+        {"strength", ParamType::Float, 0.3, 0.0, 10.0, {}, "Streak energy / the source's bright energy at f/8"},
+        {"max_samples", ParamType::Int, 48, 1.0, 256.0, {}, "Most taps per spike (one per bright-pass pixel up to it)"},
+    };
+    return s;
+}
+
+class Streaks final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        const ImageDesc& color = ctx.input("color");
+        mFactor = static_cast<uint32_t>(ctx.params().getInt("downsample"));
+        for (const char* port : {"bright", "streaks"}) {
+            ImageDesc& d = ctx.output(port);
+            d.width = (color.width + mFactor - 1) / mFactor;
+            d.height = (color.height + mFactor - 1) / mFactor;
+        }
+        mBright = ctx.computePipeline("post/streaks_bright.comp");
+        mSpikes = ctx.computePipeline("post/streaks_spikes.comp");
+        mComposite = ctx.computePipeline("post/streaks.comp");
+    }
+    void execute(ExecuteContext& ctx) override {
+        const auto& p = ctx.params();
+        const ImageDesc& low = ctx.output("streaks").desc();
+        const ImageDesc& out = ctx.output("color").desc();
+        int blades = p.getInt("blades");
+        float rotation = p.getFloat("rotation") * static_cast<float>(std::numbers::pi / 180.0);
+        float fNumber = p.getFloat("f_number");
+        float exposure = std::exp2(p.getFloat("exposure"));
+        float gate = 1.0f;
+        if (ctx.hasInput("camera_state")) {
+            const CameraState& s = ctx.objectAs<CameraStateObject>("camera_state").state;
+            blades = s.bladeCount;
+            rotation = s.bladeRotation;
+            fNumber = s.fNumber;
+            exposure = s.exposure;
+            // Wide open the blades are out of the light path: a round pupil, no spikes; straight edges by a stop down.
+            gate = std::clamp(std::log2(fNumber / std::max(s.wideOpenFNumber, 1e-3f)), 0.0f, 1.0f);
+        }
+        gpu_types::StreaksPush push{};
+        push.exposure = exposure;
+        push.threshold = p.getFloat("threshold");
+        push.factor = static_cast<int>(mFactor);
+        push.count = blades <= 0 ? 0u : static_cast<uint32_t>(blades % 2 == 0 ? blades : 2 * blades);
+        push.rotation = rotation;
+        push.spikeLength =
+            p.getFloat("length") * static_cast<float>(out.height) / static_cast<float>(mFactor) * fNumber / 8.0f;
+        push.strength = p.getFloat("strength") * fNumber / 8.0f * gate;
+        push.samples = static_cast<uint32_t>(
+            std::clamp(static_cast<int>(std::ceil(push.spikeLength)), 1, p.getInt("max_samples")));
+        ctx.dispatch(mBright, push, low.width, low.height);
+        ctx.computeBarrier();
+        ctx.dispatch(mSpikes, push, low.width, low.height);
+        ctx.computeBarrier();
+        ctx.dispatch(mComposite, push, out.width, out.height);
+    }
+
+private:
+    uint32_t mFactor = 4;
+    PipelineId mBright = 0, mSpikes = 0, mComposite = 0;
+};
+
+const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Streaks>(); });
+
+} // namespace
+} // namespace vitrine
