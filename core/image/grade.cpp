@@ -56,7 +56,8 @@ Grade::Grade(const ColorConfig& config, const GradeSettings& s) : mImpl(std::mak
     if (!s.lut.empty()) {
         if (!std::filesystem::is_regular_file(s.lut)) throw UserError("lut: no LUT file " + s.lut.string());
         auto file = OCIO::FileTransform::Create();
-        file->setSrc(s.lut.string().c_str());
+        // Absolute: OCIO resolves a relative path against the config's search path, not the working directory.
+        file->setSrc(std::filesystem::absolute(s.lut).string().c_str());
         file->setInterpolation(s.lutTetrahedral ? OCIO::INTERP_TETRAHEDRAL : OCIO::INTERP_LINEAR);
         file->setDirection(OCIO::TRANSFORM_DIR_FORWARD);
         group->appendTransform(file);

@@ -3,6 +3,7 @@
 // along a program line (or takes them from params in manual mode) and describes the lens at that setting from a
 // data/lenses/ file. Its `state` port carries the result (nodes/camera/camera_state.hpp).
 #include "core/base/error.hpp"
+#include "core/base/log.hpp"
 #include "core/gpu/buffer_set.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/vk_check.hpp"
@@ -75,6 +76,8 @@ NodeSchema schema() {
         {"fps", ParamType::Float, 24.0, 1.0, 1000.0, {}, "Frames per second, for the adaptation (the scene's fps)"},
         {"initial_ev100", ParamType::Float, 12.0, -10.0, 30.0, {},
          "Scene EV100 assumed until the first metering arrives (frame 0 of an @prev input), or always without `color`"},
+        {"log_settings", ParamType::Bool, false, {}, {}, {},
+         "Print the metered EV and the chosen settings every frame (info log)"},
         {"readback", ParamType::Enum, "same_frame", {}, {}, {"same_frame", "next_frame"},
          "same_frame: meter, wait for the GPU and use the result in this frame (the graph runs one frame in flight, so "
          "this costs one small submission); next_frame: use it one frame later, no wait"},
@@ -156,6 +159,16 @@ public:
         }
         fillState(p, *mAdapted);
         mOut->frame = ctx.frameIndex();
+        if (p.getBool("log_settings")) {
+            const CameraState& st = mOut->state;
+            char line[256];
+            std::snprintf(line, sizeof line,
+                          "camera.physical frame %u: metered EV100 %.2f, exposed EV100 %.2f (%.2f stops): f/%.1f, "
+                          "shutter %.4g s, ISO %.0f, %.1f mm",
+                          ctx.frameIndex(), st.meteredEv100, st.ev100, std::log2(st.exposure), st.fNumber,
+                          st.shutterSeconds, st.iso, st.focalLengthMm);
+            logInfo(line);
+        }
     }
 
     void releaseGpu() override {

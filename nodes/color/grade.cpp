@@ -71,9 +71,12 @@ public:
         try {
             shader = vitrine::Grade(ColorConfig::builtin(), g).shader("OCIOGrade");
         } catch (const UserError& e) {
+            // core/image/grade.cpp starts its messages with the setting they are about.
             const std::string what = e.what();
-            const std::string param = what.rfind("source", 0) == 0 ? "source" : what.rfind("working", 0) == 0 ? "working" : "lut";
-            ctx.failParam(param, what);
+            for (const char* param : {"source", "working", "lut"})
+                if (what.rfind(std::string(param) + ": ", 0) == 0)
+                    ctx.failParam(param, what.substr(std::string(param).size() + 2));
+            ctx.failParam("lut", what);
         }
         // OCIO's GLSL 4.0 declares its LUT samplers without bindings; Vulkan wants them: set 1, binding i.
         for (size_t i = 0; i < shader.luts.size(); ++i) {

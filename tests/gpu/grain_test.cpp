@@ -145,7 +145,7 @@ TEST_F(Grain, GrainSizeFollowsTheLatticeModelAndIso) {
         const double s = px * std::pow(iso / 100.0, 0.25); // 3 and 6 pixels
         for (int lag : {int(s), int(2 * s)}) {
             const double measured = autocorrelation(frames[0], lag), model = modelAutocorrelation(s, lag);
-            EXPECT_NEAR(measured, model, 0.04) << "ISO " << iso << " lag " << lag;
+            EXPECT_NEAR(measured, model, 0.015) << "ISO " << iso << " lag " << lag;
             std::printf("ISO %.0f spacing %.1f px, lag %d: autocorrelation %.4f, model %.4f\n", iso, s, lag, measured, model);
         }
         EXPECT_LT(autocorrelation(frames[0], int(3 * s)), 0.05); // beyond the B-spline's reach
