@@ -16,6 +16,10 @@
 #include <regex>
 #include <sstream>
 
+#ifndef VITRINE_DATA_DIR
+#error "VITRINE_DATA_DIR must be defined by the build (see nodes/CMakeLists.txt)"
+#endif
+
 namespace vitrine {
 namespace {
 
@@ -44,7 +48,9 @@ NodeSchema schema() {
         {"power", ParamType::Vec3, {1.0, 1.0, 1.0}, 0.01, 10.0, {}, "ASC CDL power per channel"},
         {"saturation", ParamType::Float, 1.0, 0.0, 4.0, {}, "ASC CDL saturation (Rec.709 luma weights)"},
         {"cdl_clamp", ParamType::Bool, true, {}, {}, {}, "Clamp the CDL to [0, 1] as ASC CDL v1.2 does"},
-        {"lut", ParamType::Path, "", {}, {}, {}, "LUT file OCIO can read (.cube, .3dl, .csp, ...), relative to the graph; empty: none"},
+        {"lut", ParamType::Path, "", {}, {}, {},
+         "LUT file OCIO can read (.cube, .3dl, .csp, ...): a bare file name is one of data/luts/ (warm_film.cube), a path "
+         "is relative to the graph; empty: none"},
         {"lut_interpolation", ParamType::Enum, "tetrahedral", {}, {}, {"tetrahedral", "linear"}, "3D LUT interpolation"},
     };
     return s;
@@ -65,7 +71,12 @@ public:
         g.power = p.getVec3("power");
         g.saturation = p.getFloat("saturation");
         g.cdlClamp = p.getBool("cdl_clamp");
-        if (!p.getString("lut").empty()) g.lut = ctx.resolvePath(p.getString("lut"));
+        // A bare file name is one of data/luts/ (so that variants in other folders can share it); a path is relative to
+        // the graph file.
+        const std::string lut = p.getString("lut");
+        if (!lut.empty())
+            g.lut = lut.find('/') == std::string::npos ? std::filesystem::path(VITRINE_DATA_DIR) / "luts" / lut
+                                                       : ctx.resolvePath(lut);
         g.lutTetrahedral = p.getString("lut_interpolation") == "tetrahedral";
         GradeShader shader;
         try {
