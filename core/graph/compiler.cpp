@@ -66,8 +66,8 @@ public:
         mPass.pipelines.push_back({shader, defines, {}, nodeSets});
         return static_cast<PipelineId>(mPass.pipelines.size() - 1);
     }
-    PipelineId computePipelineSource(const std::string& name, const std::string& source) override {
-        mPass.pipelines.push_back({name, {}, source});
+    PipelineId computePipelineSource(const std::string& name, const std::string& source, uint32_t nodeSets) override {
+        mPass.pipelines.push_back({name, {}, source, nodeSets});
         return static_cast<PipelineId>(mPass.pipelines.size() - 1);
     }
     void setObject(const std::string& port, std::shared_ptr<PortObject> object) override {

@@ -73,8 +73,10 @@ public:
     // bound from the ports.
     virtual PipelineId computePipeline(const std::string& shaderPath, const ShaderDefines& defines = {},
                                        uint32_t nodeSets = 0) = 0;
-    // A compute pipeline from GLSL the node generated itself; `name` appears in errors.
-    virtual PipelineId computePipelineSource(const std::string& name, const std::string& source) = 0;
+    // A compute pipeline from GLSL the node generated itself; `name` appears in errors. nodeSets as for
+    // computePipeline (color.grade binds OCIO's LUT textures in set 1).
+    virtual PipelineId computePipelineSource(const std::string& name, const std::string& source,
+                                             uint32_t nodeSets = 0) = 0;
     // Object ports (scene/camera/buffer kinds). setObject() is for outputs; object() for inputs.
     virtual void setObject(const std::string& port, std::shared_ptr<PortObject> object) = 0;
     virtual std::shared_ptr<PortObject> object(const std::string& port) const = 0;

@@ -43,6 +43,10 @@ struct CameraState {
     // Mechanical vignetting strength of this lens at this aperture (0: none); natural cos⁴ falloff follows
     // from the focal length and sensor.
     float mechanicalVignetting = 0.0f;
+    // Appended by camera.physical: the scene's EV100 as metered and eye-adapted, before exposure compensation
+    // (ev100 above is what the chosen settings expose for; the two differ by the compensation, by manual settings,
+    // or where the program ran out of aperture/shutter/ISO range).
+    float meteredEv100 = 13.0f;
 };
 
 class CameraStateObject final : public PortObject {

@@ -1,6 +1,7 @@
 // post.tonemap: exposure and a tone curve, applied to the finished HDR image.
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
+#include "nodes/camera/camera_state.hpp"
 #include "shaders/post/tonemap.h"
 
 #include <cmath>
@@ -12,7 +13,9 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "post.tonemap";
     s.doc = "Exposure (EV) then a tone curve: ACES fit for display, or an exactly invertible Reinhard curve.";
-    s.inputs = {{"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"}};
+    s.inputs = {{"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"},
+                {"camera_state", PortKind::Buffer, {}, true, Usage::Sampled,
+                 "camera.physical's state: when connected, its exposure replaces the `exposure` param"}};
     OutputPort out;
     out.name = "color";
     out.formatFrom = "color";
@@ -20,7 +23,8 @@ NodeSchema schema() {
     out.doc = "Tone-mapped linear colour in [0, 1] (or linear HDR when inverse)";
     s.outputs = {out};
     s.params = {
-        {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {}, "Exposure in stops: colour is scaled by 2^exposure"},
+        {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {},
+         "Exposure in stops: colour is scaled by 2^exposure (ignored when camera_state is connected)"},
         {"operator", ParamType::Enum, "aces_fit", {}, {}, {"linear", "reinhard", "reinhard_max", "aces_fit"},
          "Tone curve; reinhard and reinhard_max are exactly invertible"},
         {"inverse", ParamType::Bool, false, {}, {}, {},
@@ -35,12 +39,13 @@ public:
         const auto& p = ctx.params();
         if (p.getBool("inverse") && p.getString("operator") == "aces_fit")
             ctx.failParam("inverse", "aces_fit is clamped and not invertible; use linear, reinhard or reinhard_max");
+        if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
         mPipeline = ctx.computePipeline("post/tonemap.comp");
     }
     void execute(ExecuteContext& ctx) override {
         const auto& p = ctx.params();
         gpu_types::TonemapPush push{};
-        push.exposureScale = std::exp2(p.getFloat("exposure"));
+        push.exposureScale = mCamera ? mCamera->state.exposure : std::exp2(p.getFloat("exposure"));
         push.op = static_cast<uint32_t>(p.getEnumIndex("operator"));
         push.inverse = p.getBool("inverse") ? 1u : 0u;
         const ImageDesc& out = ctx.output("color").desc();
@@ -49,6 +54,7 @@ public:
 
 private:
     PipelineId mPipeline = 0;
+    std::shared_ptr<CameraStateObject> mCamera;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Tonemap>(); });
