@@ -9,8 +9,8 @@
 // shaders/post/dof_layers.glsl), layer i blurred with the CoC at its centre. At full resolution (no shrink buffer, so no shrink-buffer
 // artefacts (Kawase 2009) where the CoC jumps: every tap reads its own pixel's colour and CoC), each pixel
 // gathers, for every layer present in the 16x16 tiles around it, the taps of an aperture-shaped kernel of the
-// layer's CoC (up to a radius of 4.5 pixels every pixel of the footprint weighted by its coverage; beyond, 64 taps
-// on a Vogel spiral over the disc pushed out to the aperture's boundary, each weighted by the boundary's square so
+// layer's CoC (up to a radius of 2.5 pixels every pixel of the footprint weighted by its coverage; beyond, 24-64
+// taps, one per 2 pixels of the kernel, on a Vogel spiral over the disc pushed out to the aperture's boundary, each weighted by the boundary's square so
 // the density is uniform over the shape) that belong to that layer: their mean colour with the
 // fraction of the kernel they cover as alpha. Layers are composited far to near (nearer layers cover farther
 // ones, so a sharp object is never smeared over its blurred background and a blurred near object spreads over
@@ -43,11 +43,18 @@ void main() {
     ivec2 tiles = imageSize(out_tiles);
     int reach = int(ceil((0.5 * span + 1.0) / float(DOF_TILE)));
     ivec2 tile = p / DOF_TILE;
+    // The layers this pixel needs: those present in a tile within their own kernel's reach.
     uint mask = 0u;
     for (int ty = -reach; ty <= reach; ++ty)
         for (int tx = -reach; tx <= reach; ++tx) {
             ivec2 t = tile + ivec2(tx, ty);
-            if (all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, tiles))) mask |= imageLoad(out_tiles, t).r;
+            if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, tiles))) continue;
+            vec2 lo = vec2(t * DOF_TILE), hi = lo + float(DOF_TILE);
+            float dist = length(max(max(lo - (vec2(p) + 0.5), (vec2(p) + 0.5) - hi), vec2(0.0)));
+            uint reachable = 0u;
+            for (uint l = 0u; l < pc.layers; ++l)
+                if (0.5 * abs(layerCoc(l, span)) + 1.0 >= dist) reachable |= 1u << l;
+            mask |= imageLoad(out_tiles, t).r & reachable;
         }
 
     // Sprites, binned per 8x8 group: 64 at a time are loaded by the group's threads, those whose square reaches the
@@ -100,7 +107,7 @@ void main() {
                 sum = imageLoad(out_prepared, p).rgb;
                 alpha = 1.0;
             }
-        } else if (r <= 4.5) {
+        } else if (r <= 2.5) {
             // Small kernels: every pixel of the footprint, weighted by how much of it the aperture covers (its edge
             // antialiased over a pixel), so the few taps do not alias.
             int reachPx = int(ceil(r + 0.5));
@@ -122,7 +129,7 @@ void main() {
             sum /= weightSum;
             alpha = inside / weightSum;
         } else {
-            int taps = 64;
+            int taps = clamp(int(pc.apertureArea * r * r * 0.5), 24, 64);
             float flip = centreCoc > 0.0 ? -1.0 : 1.0;
             float weightSum = 0.0, inside = 0.0;
             for (int i = 0; i < taps; ++i) {

@@ -90,7 +90,7 @@ std::vector<std::map<std::string, Image>> runEveryFrame(const json& doc) {
 // formula at the depth the G-buffer stored, 1e-4 of the largest CoC (float32 arithmetic).
 TEST_F(Dof, CocMatchesTheThinLensFormula) {
     const int W = 64, H = 48;
-    const double yfov = 0.3, fNumber = 1.4, zf = 2.0, maxCoc = 64.0;
+    const double yfov = 0.3, fNumber = 1.4, zf = 2.0, maxCoc = 6.0; // the card's -7.1 px is clamped
     SceneBuilder b("dof_coc");
     const uint32_t grey = emissive(b, "grey", glm::vec3(0.5f));
     std::vector<Tri> tris;
@@ -119,7 +119,7 @@ TEST_F(Dof, CocMatchesTheThinLensFormula) {
             worst = std::max(worst, std::abs(coc.at(x, y)[0] - expected));
         }
     std::printf("CoC range %.3f .. %.3f px (%d sky pixels), worst |GPU - thin lens| %.2e px\n", lo, hi, sky, worst);
-    EXPECT_LT(lo, -5.0); // the floor in front of the focus plane
+    EXPECT_EQ(lo, -maxCoc); // the card in front of the focus plane, clamped
     EXPECT_GT(hi, 4.0); // the sky: the CoC at infinity, f^2 / (N (zf - f)) over the pixel pitch
     EXPECT_GT(sky, 0);
     EXPECT_LT(worst, 1e-4 * maxCoc);
@@ -368,6 +368,51 @@ TEST_F(Dof, MatchesTheAccumulatedThinLensReference) {
     writeExr(dir / "sharp.exr", out.at("sharp"), ExrPixelType::Float);
     EXPECT_LT(flipDof, 0.06); // measured 0.047 (the sharp frame: 0.19)
     EXPECT_LT(flipDof, 0.6 * flipSharp);
+}
+
+// An in-focus box (2 m) in front of a uniform wall far out of focus (8 m, CoC 4.7 px): the box stays its own colour to
+// its edge (the blurred wall does not spread over it) and the wall right beside it stays the wall's colour (the box
+// does not bleed out, and the wall's layer, partly covered there, is renormalised instead of darkened), as through
+// a thin lens, which sees the wall around an object in focus.
+TEST_F(Dof, SharpEdgeOverBlurredBackgroundHasNoHaloOrDarkening) {
+    const int W = 96, H = 64;
+    const glm::vec3 wallColor(0.2f, 0.4f, 0.8f), boxColor(1.0f, 0.5f, 0.1f);
+    SceneBuilder b("dof_edge");
+    const uint32_t wall = emissive(b, "wall", wallColor), box = emissive(b, "box", boxColor);
+    std::vector<Tri> tris;
+    addQuad(tris, {0.0f, 0.0f, -8.0f}, {6.0f, 0, 0}, {0, 4.0f, 0}, {0, 0, 1});
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", tris, wall)));
+    b.node("box", static_cast<int32_t>(b.mesh("box", boxTris({0.08f, 0.08f, 0.08f}), box)), {0.0f, 0.0f, -2.0f});
+    b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, 0.3f);
+    auto glb = b.write();
+    json nodes = {{"scene", sceneNode(glb)},
+                  {"gbuffer", gbufferNode()},
+                  {"dof", dofNode({{"f_number", 1.4}, {"focus_distance", 2.0}, {"blades", 0}})}};
+    auto out = runGraph(makeGraph(nodes, {{"dof", "dof.color"}, {"sharp", "gbuffer.emissive"}}, W, H));
+    const Image &dof = out.at("dof"), &sharp = out.at("sharp");
+    auto isBox = [&](int x, int y) { return sharp.at(x, y)[0] > 0.6f; };
+    double worstBox = 0.0, worstWall = 0.0;
+    int wallNear = 0;
+    for (int y = 2; y < H - 2; ++y)
+        for (int x = 2; x < W - 2; ++x) {
+            const glm::dvec3 c = rgb(dof, x, y);
+            if (isBox(x, y)) {
+                worstBox = std::max(worstBox, relErr(c, glm::dvec3(boxColor)));
+                continue;
+            }
+            bool near = false;
+            for (int dy = -3; dy <= 3; ++dy)
+                for (int dx = -3; dx <= 3; ++dx)
+                    if (x + dx >= 0 && x + dx < W && y + dy >= 0 && y + dy < H) near |= isBox(x + dx, y + dy);
+            if (!near) continue;
+            ++wallNear;
+            worstWall = std::max(worstWall, relErr(c, glm::dvec3(wallColor)));
+        }
+    std::printf("edge: worst relative error on the box %.4f, on the wall within 3 px of it %.4f (%d pixels)\n", worstBox,
+                worstWall, wallNear);
+    EXPECT_GT(wallNear, 50);
+    EXPECT_LT(worstBox, 0.02);
+    EXPECT_LT(worstWall, 0.05);
 }
 
 // ---------------------------------------------------------------------------------------------
