@@ -21,6 +21,7 @@ const std::vector<FormatInfo>& allFormats() {
         {"r11g11b10f", VK_FORMAT_B10G11R11_UFLOAT_PACK32, 4, 3, false, false},
         {"rgb9e5", VK_FORMAT_E5B9G9R9_UFLOAT_PACK32, 4, 3, false, false},
         {"d32f", VK_FORMAT_D32_SFLOAT, 4, 1, true, false},
+        {"r32ui", VK_FORMAT_R32_UINT, 4, 1, false, false}, // counters and bit masks (image atomics); read back as floats
     };
     return kFormats;
 }

@@ -116,6 +116,12 @@ Image unpackPixels(const void* data, uint32_t width, uint32_t height, VkFormat f
         case VK_FORMAT_R32G32_SFLOAT:
         case VK_FORMAT_R32G32B32A32_SFLOAT:
         case VK_FORMAT_D32_SFLOAT: std::memcpy(p, src, info.bytesPerPixel); break;
+        case VK_FORMAT_R32_UINT: {
+            uint32_t v;
+            std::memcpy(&v, src, 4);
+            p[0] = static_cast<float>(v);
+            break;
+        }
         case VK_FORMAT_B10G11R11_UFLOAT_PACK32: {
             uint32_t v;
             std::memcpy(&v, src, 4);

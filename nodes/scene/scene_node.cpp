@@ -2,6 +2,7 @@
 
 #include "core/accel/gpu_bvh.hpp"
 #include "core/base/error.hpp"
+#include "core/scene/aperture.hpp"
 #include "core/gpu/context.hpp"
 #include "core/scene/probes.hpp"
 
@@ -44,6 +45,25 @@ void addSceneNodeSchema(NodeSchema& s) {
     s.params.push_back({"vertex_jitter_threshold", ParamType::Float, 2.0, 0.01, 1000.0, {},
                         "jitter_space vertex: screen speed (pixels per frame) at and above which a vertex is not "
                         "jittered; slower vertices get (1 - speed / threshold) of the jitter"});
+    s.params.push_back({"lens", ParamType::Enum, "pinhole", {}, {}, {"pinhole", "thin_lens"},
+                        "pinhole: everything sharp. thin_lens: the ground truth of depth of field by accumulation: each "
+                        "frame moves the eye to a sample of the aperture polygon (lens_samples low-discrepancy samples, "
+                        "one per frame, in turn) and shears the projection so the focus plane stays put; the mean of "
+                        "lens_samples frames (aa.accumulate) is the thin lens's image"});
+    s.params.push_back({"lens_samples", ParamType::Int, 0, 0.0, 65536.0, {},
+                        "thin_lens: aperture samples, one per frame, then repeated. 0: the graph's frame count"});
+    s.params.push_back({"lens_f_number", ParamType::Float, 0.0, 0.0, 256.0, {},
+                        "thin_lens: f-number (aperture diameter = focal length / f-number). 0: the scene camera's"});
+    s.params.push_back({"lens_focus_distance", ParamType::Float, 0.0, 0.0, 1e6, {},
+                        "thin_lens: distance of the plane in focus along the view axis (m). 0: the scene camera's"});
+    s.params.push_back({"lens_blades", ParamType::Int, -1, -1.0, 32.0, {},
+                        "thin_lens: aperture blades (0: a circle). -1: the scene camera's"});
+    s.params.push_back({"lens_blade_roundness", ParamType::Float, 0.0, 0.0, 1.0, {},
+                        "thin_lens: 0 straight blades (a polygon) .. 1 a circle, once stopped down (core/scene/aperture.hpp)"});
+    s.params.push_back({"lens_blade_rotation", ParamType::Float, 0.0, -360.0, 360.0, {},
+                        "thin_lens: angle of the first corner in degrees, counter-clockwise from the camera's +x"});
+    s.params.push_back({"lens_wide_open_f_number", ParamType::Float, 1.4, 0.5, 256.0, {},
+                        "thin_lens: the lens's largest aperture; at it the aperture is round, one stop down the blades' shape"});
     s.params.push_back({"probes", ParamType::Path, "", {}, {}, {},
                         "Reflection probes from a JSON file {\"probes\": [...]} (relative to the graph file; each probe "
                         "as in core/scene/VITRINE_reflection_probes.md), combined with the scene's as probes_mode says. "
@@ -82,6 +102,17 @@ void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> s
     mJitter = static_cast<scene::JitterPattern>(p.getEnumIndex("jitter"));
     mJitterGrid = scene::jitterGridFor(static_cast<uint32_t>(p.getInt("jitter_grid")), ctx.frame().frames);
     mVertexJitterThreshold = p.getString("jitter_space") == "vertex" ? p.getFloat("vertex_jitter_threshold") : 0.0f;
+    mThinLens = p.getString("lens") == "thin_lens";
+    mLensSamples = p.getInt("lens_samples") > 0 ? static_cast<uint32_t>(p.getInt("lens_samples")) : ctx.frame().frames;
+    mLensFNumber = p.getFloat("lens_f_number");
+    mLensFocus = p.getFloat("lens_focus_distance");
+    mLensBlades = p.getInt("lens_blades");
+    mLensRoundness = p.getFloat("lens_blade_roundness");
+    mLensRotation = glm::radians(p.getFloat("lens_blade_rotation"));
+    mLensWideOpen = p.getFloat("lens_wide_open_f_number");
+    if (mThinLens && mLensFNumber > 0.0f && mLensFNumber < mLensWideOpen)
+        ctx.failParam("lens_f_number", "f/" + std::to_string(mLensFNumber) + " is wider than the lens opens (lens_wide_open_f_number f/" +
+                                           std::to_string(mLensWideOpen) + ")");
     mCameraPath = p.getString("camera");
     if (!mCameraPath.empty()) {
         if (!scene->findCameraPath(mCameraPath)) {
@@ -137,6 +168,29 @@ scene::CameraState SceneNode::cameraAt(double t) const {
     return state;
 }
 
+glm::vec2 SceneNode::lensOffset(const scene::Camera& lens, uint32_t frame, float& focus) const {
+    const float fNumber = mLensFNumber > 0.0f ? mLensFNumber : lens.fNumber;
+    const uint32_t blades = mLensBlades >= 0 ? static_cast<uint32_t>(mLensBlades) : lens.apertureBlades;
+    focus = mLensFocus > 0.0f ? mLensFocus : lens.focusDistance;
+    const scene::ApertureShape shape = scene::apertureAt(blades, mLensRoundness, mLensRotation, fNumber, mLensWideOpen);
+    // The eye moves over the aperture (radius f / 2N) scaled by zf / (zf - f): the render keeps the frame's field
+    // of view (no focus breathing: the image distance stays f, not the thin lens's f zf / (zf - f)), and with this
+    // scale a point at depth z spreads over exactly the thin lens's CoC, A f (z - zf) / (z (zf - f)) on the sensor.
+    const float f = lens.focalLengthMm() * 1e-3f;
+    const float radius = 0.5f * f / fNumber * focus / std::max(focus - f, 1e-6f);
+    return radius * scene::apertureSample(shape, frame % mLensSamples);
+}
+
+// The eye moved by `offset` (camera x right, y up, metres) on the lens and the projection sheared so that the plane
+// at view depth `focus` projects as it did from the lens centre: a pinhole through one point of a thin lens.
+void SceneNode::applyLens(scene::CameraState& state, glm::mat4& proj, glm::vec2 offset, float focus) {
+    state.position += state.orientation * glm::vec3(offset, 0.0f);
+    state.world = glm::translate(glm::mat4(1.0f), state.position) * glm::mat4_cast(state.orientation);
+    state.view = glm::inverse(state.world);
+    proj[2][0] -= proj[0][0] * offset.x / focus;
+    proj[2][1] -= proj[1][1] * offset.y / focus;
+}
+
 void SceneNode::execute(ExecuteContext& ctx) {
     const scene::Scene& s = mScene->scene();
     const uint32_t frame = ctx.frameIndex();
@@ -150,14 +204,23 @@ void SceneNode::execute(ExecuteContext& ctx) {
     // Consecutive frames hand their pose and camera on instead of evaluating them again.
     const bool consecutive = mEvaluated && frame == mLastFrame + 1;
     mScene->previousPose = consecutive ? std::move(mScene->pose) : s.evaluate(t - dt);
-    const scene::CameraState before = consecutive ? c.state : cameraAt(t - dt);
+    scene::CameraState before = consecutive ? mUnshiftedState : cameraAt(t - dt);
     mScene->time = t;
     mScene->pose = s.evaluate(t);
     c.state = cameraAt(t);
     mEvaluated = true;
     mLastFrame = frame;
 
+    mUnshiftedState = c.state;
     c.projNoJitter = c.state.projection(aspect, true);
+    glm::mat4 prevProj = before.projection(aspect, true);
+    if (mThinLens) {
+        // Velocity stays the scene's motion: last frame's camera is moved to this frame's lens sample too.
+        float focus = 0.0f;
+        const glm::vec2 offset = lensOffset(c.state.lens, frame, focus);
+        applyLens(c.state, c.projNoJitter, offset, focus);
+        applyLens(before, prevProj, offset, focus);
+    }
     c.prevJitter = frame == 0 ? glm::vec2(0.0f) : scene::jitterOffset(mJitter, frame - 1, mJitterGrid);
     c.jitter = scene::jitterOffset(mJitter, frame, mJitterGrid);
     c.vertexJitterThreshold = mVertexJitterThreshold;
@@ -165,7 +228,7 @@ void SceneNode::execute(ExecuteContext& ctx) {
     c.proj = shift * c.projNoJitter;
     c.viewProj = c.proj * c.state.view;
     c.viewProjNoJitter = c.projNoJitter * c.state.view;
-    c.prevViewProjNoJitter = before.projection(aspect, true) * before.view;
+    c.prevViewProjNoJitter = prevProj * before.view;
     c.invViewProj = glm::inverse(c.viewProj);
     c.time = t;
     c.frame = frame;

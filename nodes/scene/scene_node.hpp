@@ -24,6 +24,9 @@ protected:
 
 private:
     scene::CameraState cameraAt(double t) const;
+    // Thin-lens mode: this frame's aperture sample (metres, camera x right / y up) and the focus distance.
+    glm::vec2 lensOffset(const scene::Camera& lens, uint32_t frame, float& focus) const;
+    static void applyLens(scene::CameraState& state, glm::mat4& proj, glm::vec2 offset, float focus);
 
     std::shared_ptr<SceneObject> mScene;
     std::shared_ptr<CameraObject> mCamera;
@@ -34,6 +37,11 @@ private:
     scene::JitterPattern mJitter = scene::JitterPattern::Off;
     uint32_t mJitterGrid = 16;
     float mVertexJitterThreshold = 0.0f; // 0: frustum jitter
+    bool mThinLens = false;
+    uint32_t mLensSamples = 1;
+    float mLensFNumber = 0.0f, mLensFocus = 0.0f, mLensRoundness = 0.0f, mLensRotation = 0.0f, mLensWideOpen = 1.4f;
+    int mLensBlades = -1;
+    scene::CameraState mUnshiftedState; // this frame's camera before the lens offset (next frame's `before`)
     bool mEvaluated = false; // pose and camera of mLastFrame are in mScene / mCamera
     uint32_t mLastFrame = 0;
 };
