@@ -54,6 +54,9 @@ NodeSchema schema() {
          {},
          "Sun azimuth in the XZ plane, degrees from -Z toward +X"},
         {"ground_albedo", ParamType::Float, 0.3, 0.0, 1.0, {}, "Albedo of the Lambertian ground below the horizon"},
+        {"intensity", ParamType::Float, 1.0, 1e-4, 1e4, {},
+         "Scale of all the sky's light (sky, sun and ground): a brighter or dimmer day, e.g. for camera.physical's "
+         "program line to react to; 1 = Preetham's absolute values"},
         {"size", ParamType::Int, 64, 4.0, 2048.0, {}, "Cube map face size in texels"},
         {"sun_in_cubemap",
          ParamType::Bool,
@@ -96,6 +99,7 @@ public:
         push.sunAngularRadius = static_cast<float>(kSunAngularRadiusDeg * deg);
         push.size = static_cast<uint32_t>(p.getInt("size"));
         push.sunInCubemap = p.getBool("sun_in_cubemap") ? 1u : 0u;
+        push.intensity = p.getFloat("intensity");
         ctx.dispatch(mCubePipeline, &push, sizeof(push), push.size, push.size, 6);
         ctx.dispatch(mShPipeline, push, 1, 1);
     }

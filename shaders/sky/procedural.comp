@@ -33,7 +33,7 @@ float sunCoverage(uint face, ivec2 texel, int size, vec3 toSun, float radius) {
 void main() {
     vec3 toSun = pc.toSun.xyz;
     float T = pc.toSun.w;
-    skyEnvironmentSetup(gl_LocalInvocationIndex, toSun, T, pc.groundAlbedo, pc.sunAngularRadius);
+    skyEnvironmentSetup(gl_LocalInvocationIndex, toSun, T, pc.groundAlbedo, pc.sunAngularRadius, pc.intensity);
 
     int size = int(pc.size);
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);

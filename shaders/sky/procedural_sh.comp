@@ -18,7 +18,7 @@ void main() {
     uint t = gl_LocalInvocationIndex;
     vec3 toSun = pc.toSun.xyz;
     float T = pc.toSun.w;
-    skyEnvironmentSetup(t, toSun, T, pc.groundAlbedo, pc.sunAngularRadius);
+    skyEnvironmentSetup(t, toSun, T, pc.groundAlbedo, pc.sunAngularRadius, pc.intensity);
 
     int size = int(pc.size);
     uint texels = 6u * uint(size * size);

@@ -23,9 +23,11 @@ VITRINE_PUSH_BEGIN(SkyProceduralPush)
     float sunAngularRadius; // radians
     uint size;              // cube face size
     uint sunInCubemap;      // 1: add the sun disk to the cube map (never to the SH)
+    float intensity;        // scale of all radiance: sky, sun, ground
+    float pad0, pad1, pad2;
 VITRINE_PUSH_END(pc)
 #ifdef __cplusplus
-static_assert(sizeof(SkyProceduralPush) == 32);
+static_assert(sizeof(SkyProceduralPush) == 48);
 }
 #endif
 #endif

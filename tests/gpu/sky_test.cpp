@@ -125,6 +125,32 @@ TEST_F(Sky, SunDiskInTheCubeMapCarriesTheSunsIlluminance) {
     EXPECT_LT(relDiff(energy, sunE), 1e-3);
 }
 
+// `intensity` scales every radiance the node outputs: the cube map (sun disk included), the SH coefficients, the
+// sun's illuminance and its disk radiance, by exactly that factor (a brighter day, the light camera.physical meters).
+TEST_F(Sky, IntensityScalesSkySunAndGroundAlike) {
+    const int size = 16;
+    json bright = skyNode(2.5, 40.0, 30.0, size, true);
+    bright["params"]["intensity"] = 8.0;
+    auto out = runGraph(graph({{"one", skyNode(2.5, 40.0, 30.0, size, true)},
+                               {"eight", bright},
+                               {"u_one", {{"type", "test.cube_unfold"}, {"in", {{"cube", "one.cubemap"}}}}},
+                               {"u_eight", {{"type", "test.cube_unfold"}, {"in", {{"cube", "eight.cubemap"}}}}}},
+                              {{"one", "u_one.faces"}, {"eight", "u_eight.faces"}, {"sh_one", "one.sh"}, {"sh_eight", "eight.sh"}}));
+    double worst = 0.0;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x)
+                worst = std::max(worst, relDiff(cubeTexel(out["eight"], f, x, y), 8.0 * cubeTexel(out["one"], f, x, y)));
+    for (int i : {0, 1, 2, 3, 4, 5, 6, 7, 8, SKY_TEXEL_SUN_ILLUMINANCE})
+        worst = std::max(worst, relDiff(texel(out["sh_eight"], i), 8.0 * texel(out["sh_one"], i)));
+    worst = std::max(worst, std::abs(out["sh_eight"].at(SKY_TEXEL_SUN_INFO, 0)[0] / (8.0 * out["sh_one"].at(SKY_TEXEL_SUN_INFO, 0)[0]) - 1.0));
+    // The direction and the rest of the sun's info do not change.
+    EXPECT_EQ(texel(out["sh_eight"], SKY_TEXEL_SUN_DIRECTION), texel(out["sh_one"], SKY_TEXEL_SUN_DIRECTION));
+    EXPECT_EQ(out["sh_eight"].at(SKY_TEXEL_SUN_INFO, 0)[1], out["sh_one"].at(SKY_TEXEL_SUN_INFO, 0)[1]);
+    std::printf("sky intensity 8: largest relative difference from 8x intensity 1: %.2g\n", worst);
+    EXPECT_LT(worst, 1e-5);
+}
+
 TEST_F(Sky, SunIlluminanceFallsWithElevation) {
     const double elevations[] = {85.0, 60.0, 40.0, 20.0, 8.0, 2.0};
     json nodes, outputs;
