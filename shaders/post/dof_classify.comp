@@ -46,5 +46,5 @@ void main() {
             }
         }
     }
-    imageStore(out_prepared, p, vec4(keep, 1.0));
+    imageStore(out_prepared, p, vec4(keep, coc)); // the CoC beside the colour: the gather's taps read one texel
 }

@@ -119,10 +119,10 @@ void main() {
                     float dist = length(up);
                     float w = clamp(r * boundary(atan(up.y, up.x)) - dist + 0.5, 0.0, 1.0);
                     if (w <= 0.0) continue;
-                    ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
+                    vec4 t = imageLoad(out_prepared, clamp(p + ivec2(x, y), ivec2(0), size - 1)); // colour, CoC
                     weightSum += w;
-                    if (layerOf(imageLoad(out_coc, q).r, span) == uint(l)) {
-                        sum += w * imageLoad(out_prepared, q).rgb;
+                    if (layerOf(t.a, span) == uint(l)) {
+                        sum += w * t.rgb;
                         inside += w;
                     }
                 }
@@ -138,9 +138,10 @@ void main() {
                 vec2 o = flip * sqrt((float(i) + 0.5) / float(taps)) * b * r * vec2(cos(theta), sin(theta));
                 ivec2 q = clamp(ivec2(floor(centre + vec2(o.x, -o.y))), ivec2(0), size - 1);
                 float w = b * b;
+                vec4 t = imageLoad(out_prepared, q); // colour, CoC
                 weightSum += w;
-                if (layerOf(imageLoad(out_coc, q).r, span) == uint(l)) {
-                    sum += w * imageLoad(out_prepared, q).rgb;
+                if (layerOf(t.a, span) == uint(l)) {
+                    sum += w * t.rgb;
                     inside += w;
                 }
             }
