@@ -151,9 +151,9 @@ void main() {
                 vec4 tap = sTap[i];
                 if (tap.z <= 0.0) continue;
                 ivec2 q = r <= 2.5 ? p + ivec2(tap.xy) : ivec2(floor(centre + tap.xy));
-                vec4 t = imageLoad(out_prepared, clamp(q, ivec2(0), size - 1)); // colour, CoC
+                vec4 t = imageLoad(out_prepared, clamp(q, ivec2(0), size - 1)); // colour, layer
                 weightSum += tap.z;
-                if (layerOf(t.a, span) == uint(l)) {
+                if (t.a == float(l)) {
                     sum += tap.z * t.rgb;
                     inside += tap.z;
                 }
