@@ -415,7 +415,6 @@ TEST_F(Dof, SharpEdgeOverBlurredBackgroundHasNoHaloOrDarkening) {
     EXPECT_LT(worstWall, 0.05);
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // 3b. The gather alone (no sprites) against analytic convolutions
 
@@ -464,41 +463,44 @@ struct Harmonic {
 TEST_F(Dof, GatheredBokehIsUprightBehindTheFocusPlaneAndInvertedInFront) {
     const double rotation = glm::radians(90.0);
     for (int blades : {5, 3}) {
-    const scene::ApertureShape shape = scene::apertureAt(blades, 0.0f, static_cast<float>(rotation), 4.0f, 2.0f);
-    Harmonic reference;
-    const int n = 600;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const glm::vec2 q(-1.0f + 2.0f * (i + 0.5f) / n, -1.0f + 2.0f * (j + 0.5f) / n);
-            if (scene::insideAperture(shape, q)) reference.add(glm::dvec2(q), 1.0, blades, rotation);
-        }
-    struct Case {
-        double z, zf;
-    };
-    for (const Case& k : {Case{8.0, 1.0}, Case{1.0, 3.0}}) {
-        const PointScene ps = pointOnWall(k.z, k.zf);
-        const bool near = k.z < k.zf;
-        json params = {{"f_number", 4.0}, {"focus_distance", ps.zf}, {"blades", blades}, {"blade_roundness", 0.0},
-                       {"blade_rotation", 90.0}, {"wide_open_f_number", 2.0}, {"max_sprites", 0}};
-        json nodes = {{"scene", sceneNode(ps.glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)}};
-        auto out = runGraph(makeGraph(nodes, {{"dof", "dof.color"}, {"sharp", "gbuffer.emissive"}}, ps.size, ps.size));
-        const Image& img = out.at("dof");
-        const Spread sharp = spreadOf(out.at("sharp")), s = spreadOf(img);
-        Harmonic h;
-        for (int y = 0; y < img.height; ++y)
-            for (int x = 0; x < img.width; ++x) {
-                const glm::dvec2 d = glm::dvec2(x + 0.5, y + 0.5) - sharp.centroid;
-                h.add(glm::dvec2(d.x, -d.y), img.at(x, y)[1], blades, rotation);
+        const scene::ApertureShape shape = scene::apertureAt(blades, 0.0f, static_cast<float>(rotation), 4.0f, 2.0f);
+        Harmonic reference;
+        const int n = 600;
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const glm::vec2 q(-1.0f + 2.0f * (i + 0.5f) / n, -1.0f + 2.0f * (j + 0.5f) / n);
+                if (scene::insideAperture(shape, q)) reference.add(glm::dvec2(q), 1.0, blades, rotation);
             }
-        const double expected = near ? -reference.value() : reference.value();
-        std::printf("gather only, %d blades, point at %.0f m, focus %.0f m (CoC %.1f px): harmonic %.4f, the aperture %s %.4f; "
-                    "energy %.3f of %.3f\n",
-                    blades, k.z, k.zf, thinLensCoc(k.z, k.zf, ps.yfov, 4.0, ps.size), h.value(), near ? "inverted" : "upright",
-                    expected, s.energy, sharp.energy);
-        EXPECT_GT(std::abs(reference.value()), 0.05);
-        EXPECT_NEAR(h.value(), expected, 0.3 * std::abs(expected)) << (near ? "in front" : "behind");
-        EXPECT_NEAR(s.energy / sharp.energy, 1.0, 0.02);
-    }
+        struct Case {
+            double z, zf;
+        };
+        for (const Case& k : {Case{8.0, 1.0}, Case{1.0, 3.0}}) {
+            const PointScene ps = pointOnWall(k.z, k.zf);
+            const bool near = k.z < k.zf;
+            json params = {{"f_number", 4.0},        {"focus_distance", ps.zf}, {"blades", blades},
+                           {"blade_roundness", 0.0}, {"blade_rotation", 90.0},  {"wide_open_f_number", 2.0},
+                           {"max_sprites", 0}};
+            json nodes = {{"scene", sceneNode(ps.glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)}};
+            auto out =
+                runGraph(makeGraph(nodes, {{"dof", "dof.color"}, {"sharp", "gbuffer.emissive"}}, ps.size, ps.size));
+            const Image& img = out.at("dof");
+            const Spread sharp = spreadOf(out.at("sharp")), s = spreadOf(img);
+            Harmonic h;
+            for (int y = 0; y < img.height; ++y)
+                for (int x = 0; x < img.width; ++x) {
+                    const glm::dvec2 d = glm::dvec2(x + 0.5, y + 0.5) - sharp.centroid;
+                    h.add(glm::dvec2(d.x, -d.y), img.at(x, y)[1], blades, rotation);
+                }
+            const double expected = near ? -reference.value() : reference.value();
+            std::printf("gather only, %d blades, point at %.0f m, focus %.0f m (CoC %.1f px): harmonic %.4f, the "
+                        "aperture %s %.4f; "
+                        "energy %.3f of %.3f\n",
+                        blades, k.z, k.zf, thinLensCoc(k.z, k.zf, ps.yfov, 4.0, ps.size), h.value(),
+                        near ? "inverted" : "upright", expected, s.energy, sharp.energy);
+            EXPECT_GT(std::abs(reference.value()), 0.05);
+            EXPECT_NEAR(h.value(), expected, 0.3 * std::abs(expected)) << (near ? "in front" : "behind");
+            EXPECT_NEAR(s.energy / sharp.energy, 1.0, 0.02);
+        }
     }
 }
 
@@ -530,56 +532,61 @@ TEST_F(Dof, GatheredStepEdgeIsTheConvolutionWithTheApertureArea) {
         double rotation;
     };
     for (const Case& k : {Case{5, 90.0}, Case{3, 0.0}}) {
-    json params = {{"f_number", fNumber}, {"focus_distance", zf}, {"blades", k.blades}, {"blade_roundness", 0.0},
-                   {"blade_rotation", k.rotation}, {"wide_open_f_number", 1.0}, {"max_sprites", 0}};
-    json nodes = {{"scene", sceneNode(glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)}};
-    auto out = runGraph(makeGraph(nodes, {{"dof", "dof.color"}, {"depth", "gbuffer.depth"}}, W, H));
-    const Image &dof = out.at("dof"), &depth = out.at("depth");
-    const double coc = thinLensCoc(z, zf, yfov, fNumber, H), r = 0.5 * coc;
-    const scene::ApertureShape shape = scene::apertureAt(k.blades, 0.0f, static_cast<float>(glm::radians(k.rotation)), static_cast<float>(fNumber), 1.0f);
-    // The share of the kernel left of the edge at signed distance d = x + 0.5 - W/2 of the pixel centre from it. Behind
-    // the focus plane the gather's taps lie in the reflected aperture: offset -r a for a in the aperture.
-    const int n = 800;
-    std::vector<glm::dvec2> pts;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const glm::vec2 q(-1.0f + 2.0f * (i + 0.5f) / n, -1.0f + 2.0f * (j + 0.5f) / n);
-            if (scene::insideAperture(shape, q)) pts.push_back(-r * glm::dvec2(q));
-        }
-    auto share = [&](double d) {
-        size_t in = 0;
-        for (const glm::dvec2& o : pts) in += d + o.x < 0.0;
-        return static_cast<double>(in) / pts.size();
-    };
-    std::vector<std::pair<int, int>> cardPixels;
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x)
-            if (depth.at(x, y)[0] > 2.0 * kZNear / z) cardPixels.push_back({x, y});
-    double worst = 0.0, sum = 0.0, worstCardTile = 0.0;
-    int count = 0, cardTile = 0;
-    for (int x = 0; x < W; ++x) {
-        const double expected = share(x + 0.5 - 0.5 * W);
-        for (int y = 0; y < H; ++y) {
-            double gap = 1e9;
-            for (auto [cx, cy] : cardPixels) gap = std::min(gap, std::hypot(double(cx - x), double(cy - y)));
-            if (gap < r + 1.5) continue;
-            const double got = (dof.at(x, y)[0] - dark.x) / (white.x - dark.x);
-            const double err = std::abs(got - expected);
-            worst = std::max(worst, err);
-            sum += err;
-            ++count;
-            if (y / 16 == 1 && (x / 16 == 3 || x / 16 == 4)) {
-                worstCardTile = std::max(worstCardTile, err);
-                ++cardTile;
+        json params = {{"f_number", fNumber},    {"focus_distance", zf},         {"blades", k.blades},
+                       {"blade_roundness", 0.0}, {"blade_rotation", k.rotation}, {"wide_open_f_number", 1.0},
+                       {"max_sprites", 0}};
+        json nodes = {{"scene", sceneNode(glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)}};
+        auto out = runGraph(makeGraph(nodes, {{"dof", "dof.color"}, {"depth", "gbuffer.depth"}}, W, H));
+        const Image &dof = out.at("dof"), &depth = out.at("depth");
+        const double coc = thinLensCoc(z, zf, yfov, fNumber, H), r = 0.5 * coc;
+        const scene::ApertureShape shape = scene::apertureAt(
+            k.blades, 0.0f, static_cast<float>(glm::radians(k.rotation)), static_cast<float>(fNumber), 1.0f);
+        // The share of the kernel left of the edge at signed distance d = x + 0.5 - W/2 of the pixel centre from it.
+        // Behind the focus plane the gather's taps lie in the reflected aperture: offset -r a for a in the aperture.
+        const int n = 800;
+        std::vector<glm::dvec2> pts;
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const glm::vec2 q(-1.0f + 2.0f * (i + 0.5f) / n, -1.0f + 2.0f * (j + 0.5f) / n);
+                if (scene::insideAperture(shape, q)) pts.push_back(-r * glm::dvec2(q));
+            }
+        auto share = [&](double d) {
+            size_t in = 0;
+            for (const glm::dvec2& o : pts)
+                in += d + o.x < 0.0;
+            return static_cast<double>(in) / pts.size();
+        };
+        std::vector<std::pair<int, int>> cardPixels;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x)
+                if (depth.at(x, y)[0] > 2.0 * kZNear / z) cardPixels.push_back({x, y});
+        double worst = 0.0, sum = 0.0, worstCardTile = 0.0;
+        int count = 0, cardTile = 0;
+        for (int x = 0; x < W; ++x) {
+            const double expected = share(x + 0.5 - 0.5 * W);
+            for (int y = 0; y < H; ++y) {
+                double gap = 1e9;
+                for (auto [cx, cy] : cardPixels)
+                    gap = std::min(gap, std::hypot(double(cx - x), double(cy - y)));
+                if (gap < r + 1.5) continue;
+                const double got = (dof.at(x, y)[0] - dark.x) / (white.x - dark.x);
+                const double err = std::abs(got - expected);
+                worst = std::max(worst, err);
+                sum += err;
+                ++count;
+                if (y / 16 == 1 && (x / 16 == 3 || x / 16 == 4)) {
+                    worstCardTile = std::max(worstCardTile, err);
+                    ++cardTile;
+                }
             }
         }
-    }
-    std::printf("step edge, %d blades, CoC %.2f px: %zu card pixels; |gathered share - aperture area share| worst %.4f, mean %.4f "
-                "over %d pixels; in the card's tiles worst %.4f over %d pixels\n",
-                k.blades, coc, cardPixels.size(), worst, sum / count, count, worstCardTile, cardTile);
-    EXPECT_GT(cardPixels.size(), 8u);
-    EXPECT_GT(cardTile, 60);
-    EXPECT_LT(worst, 0.06);
+        std::printf("step edge, %d blades, CoC %.2f px: %zu card pixels; |gathered share - aperture area share| worst "
+                    "%.4f, mean %.4f "
+                    "over %d pixels; in the card's tiles worst %.4f over %d pixels\n",
+                    k.blades, coc, cardPixels.size(), worst, sum / count, count, worstCardTile, cardTile);
+        EXPECT_GT(cardPixels.size(), 8u);
+        EXPECT_GT(cardTile, 60);
+        EXPECT_LT(worst, 0.06);
     }
 }
 
@@ -589,11 +596,11 @@ TEST_F(Dof, GatheredStepEdgeIsTheConvolutionWithTheApertureArea) {
 // across the edge vs the exact coverage; a hard edge: 22 %); inside, under 1 %.
 TEST_F(Dof, SpriteIsTheApertureBoxFilteredOverThePixels) {
     const PointScene ps = pointScene(6.0, 1.0);
-    json params = {{"f_number", 2.8}, {"focus_distance", ps.zf}, {"max_coc", 64.0}, {"blades", 5},
-                   {"blade_roundness", 0.0}, {"blade_rotation", 90.0}, {"wide_open_f_number", 1.4}};
+    json params = {{"f_number", 2.8},        {"focus_distance", ps.zf}, {"max_coc", 64.0},          {"blades", 5},
+                   {"blade_roundness", 0.0}, {"blade_rotation", 90.0},  {"wide_open_f_number", 1.4}};
     json nodes = {{"scene", sceneNode(ps.glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)}};
-    auto out = runGraph(makeGraph(nodes, {{"dof", "dof.color"}, {"sharp", "gbuffer.emissive"}, {"coc", "dof.coc"}},
-                                  ps.size, ps.size));
+    auto out = runGraph(
+        makeGraph(nodes, {{"dof", "dof.color"}, {"sharp", "gbuffer.emissive"}, {"coc", "dof.coc"}}, ps.size, ps.size));
     const Image& img = out.at("dof");
     const Spread sharp = spreadOf(out.at("sharp"));
     const int sx = static_cast<int>(sharp.centroid.x), sy = static_cast<int>(sharp.centroid.y);
@@ -622,7 +629,8 @@ TEST_F(Dof, SpriteIsTheApertureBoxFilteredOverThePixels) {
         }
     edgeErr /= edge;
     std::printf("sprite of CoC %.2f px: %d inner pixels (worst error %.4f of the plateau), %d edge pixels (mean error "
-                "%.4f)\n", 2.0 * r, inner, innerWorst, edge, edgeErr);
+                "%.4f)\n",
+                2.0 * r, inner, innerWorst, edge, edgeErr);
     EXPECT_GT(edge, 60);
     EXPECT_LT(innerWorst, 0.01);
     EXPECT_LT(edgeErr, 0.08);
@@ -646,8 +654,10 @@ TEST_F(Dof, ResolvedCocHasNoGhostOnDisocclusion) {
     const double pixel = 2.0 * 2.0 * std::tan(0.5 * yfov) / H; // at 2 m
     scene::Animation slide;
     slide.name = "slide";
-    slide.samplers = {{scene::Interpolation::Linear, {0.0f, 1.0f / 24.0f},
-                       {glm::vec4(-0.2f, 0.0f, -2.0f, 0.0f), glm::vec4(static_cast<float>(-0.2 + 16.0 * pixel), 0.0f, -2.0f, 0.0f)}}};
+    slide.samplers = {
+        {scene::Interpolation::Linear,
+         {0.0f, 1.0f / 24.0f},
+         {glm::vec4(-0.2f, 0.0f, -2.0f, 0.0f), glm::vec4(static_cast<float>(-0.2 + 16.0 * pixel), 0.0f, -2.0f, 0.0f)}}};
     slide.channels = {{static_cast<uint32_t>(b.s.nodes.size() - 1), scene::AnimationPath::Translation, 0}};
     b.s.animations.push_back(slide);
     b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, static_cast<float>(yfov));
@@ -666,7 +676,8 @@ TEST_F(Dof, ResolvedCocHasNoGhostOnDisocclusion) {
             const bool now = isCard(d1, x, y);
             if (now == isCard(d0, x, y)) continue;
             bool uniform = true;
-            for (int i = 0; i < 9; ++i) uniform &= isCard(d1, x + i % 3 - 1, y + i / 3 - 1) == now;
+            for (int i = 0; i < 9; ++i)
+                uniform &= isCard(d1, x + i % 3 - 1, y + i / 3 - 1) == now;
             if (!uniform) continue;
             ++changed;
             const double expected = thinLensCoc(kZNear / d1.at(x, y)[0], zf, yfov, fNumber, H);
@@ -823,8 +834,10 @@ TEST_F(Dof, AiryResponseHasTheAnalyticEnergyAndFirstDarkRing) {
 TEST_F(Dof, AiryResponseIsRadiallySymmetric) {
     const int S = 65;
     Image impulse(S, S);
-    for (int i = 0; i < S * S; ++i) impulse.pixels[i * 4 + 3] = 1.0f;
-    for (int c = 0; c < 3; ++c) impulse.at(S / 2, S / 2)[c] = 1000.0f;
+    for (int i = 0; i < S * S; ++i)
+        impulse.pixels[i * 4 + 3] = 1.0f;
+    for (int c = 0; c < 3; ++c)
+        impulse.at(S / 2, S / 2)[c] = 1000.0f;
     const std::filesystem::path dir = freshDir("airy_symmetry");
     writeExr(dir / "impulse.exr", impulse, ExrPixelType::Float);
     const double fNumber = 96.0, sensorMm = 0.3;
@@ -848,7 +861,8 @@ TEST_F(Dof, AiryResponseIsRadiallySymmetric) {
                 (std::min(a, 0.5 * kPi - a) < 0.125 * kPi ? axial : diagonal) += v;
             }
         std::printf("channel %d: r0 %.2f px; energy from r0 to %d px along the axes %.5f, along the diagonals %.5f "
-                    "(ratio %.4f)\n", c, r0, S / 2, axial / total, diagonal / total, diagonal / axial);
+                    "(ratio %.4f)\n",
+                    c, r0, S / 2, axial / total, diagonal / total, diagonal / axial);
         EXPECT_GT(axial / total, 1e-3);
         EXPECT_NEAR(diagonal / axial, 1.0, 0.03);
     }
