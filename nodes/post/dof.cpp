@@ -56,11 +56,14 @@ NodeSchema schema() {
         storage("coc", VK_FORMAT_R32_SFLOAT,
                 "Signed CoC diameter in pixels (negative in front of the focus plane), resolved when coc_history is "
                 "connected (its history)"),
-        storage("prepared", VK_FORMAT_R32G32B32A32_SFLOAT, "Internal: the colour left to gather after the sprites took theirs"),
+        storage("prepared", VK_FORMAT_R32G32B32A32_SFLOAT,
+                "Internal: the colour left to gather after the sprites took theirs; alpha: the pixel's layer"),
         storage("tiles", VK_FORMAT_R32_UINT, "Internal: per 16x16 tile, a bit per layer present"),
-        storage("sprite_count", VK_FORMAT_R32_UINT,
-                "Internal: 2x1, pixels that asked to scatter (the list keeps max_sprites); the largest |CoC| (float bits)"),
-        storage("sprites", VK_FORMAT_R32G32B32A32_SFLOAT, "Internal: the scatter list, two texels a sprite (x, y, CoC; colour)"),
+        storage(
+            "sprite_count", VK_FORMAT_R32_UINT,
+            "Internal: 2x1, pixels that asked to scatter (the list keeps max_sprites); the largest |CoC| (float bits)"),
+        storage("sprites", VK_FORMAT_R32G32B32A32_SFLOAT,
+                "Internal: the scatter list, two texels a sprite (x, y, CoC; colour)"),
     };
     s.params = {
         {"f_number", ParamType::Float, 0.0, 0.0, 256.0, {}, "f-number N (aperture diameter f / N). 0: the scene camera's"},

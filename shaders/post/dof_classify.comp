@@ -46,5 +46,6 @@ void main() {
             }
         }
     }
-    imageStore(out_prepared, p, vec4(keep, 1.0));
+    // The pixel's layer beside the colour: the gather's taps read one texel and compare its layer.
+    imageStore(out_prepared, p, vec4(keep, float(layerOf(coc, span))));
 }

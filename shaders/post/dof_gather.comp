@@ -32,6 +32,8 @@ float boundary(float theta) { return apertureBoundary(pc.blades, pc.roundness, p
 shared vec4 sSprite[64];
 shared vec3 sColor[64];
 shared uint sCount;
+shared vec4 sTap[64]; // this layer's taps: offset (pixels, y down), weight
+shared uint sMask;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -91,15 +93,51 @@ void main() {
         }
         barrier();
     }
-    if (!inImage) return;
+    // The kernel's taps depend on the layer only, not on the pixel: the group's threads compute them once per layer
+    // present anywhere in the group (one tap a thread, at most 64) into shared memory, and every pixel reads them.
+    if (gl_LocalInvocationIndex == 0u) sMask = 0u;
+    barrier();
+    atomicOr(sMask, mask);
+    barrier();
+    uint groupMask = sMask;
 
     uint own = layerOf(imageLoad(out_coc, p).r, span);
     vec3 acc = vec3(0.0), accSprites = vec3(0.0);
     float transmittance = 1.0;
     for (int l = int(pc.layers) - 1; l >= 0; --l) {
-        if ((mask & (1u << uint(l))) == 0u) continue;
+        if ((groupMask & (1u << uint(l))) == 0u) continue; // uniform over the group: the barriers below stay uniform
         float centreCoc = layerCoc(uint(l), span);
         float r = 0.5 * abs(centreCoc);
+        // A gather kernel is the bokeh point-reflected: behind the focus plane the taps come from the reflected aperture.
+        float flip = centreCoc > 0.0 ? -1.0 : 1.0;
+        int reachPx = int(ceil(r + 0.5));
+        int side = 2 * reachPx + 1;
+        int taps = r <= 2.5 ? side * side : clamp(int(pc.apertureArea * r * r * 0.5), 24, 64);
+        if (r >= 1.0) {
+            barrier(); // the previous layer's taps are read
+            int i = int(gl_LocalInvocationIndex);
+            if (i < taps) {
+                if (r <= 2.5) {
+                    // Small kernels: every pixel of the footprint, weighted by how much of it the aperture covers (its
+                    // edge antialiased over a pixel), so the few taps do not alias.
+                    int x = i % side - reachPx, y = i / side - reachPx;
+                    vec2 up = flip * vec2(x, -y); // the offset in the aperture's frame (y up)
+                    float dist = length(up);
+                    float w = clamp(r * boundary(atan(up.y, up.x)) - dist + 0.5, 0.0, 1.0);
+                    sTap[i] = vec4(x, y, w, 0.0);
+                } else {
+                    // 24-64 taps on a Vogel spiral over the disc pushed out to the aperture's boundary, each weighted
+                    // by the boundary's square so the density is uniform over the shape.
+                    float theta = float(i) * 2.39996323;
+                    float b = boundary(theta);
+                    vec2 o = flip * sqrt((float(i) + 0.5) / float(taps)) * b * r * vec2(cos(theta), sin(theta));
+                    float w = b * b;
+                    sTap[i] = vec4(o.x, -o.y, w, 0.0);
+                }
+            }
+            barrier();
+        }
+        if (!inImage || (mask & (1u << uint(l))) == 0u) continue;
         vec3 sum = vec3(0.0);
         float alpha = 0.0;
         if (r < 1.0) {
@@ -107,41 +145,17 @@ void main() {
                 sum = imageLoad(out_prepared, p).rgb;
                 alpha = 1.0;
             }
-        } else if (r <= 2.5) {
-            // Small kernels: every pixel of the footprint, weighted by how much of it the aperture covers (its edge
-            // antialiased over a pixel), so the few taps do not alias.
-            int reachPx = int(ceil(r + 0.5));
-            float flip = centreCoc > 0.0 ? -1.0 : 1.0;
-            float weightSum = 0.0, inside = 0.0;
-            for (int y = -reachPx; y <= reachPx; ++y)
-                for (int x = -reachPx; x <= reachPx; ++x) {
-                    vec2 up = flip * vec2(x, -y); // the offset in the aperture's frame (y up)
-                    float dist = length(up);
-                    float w = clamp(r * boundary(atan(up.y, up.x)) - dist + 0.5, 0.0, 1.0);
-                    if (w <= 0.0) continue;
-                    ivec2 q = clamp(p + ivec2(x, y), ivec2(0), size - 1);
-                    weightSum += w;
-                    if (layerOf(imageLoad(out_coc, q).r, span) == uint(l)) {
-                        sum += w * imageLoad(out_prepared, q).rgb;
-                        inside += w;
-                    }
-                }
-            sum /= weightSum;
-            alpha = inside / weightSum;
         } else {
-            int taps = clamp(int(pc.apertureArea * r * r * 0.5), 24, 64);
-            float flip = centreCoc > 0.0 ? -1.0 : 1.0;
             float weightSum = 0.0, inside = 0.0;
             for (int i = 0; i < taps; ++i) {
-                float theta = float(i) * 2.39996323;
-                float b = boundary(theta);
-                vec2 o = flip * sqrt((float(i) + 0.5) / float(taps)) * b * r * vec2(cos(theta), sin(theta));
-                ivec2 q = clamp(ivec2(floor(centre + vec2(o.x, -o.y))), ivec2(0), size - 1);
-                float w = b * b;
-                weightSum += w;
-                if (layerOf(imageLoad(out_coc, q).r, span) == uint(l)) {
-                    sum += w * imageLoad(out_prepared, q).rgb;
-                    inside += w;
+                vec4 tap = sTap[i];
+                if (tap.z <= 0.0) continue;
+                ivec2 q = r <= 2.5 ? p + ivec2(tap.xy) : ivec2(floor(centre + tap.xy));
+                vec4 t = imageLoad(out_prepared, clamp(q, ivec2(0), size - 1)); // colour, layer
+                weightSum += tap.z;
+                if (t.a == float(l)) {
+                    sum += tap.z * t.rgb;
+                    inside += tap.z;
                 }
             }
             sum /= weightSum;
@@ -151,6 +165,7 @@ void main() {
         accSprites = spriteAdd[l] + (1.0 - alpha) * accSprites;
         transmittance *= 1.0 - alpha;
     }
+    if (!inImage) return;
     float coverage = 1.0 - transmittance;
     vec3 gathered = coverage > 1e-4 ? acc / coverage : imageLoad(out_prepared, p).rgb;
     imageStore(out_color, p, vec4(gathered + accSprites, 1.0));
