@@ -246,6 +246,24 @@ TEST_F(Ssr, ColorPyramidTexelsAreTheMeanOfTheirFootprint) {
     }
 }
 
+// The SSR chain over a scene's G-buffer with a test image (each pixel's coordinates by default) as the colour the
+// reflections read: scene, G-buffer, Hi-Z, colour pyramid and ssr.hiz with `params`.
+json ssrNodes(const std::filesystem::path& glb, json params, const char* source = "test.ssr_coords") {
+    json n = baseNodes(glb);
+    n["coords"] = {{"type", source}};
+    n["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
+    n["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
+    n["ssr"] = {{"type", "ssr.hiz"},
+                {"in",
+                 {{"normal", "gbuffer.normal"},
+                  {"depth", "gbuffer.depth"},
+                  {"hiz", "hiz.hiz"},
+                  {"color", "pyramid.pyramid"},
+                  {"camera", "scene.camera"}}},
+                {"params", params}};
+    return n;
+}
+
 // --- A mirror floor under a wall, a pillar and a plate -------------------------------------------------------
 
 enum class Hit { None, Floor, Wall, Pillar, Plate };
@@ -378,21 +396,7 @@ struct MirrorScene {
         return path;
     }
 
-    json nodes(json ssrParams, const char* source = "test.ssr_coords") const {
-        json n = baseNodes(glb);
-        n["coords"] = {{"type", source}};
-        n["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-        n["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
-        n["ssr"] = {{"type", "ssr.hiz"},
-                    {"in",
-                     {{"normal", "gbuffer.normal"},
-                      {"depth", "gbuffer.depth"},
-                      {"hiz", "hiz.hiz"},
-                      {"color", "pyramid.pyramid"},
-                      {"camera", "scene.camera"}}},
-                    {"params", ssrParams}};
-        return n;
-    }
+    json nodes(json ssrParams, const char* source = "test.ssr_coords") const { return ssrNodes(glb, ssrParams, source); }
 };
 
 constexpr double kThickness = 0.1, kMaxDistance = 6.0, kEdgeFade = 0.1;
@@ -720,18 +724,7 @@ TEST_F(Ssr, RaysIntoABackFaceHaveNoConfidence) {
     b.sun({0.3f, 1.0f, 0.6f});
     auto glb = b.write();
     Pinhole cam(b.s, W, H);
-    json nodes = baseNodes(glb);
-    nodes["coords"] = {{"type", "test.ssr_coords"}};
-    nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-    nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
-    nodes["ssr"] = {{"type", "ssr.hiz"},
-                    {"in",
-                     {{"normal", "gbuffer.normal"},
-                      {"depth", "gbuffer.depth"},
-                      {"hiz", "hiz.hiz"},
-                      {"color", "pyramid.pyramid"},
-                      {"camera", "scene.camera"}}},
-                    {"params", mirrorParams(64)}};
+    json nodes = ssrNodes(glb, mirrorParams(64));
     auto out = runGraph(graph(nodes, {{"ssr", "ssr.reflection"}}, W, H));
     const Image& ssr = out.at("ssr");
     int intoBack = 0, confident = 0;
@@ -831,24 +824,12 @@ TEST_F(Ssr, RoughRaysFollowTheVisibleNormalDistribution) {
     b.sun({0.3f, 1.0f, 0.6f});
     auto glb = b.write();
     Pinhole cam(b.s, W, H);
-    json nodes = baseNodes(glb);
-    nodes["coords"] = {{"type", "test.ssr_coords"}};
-    nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-    nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
-    nodes["ssr"] = {{"type", "ssr.hiz"},
-                    {"in",
-                     {{"normal", "gbuffer.normal"},
-                      {"depth", "gbuffer.depth"},
-                      {"hiz", "hiz.hiz"},
-                      {"color", "pyramid.pyramid"},
-                      {"camera", "scene.camera"}}},
-                    {"params",
-                     {{"resolution_scale", 1.0},
-                      {"max_taps", 64},
-                      {"thickness", 0.2},
-                      {"max_distance", maxDistance},
-                      {"edge_fade", edgeFade},
-                      {"max_roughness", 1.0}}}};
+    json nodes = ssrNodes(glb, {{"resolution_scale", 1.0},
+                                {"max_taps", 64},
+                                {"thickness", 0.2},
+                                {"max_distance", maxDistance},
+                                {"edge_fade", edgeFade},
+                                {"max_roughness", 1.0}});
     auto out = runGraph(graph(nodes, {{"ssr", "ssr.reflection"}, {"normal", "gbuffer.normal"}}, W, H));
     const Image& ssr = out.at("ssr");
     const Image& normal = out.at("normal");
@@ -949,21 +930,11 @@ TEST_F(Ssr, RaysFoundAtTheBackOfASlabHaveNoConfidence) {
     b.sun({0.3f, 1.0f, 0.6f});
     auto glb = b.write();
     Pinhole cam(b.s, W, H);
-    json nodes = baseNodes(glb);
-    nodes["coords"] = {{"type", "test.ssr_coords"}};
+    json nodes = ssrNodes(glb, mirrorParams(64));
     nodes["normals"] = {{"type", "test.ssr_normals"},
                         {"in", {{"normal", "gbuffer.normal"}}},
                         {"params", {{"near", 5.0}, {"far", 6.0}, {"normal", {0.0, 0.0, -1.0}}}}};
-    nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-    nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
-    nodes["ssr"] = {{"type", "ssr.hiz"},
-                    {"in",
-                     {{"normal", "normals.result"},
-                      {"depth", "gbuffer.depth"},
-                      {"hiz", "hiz.hiz"},
-                      {"color", "pyramid.pyramid"},
-                      {"camera", "scene.camera"}}},
-                    {"params", mirrorParams(64)}};
+    nodes["ssr"]["in"]["normal"] = "normals.result";
     auto out = runGraph(graph(nodes, {{"ssr", "ssr.reflection"}}, W, H));
     const Image& ssr = out.at("ssr");
     auto inCard = [&](glm::dvec3 p) { return p.x >= cardLo.x && p.x <= cardHi.x && p.y >= cardLo.y && p.y <= cardHi.y; };
@@ -1020,18 +991,7 @@ TEST_F(Ssr, RaysMeetingABackFaceWithinItsSlabStopThere) {
     Pinhole cam(b.s, W, H);
     json params = mirrorParams(64);
     params["thickness"] = 0.5;
-    json nodes = baseNodes(glb);
-    nodes["coords"] = {{"type", "test.ssr_coords"}};
-    nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-    nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
-    nodes["ssr"] = {{"type", "ssr.hiz"},
-                    {"in",
-                     {{"normal", "gbuffer.normal"},
-                      {"depth", "gbuffer.depth"},
-                      {"hiz", "hiz.hiz"},
-                      {"color", "pyramid.pyramid"},
-                      {"camera", "scene.camera"}}},
-                    {"params", params}};
+    json nodes = ssrNodes(glb, params);
     auto out = runGraph(graph(nodes, {{"ssr", "ssr.reflection"}}, W, H));
     const Image& ssr = out.at("ssr");
     int intoBack = 0, confident = 0;
