@@ -306,6 +306,14 @@ def main():
     r, body = server.json("POST", "/api/validate", {"document": bad, "base": "graphs/fxaa_zoneplate.json"})
     check(body.get("ok") is False and body["errors"][0].get("pointer") == "/nodes/fxaa/params/subpix",
           f"validate points at a wrong param ({body})")
+    # Every error at once, each with its pointer (the editor marks them all).
+    bad["nodes"]["fxaa"]["params"] = {"subpix": "lots", "edge_threshold_min": -1}
+    bad["nodes"]["fxaa"]["in"] = {"color": "pattern.nope"}
+    r, body = server.json("POST", "/api/validate", {"document": bad, "base": "graphs/fxaa_zoneplate.json"})
+    pointers = sorted(e.get("pointer") for e in body.get("errors", []))
+    check(body.get("ok") is False and pointers == ["/nodes/fxaa/in/color", "/nodes/fxaa/params/edge_threshold_min",
+                                                   "/nodes/fxaa/params/subpix"],
+          f"validate reports every error with its pointer ({pointers})")
     r, body = server.json("POST", "/api/validate", {"graph": "graphs/image_outside.json"})
     check(body.get("ok") is False and "refused" in body["errors"][0]["error"], "validate reports a path outside DIR")
 

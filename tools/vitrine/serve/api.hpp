@@ -72,6 +72,16 @@ private:
         uint32_t width = 0, height = 0, frames = 0; // 0: the graph's own
         std::string output;
     };
+    // The document a request names (a file under DIR or sent inline), merged (extends, "set") and edited for the
+    // preview (size, frames, the output): not yet validated.
+    struct PreparedDocument {
+        nlohmann::json document;
+        std::filesystem::path file; // the file it is or stands for
+        std::string label;          // how errors name it
+        std::string output;
+    };
+    PreparedDocument prepareDocument(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
+    PreparedGraph prepare(const PreparedDocument& document, const std::string& pointer);
     PreparedGraph prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
     RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph);
     void validate(const httplib::Request& req, httplib::Response& res);

@@ -45,7 +45,8 @@ nlohmann::json specOf(const nlohmann::json& value, const std::string& pointer) {
 
 } // namespace
 
-PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults) {
+Api::PreparedDocument Api::prepareDocument(const nlohmann::json& spec, const std::string& pointer,
+                                           const Defaults& defaults) {
     // Where the document comes from: a file under the served directory, or the request itself (the editor's unsaved
     // graph; `base` is the file it stands for, from whose directory its relative paths and `extends` resolve).
     nlohmann::json document;
@@ -113,9 +114,18 @@ PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointe
         output = "preview";
     }
 
+    return {std::move(document), std::move(file), std::move(label), std::move(output)};
+}
+
+PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults) {
+    return prepare(prepareDocument(spec, pointer, defaults), pointer);
+}
+
+PreparedGraph Api::prepare(const PreparedDocument& doc, const std::string& pointer) {
+    const std::string& label = doc.label;
     PreparedGraph prepared;
-    prepared.desc = validateGraph(document, label, NodeRegistry::global());
-    prepared.desc.directory = file.parent_path();
+    prepared.desc = validateGraph(doc.document, label, NodeRegistry::global());
+    prepared.desc.directory = doc.file.parent_path();
     const FrameSettings& frame = prepared.desc.frame;
     if (static_cast<uint64_t>(frame.width) * frame.height > kMaxPixels)
         throw HttpError(400,
@@ -123,7 +133,7 @@ PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointe
                             " is larger than vitrine serve renders (at most 4096x4096 pixels); ask for a preview "
                             "size with \"width\" and \"height\"",
                         {{"pointer", pointer + "/width"}});
-    prepared.output = cli::pickOutput(prepared.desc, output);
+    prepared.output = cli::pickOutput(prepared.desc, doc.output);
     std::erase_if(prepared.desc.outputs, [&](const OutputDecl& o) { return o.name != prepared.output; });
     nlohmann::json kept = {{prepared.output, prepared.desc.document["outputs"][prepared.output]}};
     prepared.desc.document["outputs"] = kept;
@@ -145,8 +155,16 @@ void Api::validate(const httplib::Request& req, httplib::Response& res) {
     // As `vitrine validate`: the graph is loaded and compiled (every node's setup runs), nothing is rendered. The
     // compile runs on the GPU thread, after the jobs before it, because node setups build scenes and load files.
     try {
-        Defaults defaults;
-        PreparedGraph prepared = prepare(request, "", defaults);
+        PreparedDocument doc = prepareDocument(request, "", Defaults{});
+        // Every error the document has, each with its pointer, so that the editor marks them all at once.
+        std::vector<std::string> errors = validateGraphErrors(doc.document, doc.label, NodeRegistry::global());
+        if (!errors.empty()) {
+            nlohmann::json bodies = nlohmann::json::array();
+            for (const std::string& e : errors) bodies.push_back(userErrorBody(e));
+            replyJson(res, 200, {{"ok", false}, {"errors", bodies}});
+            return;
+        }
+        PreparedGraph prepared = prepare(doc, "");
         std::promise<nlohmann::json> done;
         std::future<nlohmann::json> result = done.get_future();
         mGpu.post([&] {
