@@ -79,11 +79,15 @@ private:
         std::filesystem::path file; // the file it is or stands for
         std::string label;          // how errors name it
         std::string output;
+        std::vector<std::string> previews; // "outputs": [...] asked for several at once
     };
     PreparedDocument prepareDocument(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
     PreparedGraph prepare(const PreparedDocument& document, const std::string& pointer);
     PreparedGraph prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
-    RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph);
+    // Publishes a node's long work (a bake) as `stage: "node"` events of the job.
+    NodeProgressFn nodeProgress(const std::string& job, const std::string& kind, const std::string& file);
+    RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph,
+                           const std::string& tag = {});
     void validate(const httplib::Request& req, httplib::Response& res);
     void render(const httplib::Request& req, httplib::Response& res);
     void compare(const httplib::Request& req, httplib::Response& res);
