@@ -205,6 +205,15 @@ def main():
     check("graphs/link_out.json" not in listed and not any(p.startswith("linkdir") for p in listed),
           "GET /api/graphs leaves out files behind symlinks out of DIR")
 
+    r, body = server.json("GET", "/api/files?ext=png,.GLTF")
+    files = body.get("files", [])
+    check(r.status == 200 and "images/inside.png" in files and "scene/evil.gltf" in files and
+          not any(f.endswith(".json") for f in files), f"GET /api/files?ext= lists those extensions ({files[:6]})")
+    check(not any(f.startswith("linkdir") for f in files) and "graphs/link_out.json" not in files,
+          "GET /api/files leaves out files behind symlinks out of DIR")
+    r, body = server.json("GET", "/api/files")
+    check(r.status == 200 and "graphs/fxaa_zoneplate.json" in body.get("files", []), "GET /api/files lists every file")
+
     # GET -> PUT round trip, byte-identical; new files; malformed bodies.
     r, payload = server.request("GET", "/api/graphs/graphs/fxaa_zoneplate.json")
     check(r.status == 200 and payload == zoneplate_bytes, "GET a graph returns its bytes")

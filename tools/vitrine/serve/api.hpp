@@ -63,6 +63,7 @@ private:
 
     // api_files.cpp
     void listGraphs(const httplib::Request& req, httplib::Response& res);
+    void listFiles(const httplib::Request& req, httplib::Response& res);
     void getGraph(const httplib::Request& req, httplib::Response& res);
     void putGraph(const httplib::Request& req, httplib::Response& res);
     void staticFile(const httplib::Request& req, httplib::Response& res);
