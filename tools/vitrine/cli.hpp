@@ -38,5 +38,6 @@ int goldenCommand(const Args& args);
 int exportSceneCommand(const Args& args);
 int jitterCommand(const Args& args);
 int serveCommand(const Args& args);
+int sweepCommand(const Args& args);
 
 } // namespace vitrine::cli

@@ -168,12 +168,7 @@ int benchCommand(const Args& args) {
     CompiledGraph graph = compileFromArgs(args, frames + warmup);
     double graphMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - compileStart).count();
     // Scene nodes build (the museum) or load (glTF) their scene in setup(): reported apart from compiling the graph.
-    double sceneMs = 0.0;
-    auto outputsScene = [&](const PassUse& u) {
-        return u.output && graph.resources[u.resource].kind == PortKind::Scene;
-    };
-    for (const CompiledPass& p : graph.passes)
-        if (std::any_of(p.uses.begin(), p.uses.end(), outputsScene)) sceneMs += p.setupMs;
+    const double sceneMs = sceneBuildMs(graph);
     graphMs -= sceneMs;
 
     Context ctx(contextOptions(args));

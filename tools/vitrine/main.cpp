@@ -50,6 +50,14 @@ commands:
       default 4) compiled graphs stay warm between requests. Binds 127.0.0.1:8420 by default (--port 0: any
       free port; the URL is printed); another --host needs the access token printed at start-up (or
       --token). Reads and writes files under DIR only (default: the current directory).
+  sweep FILE [--out DIR] [--jobs N] [--retry-failed] [--devices 0,1] [--list]
+      Quality-versus-cost study (README "Sweeps"): every point of the vitrine-sweep/1 FILE (axes of --set
+      values, variant files, frame ranges) rendered as its own process, --jobs at once, compared with the
+      sweep's reference (FLIP, SSIM, PSNR as `compare`), timed per node (as `bench`); results in
+      DIR/points/<id>/ (default out/sweep/<FILE's stem>), DIR/sweep.json, sweep.csv and report.html.
+      Resumable: done points are skipped, failed ones too unless --retry-failed. Exit 3: some point failed.
+      --point ID|INDEX: run one point in this process (what the driver and Slurm array tasks run).
+  sweep --collect DIR               Gather DIR/points/*/metrics.json into sweep.json, sweep.csv, report.html.
   devices                           List Vulkan devices.
 
 common options:
@@ -69,7 +77,8 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm"},
+                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm",
+                                     "jobs", "point", "collect", "devices"},
                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
@@ -89,6 +98,7 @@ int main(int argc, char** argv) {
         if (args.command == "export-scene") return cli::exportSceneCommand(args);
         if (args.command == "jitter") return cli::jitterCommand(args);
         if (args.command == "serve") return cli::serveCommand(args);
+        if (args.command == "sweep") return cli::sweepCommand(args);
         throw UserError("unknown command '" + args.command + "'; run `vitrine help`");
     } catch (const UserError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

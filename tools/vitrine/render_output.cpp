@@ -6,6 +6,7 @@
 #include "core/graph/executor.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cctype>
 #include <filesystem>
 
@@ -78,12 +79,30 @@ std::string pickOutput(const GraphDesc& desc, const std::string& requested) {
     throw UserError(desc.where("/outputs") + ": --output " + requested + ": no such output; the graph has " + names);
 }
 
+double sceneBuildMs(const CompiledGraph& graph) {
+    double ms = 0.0;
+    auto outputsScene = [&](const PassUse& u) {
+        return u.output && graph.resources[u.resource].kind == PortKind::Scene;
+    };
+    for (const CompiledPass& p : graph.passes)
+        if (std::any_of(p.uses.begin(), p.uses.end(), outputsScene)) ms += p.setupMs;
+    return ms;
+}
+
 std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, GraphDesc desc, const std::string& output,
-                                       uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress) {
+                                       uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress,
+                                       RenderStats* stats) {
+    using Clock = std::chrono::steady_clock;
+    auto ms = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
     std::erase_if(desc.outputs, [&](const OutputDecl& o) { return o.name != output; });
     desc.frame.frames = frameCount;
     desc.frame.write = frames;
+    auto t = Clock::now();
     CompiledGraph graph = compileGraph(std::move(desc));
+    if (stats) {
+        stats->compileMs = ms(t);
+        stats->sceneBuildMs = sceneBuildMs(graph);
+    }
     Executor executor(ctx, graph, shaders);
     std::map<uint32_t, Image> images;
     RunOptions options;
@@ -91,7 +110,16 @@ std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, Gr
     options.write = frames;
     options.progress = progress;
     options.onOutput = [&](uint32_t frame, const std::string&, const Image& image) { images[frame] = image; };
+    t = Clock::now();
     executor.run(options);
+    if (stats) {
+        stats->runMs = ms(t);
+        stats->pipelineMs = executor.pipelineMs();
+        stats->memory = executor.memory();
+        stats->timings = executor.timings();
+        stats->passIds.clear();
+        for (const CompiledPass& p : graph.passes) stats->passIds.push_back(p.id);
+    }
     return images;
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 
 #include "core/gpu/context.hpp"
+#include "core/graph/compiler.hpp"
+#include "core/graph/executor.hpp"
 #include "core/graph/graph_desc.hpp"
 #include "core/image/image.hpp"
 #include "core/shader/compiler.hpp"
@@ -35,9 +37,25 @@ std::string deviceClass(const Context& ctx);
 // it has when there is no such output.
 std::string pickOutput(const GraphDesc& desc, const std::string& requested);
 
+// What renderOutput() measured: `vitrine sweep` records it per point.
+struct RenderStats {
+    double compileMs = 0.0;    // compileGraph(), the nodes' setup() included
+    double sceneBuildMs = 0.0; // the setup() of nodes that output a scene (part of compileMs): see sceneBuildMs()
+    double pipelineMs = 0.0;   // the executor's pipelines
+    double runMs = 0.0;        // the frames, readback included
+    MemoryStats memory;
+    std::vector<std::string> passIds; // per pass, in timings[f].passGpuMs order
+    std::vector<FrameTiming> timings;
+};
+
+// Scene nodes build (the museum) or load (glTF) their scene in setup(): the sum of those setup() times, which
+// `bench` and `sweep` report apart from compiling the graph.
+double sceneBuildMs(const CompiledGraph& graph);
+
 // Compiles `desc` with only `output` kept (so nodes no other output needs are culled), runs `frameCount` frames and
 // returns the output at each of `frames` (all < frameCount).
 std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, GraphDesc desc, const std::string& output,
-                                       uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress);
+                                       uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress,
+                                       RenderStats* stats = nullptr);
 
 } // namespace vitrine::cli
