@@ -29,7 +29,7 @@ vitrine = os.path.abspath(sys.argv[1])
 sweep_file = os.path.abspath(sys.argv[2])
 passed = 0
 failed = []
-QUALITY = ("flip", "ssim", "psnr", "flicker")
+MEASURED = ("gpu_ms", "max_rss_bytes")  # and every *_ms: timings and the process's peak memory differ run to run
 
 
 def check(condition, what):
@@ -62,7 +62,8 @@ def same_number(a, b):
 
 
 def quality_of(metrics):
-    """The metrics that depend only on the pixels (not on timings), flattened: {"flip": .., "flicker.flip": ..}."""
+    """The metrics that depend only on the renders (FLIP, SSIM, PSNR, flicker, device memory), not on timings,
+    flattened: {"flip": .., "flicker.flip": ..}."""
     flat = {}
 
     def walk(prefix, value):
@@ -73,7 +74,7 @@ def quality_of(metrics):
             flat[prefix] = value
 
     walk("", metrics)
-    return {k: v for k, v in flat.items() if k.split(".")[0] in QUALITY}
+    return {k: v for k, v in flat.items() if k.split(".")[0] not in MEASURED and not k.endswith("_ms")}
 
 
 def compare_tables(local, slurm):
@@ -85,7 +86,7 @@ def compare_tables(local, slurm):
     compared = 0
     for pid in sorted(set(lp) & set(sp)):
         a, b = lp[pid], sp[pid]
-        for key in ("label", "values", "status", "sets", "frames", "graph"):
+        for key in ("label", "values", "status", "sets", "frames", "graph", "error", "exit_code"):
             check(a.get(key) == b.get(key), f"{pid}: {key} local {a.get(key)!r} vs slurm {b.get(key)!r}")
         qa, qb = quality_of(a.get("metrics", {})), quality_of(b.get("metrics", {}))
         check(sorted(qa) == sorted(qb), f"{pid}: same quality metrics: local {sorted(qa)}, slurm {sorted(qb)}")
@@ -152,12 +153,21 @@ def main():
             with open(sweep_file) as f:
                 doc = json.load(f)
             base = os.path.dirname(sweep_file)
-            for key in ("graph", "reference"):
-                if isinstance(doc.get(key), str):
-                    doc[key] = os.path.join(base, doc[key])
-            for axis in doc.get("axes", []):
-                if isinstance(axis, dict) and isinstance(axis.get("variants"), list):
-                    axis["variants"] = [os.path.join(base, v) for v in axis["variants"]]
+
+            def absolute(node):  # graph, reference and variant paths are relative to the sweep file
+                if isinstance(node, dict):
+                    for k, v in node.items():
+                        if k in ("graph", "reference", "variant") and isinstance(v, str):
+                            node[k] = os.path.join(base, v)
+                        elif k == "variants" and isinstance(v, list):
+                            node[k] = [os.path.join(base, x) for x in v]
+                        else:
+                            absolute(v)
+                elif isinstance(node, list):
+                    for v in node:
+                        absolute(v)
+
+            absolute(doc)
             doc["slurm"] = {"partition": "debug", "gpus_per_task": "one"}
             bad = os.path.join(work, "bad.sweep.json")
             with open(bad, "w") as f:
@@ -165,6 +175,46 @@ def main():
             r = run(["sweep", bad, "--out", os.path.join(work, "bad"), "--slurm"], env)
             check(r.returncode == 1 and "/slurm/gpus_per_task" in r.stderr,
                   f"bad slurm block: exit 1 naming /slurm/gpus_per_task (got {r.returncode}: {r.stderr})")
+
+            # A point that fails (subpix 2 is outside FXAA's range [0, 1]): recorded as failed in both runs alike, the
+            # other point done; exit status 3 in both.
+            del doc["slurm"]
+            doc.pop("points", None)
+            doc["axes"] = [{"name": "subpix", "set": "fxaa.params.subpix", "values": [0.5, 2.0]}]
+            failing = os.path.join(work, "failing.sweep.json")
+            with open(failing, "w") as f:
+                json.dump(doc, f)
+            rl = run(["sweep", failing, "--out", os.path.join(work, "failing-local")], env)
+            rs = run(["sweep", failing, "--out", os.path.join(work, "failing-slurm"), "--slurm"], env)
+            check(rl.returncode == 3 and rs.returncode == 3,
+                  f"a failed point: exit 3 locally ({rl.returncode}) and with --slurm ({rs.returncode}): {rs.stderr[-2000:]}")
+            tl, ts = table(os.path.join(work, "failing-local")), table(os.path.join(work, "failing-slurm"))
+            check([p["status"] for p in ts["points"]] == ["done", "failed"], f"statuses {[p['status'] for p in ts['points']]}")
+            compare_tables(tl, ts)
+
+            # Tasks Slurm ends without a result (here: the array cancelled while it waits for the reference job) are
+            # recorded as failed by the waiting command, with what happened, and the table shows them.
+            cancelled = os.path.join(work, "cancelled")
+            p = subprocess.Popen([vitrine, "sweep", failing, "--out", cancelled, "--slurm"], env=env,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            jobs_file = os.path.join(cancelled, "slurm", "1", "jobs.json")
+            deadline = time.monotonic() + 60
+            while not os.path.exists(jobs_file) and time.monotonic() < deadline and p.poll() is None:
+                time.sleep(0.05)
+            with open(jobs_file) as f:
+                array_job = json.load(f)["array"]
+            subprocess.run(["scancel", array_job], env=env, check=True)
+            out_c, err_c = p.communicate(timeout=300)
+            check(p.returncode == 3, f"cancelled array: exit 3 (got {p.returncode}): {out_c}{err_c}")
+            tc = table(cancelled)
+            check([q["status"] for q in tc["points"]] == ["failed", "failed"],
+                  f"cancelled tasks recorded as failed: {[q['status'] for q in tc['points']]}")
+            check(all("ended without a result" in q.get("error", "") and "never started" in q.get("error", "")
+                      for q in tc["points"]), f"their error says what happened: {[q.get('error') for q in tc['points']]}")
+            # ... and --retry-failed runs them.
+            r = run(["sweep", failing, "--out", cancelled, "--slurm", "--retry-failed"], env)
+            check(r.returncode == 3 and [q["status"] for q in table(cancelled)["points"]] == ["done", "failed"],
+                  f"--retry-failed reruns cancelled points: {r.returncode} {[q['status'] for q in table(cancelled)['points']]}")
 
             r = run(["sweep", sweep_file, "--out", os.path.join(work, "nopart"), "--slurm", "--partition", "nosuch"],
                     env)

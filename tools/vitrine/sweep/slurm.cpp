@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -389,8 +390,12 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
         std::string why = "Slurm array task " + arrayJob + "_" + task + " ended without a result";
         if (accounted.count(task)) why += " (sacct: " + accounted.at(task) + ")";
         if (fs::exists(log, ec)) why += "; log " + log.string() + ": " + tailOf(log, 1500);
-        else if (!refJob.empty()) why += "; it never started (did the reference job " + refJob + " fail? " +
-                                         (logDir / ("reference-" + refJob + ".out")).string() + ")";
+        else
+            why += "; it never started (cancelled" +
+                   (refJob.empty() ? std::string()
+                                   : ", or the reference job " + refJob + " failed: " +
+                                         (logDir / ("reference-" + refJob + ".out")).string()) +
+                   ")";
         writePointError(outDir / "points" / todo[i]->id, *todo[i], why, 2);
     }
     const CollectSummary summary = collect(outDir); // again, here: the lost points are in the table now
