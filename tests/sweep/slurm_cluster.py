@@ -6,7 +6,7 @@ usage: slurm_cluster.py selftest            start, run a 4-task `sbatch --array 
 
 or from Python: `with SlurmCluster() as cluster: subprocess.run(["sbatch", ...], env=cluster.env)`.
 
-Everything lives in one temporary folder (mode 0700): the munge key, socket, pid, seed and log files, slurm.conf, the
+Everything lives in one temporary folder (mode 0711, its subfolders 0700 but munged's socket folder 0755): the munge key, socket, pid, seed and log files, slurm.conf, the
 controller's state and slurmd's spool. The daemons run in the foreground (munged -F, slurmctld -D, slurmd -D) as
 children of this process on free TCP ports, so each is stopped by its own pid at the end (SIGTERM, then SIGKILL after
 a grace period); nothing is written under /etc, /run or /var. Jobs still queued at the end are cancelled first, and
@@ -14,7 +14,8 @@ any slurmstepd left behind is found by a marker variable only our slurmd carries
 pid. If a daemon does not come up, SlurmClusterError carries the daemons' logs: a test using this fails, it never
 skips.
 
-What a container needed, solved within the folder's config: no systemd (daemons run in the foreground, children of
+What a container needed, solved within the folder's config: munged refuses a socket folder that other users cannot
+reach (a mkdtemp folder is 0700), hence the modes above rather than --force; no systemd (daemons run in the foreground, children of
 this process); no /run/munge or /var/log/slurm (every path points into the folder); no cgroup hierarchy to delegate
 (proctrack/linuxproc, task/none, jobacct_gather/none: nothing touches cgroups); a host name that may not resolve
 (SlurmctldHost and the node's NodeAddr are 127.0.0.1); no accounting database (accounting_storage/none: `sacct`
@@ -81,11 +82,15 @@ class SlurmCluster:
                     f"'{tool}' not found: install Debian's munge, slurmctld, slurmd and slurm-client "
                     "(tools/install-deps.sh does)")
         self.dir = tempfile.mkdtemp(prefix="vitrine-slurm-")
-        os.chmod(self.dir, 0o700)
+        # munged wants its socket reachable by every user (execute on each directory above it, the socket's own
+        # directory readable): the folder is 0711 and the socket's 0755; everything else stays 0700.
+        os.chmod(self.dir, 0o711)
         d = self.dir
         self.hostname = socket.gethostname().split(".")[0]
         self.conf = os.path.join(d, "slurm.conf")
-        self.munge_socket = os.path.join(d, "munge", "munge.socket")
+        self.munge_socket = os.path.join(d, "munge-socket", "munge.socket")
+        os.makedirs(os.path.join(d, "munge-socket"), mode=0o755)
+        os.chmod(os.path.join(d, "munge-socket"), 0o755)  # mode= is masked by the umask
         os.makedirs(os.path.join(d, "munge"), mode=0o700)
         os.makedirs(os.path.join(d, "state"), mode=0o700)
         os.makedirs(os.path.join(d, "spool"), mode=0o700)
@@ -103,9 +108,7 @@ class SlurmCluster:
                   "--pid-file", os.path.join(d, "munge", "munged.pid"),
                   "--log-file", os.path.join(d, "log", "munged.log"),
                   "--seed-file", os.path.join(d, "munge", "munged.seed")]
-        # munged refuses to run when a directory above its files is writable by others without the sticky bit;
-        # --force turns such refusals into warnings (in its log), which a throw-away test folder can accept.
-        self._spawn("munged", munged + ["--force"], daemon_env)
+        self._spawn("munged", munged, daemon_env)
         self._wait_for(lambda: os.path.exists(self.munge_socket), 15, "munged's socket")
         probe = subprocess.run(f"munge -n -S '{self.munge_socket}' | unmunge -S '{self.munge_socket}'", shell=True,
                                capture_output=True, text=True)
