@@ -311,7 +311,8 @@ void renderReferences(const SweepFile& sweep, const std::vector<Point>& points, 
             continue; // that point fails in its own process, with its own error.json
         }
         const fs::path dir = referenceDir(outDir, *l);
-        if (!done.insert(dir).second) continue;
+        std::error_code ec;
+        if (!done.insert(dir).second || fs::exists(dir / "done", ec)) continue;
         if (!ctx) {
             ctx = std::make_unique<Context>(cli::contextOptions(args));
             shaders = std::make_unique<ShaderCompiler>();
