@@ -111,10 +111,12 @@ def main():
 
             out = os.path.join(work, "slurm")
             r = run(["sweep", sweep_file, "--out", out, "--slurm"], env)
-            check(r.returncode == 0, f"--slurm exit status 0 (got {r.returncode}): {r.stdout[-2000:]}{r.stderr[-3000:]}")
+            check(r.returncode == 0,
+                  f"--slurm exit status 0 (got {r.returncode}): {r.stdout[-2000:]}{r.stderr[-3000:]}")
             print(f"--slurm sweep: {r.seconds:.1f} s", flush=True)
             check("array job" in r.stdout and "collect job" in r.stdout, f"--slurm names its jobs: {r.stdout}")
-            check("sweep.json" in r.stdout and "report.html" in r.stdout, f"--slurm says where the table is: {r.stdout}")
+            check("sweep.json" in r.stdout and "report.html" in r.stdout,
+                  f"--slurm says where the table is: {r.stdout}")
             check("done" in r.stderr and "running" in r.stderr and "pending" in r.stderr,
                   f"--slurm shows progress from squeue: {r.stderr[-1500:]}")
             if os.path.exists(os.path.join(out, "sweep.json")) and os.path.exists(os.path.join(local, "sweep.json")):
@@ -187,9 +189,11 @@ def main():
             rl = run(["sweep", failing, "--out", os.path.join(work, "failing-local")], env)
             rs = run(["sweep", failing, "--out", os.path.join(work, "failing-slurm"), "--slurm"], env)
             check(rl.returncode == 3 and rs.returncode == 3,
-                  f"a failed point: exit 3 locally ({rl.returncode}) and with --slurm ({rs.returncode}): {rs.stderr[-2000:]}")
+                  f"a failed point: exit 3 locally ({rl.returncode}) and with --slurm ({rs.returncode}): "
+                  f"{rs.stderr[-2000:]}")
             tl, ts = table(os.path.join(work, "failing-local")), table(os.path.join(work, "failing-slurm"))
-            check([p["status"] for p in ts["points"]] == ["done", "failed"], f"statuses {[p['status'] for p in ts['points']]}")
+            statuses = [q["status"] for q in ts["points"]]
+            check(statuses == ["done", "failed"], f"statuses {statuses}")
             compare_tables(tl, ts)
 
             # Tasks Slurm ends without a result (here: the array cancelled while it waits for the reference job) are
@@ -210,11 +214,13 @@ def main():
             check([q["status"] for q in tc["points"]] == ["failed", "failed"],
                   f"cancelled tasks recorded as failed: {[q['status'] for q in tc['points']]}")
             check(all("ended without a result" in q.get("error", "") and "never started" in q.get("error", "")
-                      for q in tc["points"]), f"their error says what happened: {[q.get('error') for q in tc['points']]}")
+                      for q in tc["points"]),
+                  f"their error says what happened: {[q.get('error') for q in tc['points']]}")
             # ... and --retry-failed runs them.
             r = run(["sweep", failing, "--out", cancelled, "--slurm", "--retry-failed"], env)
             check(r.returncode == 3 and [q["status"] for q in table(cancelled)["points"]] == ["done", "failed"],
-                  f"--retry-failed reruns cancelled points: {r.returncode} {[q['status'] for q in table(cancelled)['points']]}")
+                  f"--retry-failed reruns cancelled points: {r.returncode} "
+                  f"{[q['status'] for q in table(cancelled)['points']]}")
 
             r = run(["sweep", sweep_file, "--out", os.path.join(work, "nopart"), "--slurm", "--partition", "nosuch"],
                     env)

@@ -6,20 +6,20 @@ usage: slurm_cluster.py selftest            start, run a 4-task `sbatch --array 
 
 or from Python: `with SlurmCluster() as cluster: subprocess.run(["sbatch", ...], env=cluster.env)`.
 
-Everything lives in one temporary folder (mode 0711, its subfolders 0700 but munged's socket folder 0755): the munge key, socket, pid, seed and log files, slurm.conf, the
-controller's state and slurmd's spool. The daemons run in the foreground (munged -F, slurmctld -D, slurmd -D) as
-children of this process on free TCP ports, so each is stopped by its own pid at the end (SIGTERM, then SIGKILL after
-a grace period); nothing is written under /etc, /run or /var. Jobs still queued at the end are cancelled first, and
-any slurmstepd left behind is found by a marker variable only our slurmd carries in its environment and killed by
-pid. If a daemon does not come up, SlurmClusterError carries the daemons' logs: a test using this fails, it never
-skips.
+Everything lives in one temporary folder (mode 0711, its subfolders 0700 but munged's socket folder 0755): the munge
+key, socket, pid, seed and log files, slurm.conf, the controller's state and slurmd's spool. The daemons run in the
+foreground (munged -F, slurmctld -D, slurmd -D) as children of this process on free TCP ports, so each is stopped by
+its own pid at the end (SIGTERM, then SIGKILL after a grace period); nothing is written under /etc, /run or /var.
+Jobs still queued at the end are cancelled first, and any slurmstepd left behind is found by a marker variable only
+our slurmd carries in its environment and killed by pid. If a daemon does not come up, SlurmClusterError carries the
+daemons' logs: a test using this fails, it never skips.
 
 What a container needed, solved within the folder's config: munged refuses a socket folder that other users cannot
-reach (a mkdtemp folder is 0700), hence the modes above rather than --force; no systemd (daemons run in the foreground, children of
-this process); no /run/munge or /var/log/slurm (every path points into the folder); no cgroup hierarchy to delegate
-(proctrack/linuxproc, task/none, jobacct_gather/none: nothing touches cgroups); a host name that may not resolve
-(SlurmctldHost and the node's NodeAddr are 127.0.0.1); no accounting database (accounting_storage/none: `sacct`
-does not work on this cluster, `squeue` does).
+reach (a mkdtemp folder is 0700), hence the modes above rather than --force; no systemd (daemons run in the
+foreground, children of this process); no /run/munge or /var/log/slurm (every path points into the folder); no
+cgroup hierarchy to delegate (proctrack/linuxproc, task/none, jobacct_gather/none: nothing touches cgroups); a host
+name that may not resolve (SlurmctldHost and the node's NodeAddr are 127.0.0.1); no accounting database
+(accounting_storage/none: `sacct` does not work on this cluster, `squeue` does).
 """
 import os
 import shutil

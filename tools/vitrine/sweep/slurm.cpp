@@ -30,7 +30,8 @@ using Clock = std::chrono::steady_clock;
 // Single-quoted for sh: safe for any path (a ' becomes '\'').
 std::string shellQuote(const std::string& s) {
     std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    for (char c : s)
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return q + "'";
 }
 
@@ -38,7 +39,8 @@ std::string shellQuote(const std::string& s) {
 // newline in it would not arrive as written: refused here rather than mangled.
 std::string sbatchLine(const std::string& option) {
     if (option.find_first_of(" \t\n\r'\"\\") != std::string::npos)
-        throw UserError("sbatch option '" + option + "': blanks, quotes and backslashes are not supported in sbatch "
+        throw UserError("sbatch option '" + option +
+                        "': blanks, quotes and backslashes are not supported in sbatch "
                         "options written into the batch script");
     return "#SBATCH " + option + "\n";
 }
@@ -48,7 +50,8 @@ std::string commonLines(const SlurmOptions& o, const std::string& jobName, bool 
     if (!o.partition.empty()) s += sbatchLine("--partition=" + o.partition);
     if (!o.time.empty()) s += sbatchLine("--time=" + o.time);
     if (gpus && o.gpusPerTask > 0) s += sbatchLine("--gpus-per-task=" + std::to_string(o.gpusPerTask));
-    for (const std::string& a : o.sbatchArgs) s += sbatchLine(a);
+    for (const std::string& a : o.sbatchArgs)
+        s += sbatchLine(a);
     return s;
 }
 
@@ -62,8 +65,10 @@ std::string jobNameOf(const SweepFile& sweep) {
 std::string clockText(double seconds) {
     const long s = static_cast<long>(seconds + 0.5);
     char buf[32];
-    if (s >= 3600) std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
-    else std::snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
+    if (s >= 3600)
+        std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+    else
+        std::snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
     return buf;
 }
 
@@ -83,12 +88,13 @@ std::string submit(const std::vector<std::string>& argv, const fs::path& script)
     cmd.push_back(script.string());
     const Captured r = capture(cmd);
     if (r.notFound)
-        throw UserError("--slurm: '" + cmd[0] + "' not found on PATH: submitting needs Slurm's client commands "
+        throw UserError("--slurm: '" + cmd[0] +
+                        "' not found on PATH: submitting needs Slurm's client commands "
                         "(Debian: slurm-client) on this machine, configured for the cluster");
     std::string id = r.out.substr(0, r.out.find_first_of(";\n"));
     if (r.status != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
-        throw UserError("--slurm: `" + joinArgv(cmd) + "` failed (exit status " + std::to_string(r.status) +
-                        "):\n" + r.err + r.out);
+        throw UserError("--slurm: `" + joinArgv(cmd) + "` failed (exit status " + std::to_string(r.status) + "):\n" +
+                        r.err + r.out);
     return id;
 }
 
@@ -113,7 +119,8 @@ QueueState queryQueue(const std::string& ref, const std::string& array, const st
     for (std::string line; std::getline(lines, line);) {
         std::vector<std::string> f;
         std::stringstream ls(line);
-        for (std::string x; std::getline(ls, x, '|');) f.push_back(x);
+        for (std::string x; std::getline(ls, x, '|');)
+            f.push_back(x);
         if (f.size() < 4) continue;
         if (!array.empty() && f[0] == array) {
             ++q.array[f[2]];
@@ -149,7 +156,8 @@ std::string tailOf(const fs::path& file, size_t bytes) {
     ss << in.rdbuf();
     std::string s = ss.str();
     if (s.size() > bytes) s = "…" + s.substr(s.size() - bytes);
-    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+    while (!s.empty() && (s.back() == '\n' || s.back() == ' '))
+        s.pop_back();
     return s;
 }
 
@@ -199,7 +207,8 @@ SlurmOptions slurmOptions(const cli::Args& args, const SweepFile& sweep) {
         if (a.rfind("--", 0) != 0) throw UserError("--sbatch-arg '" + a + "': expected an sbatch option --name=value");
         o.sbatchArgs.push_back(a);
     }
-    for (const std::string& a : o.sbatchArgs) sbatchLine(a); // refuse what the script could not carry, before submitting
+    for (const std::string& a : o.sbatchArgs)
+        sbatchLine(a); // refuse what the script could not carry, before submitting
     o.wait = !args.has("no-wait");
     return o;
 }
@@ -217,7 +226,8 @@ std::string arrayScript(const SlurmOptions& options, const std::string& jobName,
     s += "echo \"array task $SLURM_ARRAY_TASK_ID: point $id on $(hostname)\"\n";
     s += "exec " + shellQuote(vitrine.string()) + " sweep " + shellQuote(sweepFile.string()) + " --out " +
          shellQuote(outDir.string()) + " --point \"$id\"";
-    for (const std::string& a : passThrough) s += " " + shellQuote(a);
+    for (const std::string& a : passThrough)
+        s += " " + shellQuote(a);
     return s + "\n";
 }
 
@@ -229,7 +239,8 @@ std::string referenceScript(const SlurmOptions& options, const std::string& jobN
     s += commonLines(options, jobName + "-reference", true);
     s += "exec " + shellQuote(vitrine.string()) + " sweep " + shellQuote(sweepFile.string()) + " --out " +
          shellQuote(outDir.string()) + " --reference-only";
-    for (const std::string& a : passThrough) s += " " + shellQuote(a);
+    for (const std::string& a : passThrough)
+        s += " " + shellQuote(a);
     return s + "\n";
 }
 
@@ -260,19 +271,24 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
     size_t done = 0, failedBefore = 0;
     for (const Point& p : points) {
         const PointState s = pointState(outDir, p);
-        if (s == PointState::Done) ++done;
-        else if (s == PointState::Failed && !retryFailed) ++failedBefore;
-        else todo.push_back(&p);
+        if (s == PointState::Done)
+            ++done;
+        else if (s == PointState::Failed && !retryFailed)
+            ++failedBefore;
+        else
+            todo.push_back(&p);
     }
     writePlan(outDir, planOf(sweep, points));
-    for (const Point* p : todo) fs::remove(outDir / "points" / p->id / "error.json", ec);
+    for (const Point* p : todo)
+        fs::remove(outDir / "points" / p->id / "error.json", ec);
 
     // Each submission gets its own numbered folder: a second `--slurm` while the first array runs must not change
     // the task -> point file the first one reads.
     const fs::path slurmDir = outDir / "slurm";
     fs::create_directories(slurmDir, ec);
     unsigned n = 1;
-    while (fs::exists(slurmDir / std::to_string(n), ec)) ++n;
+    while (fs::exists(slurmDir / std::to_string(n), ec))
+        ++n;
     const fs::path subDir = slurmDir / std::to_string(n);
     const fs::path logDir = subDir / "logs";
     fs::create_directories(logDir, ec);
@@ -287,12 +303,14 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
     std::string refJob, arrayJob;
     if (!todo.empty()) {
         std::string tasks;
-        for (const Point* p : todo) tasks += p->id + "\n";
+        for (const Point* p : todo)
+            tasks += p->id + "\n";
         writeFileAtomically(subDir / "tasks.txt", tasks);
         std::vector<std::string> sbatch = {"sbatch", "--parsable"};
         if (sweep.reference) {
             const fs::path script = subDir / "reference.sh";
-            writeFileAtomically(script, referenceScript(options, jobName, vitrine, sweepFile, outDir, logDir, passThrough));
+            writeFileAtomically(script,
+                                referenceScript(options, jobName, vitrine, sweepFile, outDir, logDir, passThrough));
             refJob = submit(sbatch, script);
             sbatch.push_back("--dependency=afterok:" + refJob);
             sbatch.push_back("--kill-on-invalid-dep=yes"); // a failed reference cancels the array
@@ -307,15 +325,15 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
     std::vector<std::string> collectCmd = {"sbatch", "--parsable"};
     if (!arrayJob.empty()) collectCmd.push_back("--dependency=afterany:" + arrayJob);
     const std::string collectJob = submit(collectCmd, collectSh);
-    writeFileAtomically(subDir / "jobs.json", nlohmann::json{{"reference", refJob},
-                                                              {"array", arrayJob},
-                                                              {"collect", collectJob},
-                                                              {"points", todo.size()}}
-                                                  .dump(2) + "\n");
+    writeFileAtomically(
+        subDir / "jobs.json",
+        nlohmann::json{{"reference", refJob}, {"array", arrayJob}, {"collect", collectJob}, {"points", todo.size()}}
+                .dump(2) +
+            "\n");
     std::printf("submitted: %s%s%s collect job %s; scripts and logs in %s\n",
                 refJob.empty() ? "" : ("reference job " + refJob + ", ").c_str(),
-                arrayJob.empty() ? "no array (nothing to run)," : ("array job " + arrayJob + " (" +
-                                                                   std::to_string(todo.size()) + " tasks),").c_str(),
+                arrayJob.empty() ? "no array (nothing to run),"
+                                 : ("array job " + arrayJob + " (" + std::to_string(todo.size()) + " tasks),").c_str(),
                 "", collectJob.c_str(), subDir.string().c_str());
     std::fflush(stdout);
     if (!options.wait) {
@@ -350,15 +368,16 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
         if (!q.ok) {
             if (++squeueFailures == 30)
                 throw UserError("--slurm: squeue failed 30 times in a row while waiting (the jobs may still run; "
-                                "`vitrine sweep --collect " + outDir.string() + "` gathers what they wrote): " + q.error);
+                                "`vitrine sweep --collect " +
+                                outDir.string() + "` gathers what they wrote): " + q.error);
             std::this_thread::sleep_for(std::chrono::seconds(2));
             continue;
         }
         squeueFailures = 0;
         const bool finished = q.collect.empty();
         if (tty) {
-            std::fprintf(stderr, "\r%s, %s elapsed   ", line.c_str(), clockText(
-                std::chrono::duration<double>(Clock::now() - start).count()).c_str());
+            std::fprintf(stderr, "\r%s, %s elapsed   ", line.c_str(),
+                         clockText(std::chrono::duration<double>(Clock::now() - start).count()).c_str());
         } else if (line != lastLine) {
             std::fprintf(stderr, "%s, %s elapsed\n", line.c_str(),
                          clockText(std::chrono::duration<double>(Clock::now() - start).count()).c_str());
@@ -366,8 +385,9 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
         lastLine = line;
         if (finished) break;
         if (cli::InterruptHandlers::received()) {
-            std::fprintf(stderr, "\nstopped waiting; the jobs go on (`scancel %s` stops them) and the collect job "
-                                 "writes %s when the array ends\n",
+            std::fprintf(stderr,
+                         "\nstopped waiting; the jobs go on (`scancel %s` stops them) and the collect job "
+                         "writes %s when the array ends\n",
                          (arrayJob.empty() ? collectJob : arrayJob + " " + collectJob).c_str(),
                          (outDir / "sweep.json").string().c_str());
             return cli::kExitInterrupted;
@@ -379,8 +399,8 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
 
     // Tasks Slurm ended without a result in their folder (time limit, node failure, cancelled, a failed reference):
     // recorded as failed with what Slurm says, so that the table shows them and --retry-failed reruns them.
-    const std::map<std::string, std::string> accounted = arrayJob.empty() ? std::map<std::string, std::string>{}
-                                                                           : accountedStates(arrayJob);
+    const std::map<std::string, std::string> accounted =
+        arrayJob.empty() ? std::map<std::string, std::string>{} : accountedStates(arrayJob);
     size_t lost = 0;
     for (size_t i = 0; i < todo.size(); ++i) {
         if (pointState(outDir, *todo[i]) != PointState::Todo) continue;
@@ -389,12 +409,13 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
         const fs::path log = logDir / (arrayJob + "_" + task + ".out");
         std::string why = "Slurm array task " + arrayJob + "_" + task + " ended without a result";
         if (accounted.count(task)) why += " (sacct: " + accounted.at(task) + ")";
-        if (fs::exists(log, ec)) why += "; log " + log.string() + ": " + tailOf(log, 1500);
+        if (fs::exists(log, ec))
+            why += "; log " + log.string() + ": " + tailOf(log, 1500);
         else
             why += "; it never started (cancelled" +
                    (refJob.empty() ? std::string()
-                                   : ", or the reference job " + refJob + " failed: " +
-                                         (logDir / ("reference-" + refJob + ".out")).string()) +
+                                   : ", or the reference job " + refJob +
+                                         " failed: " + (logDir / ("reference-" + refJob + ".out")).string()) +
                    ")";
         writePointError(outDir / "points" / todo[i]->id, *todo[i], why, 2);
     }

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-// `vitrine sweep FILE --slurm` (README "Sweeps", "On a Slurm cluster"): the points still to do become one Slurm job
+// `vitrine sweep FILE --slurm` (README "Sweeps on a Slurm cluster"): the points still to do become one Slurm job
 // array (`sbatch --array`), each array task running `vitrine sweep FILE --out DIR --point ID` with this same binary;
 // a second job that depends on the array (`--dependency=afterany:`) runs `vitrine sweep --collect DIR`. While they
 // run, squeue (and sacct where the cluster keeps accounting) and the points' folders give a progress line. No daemon

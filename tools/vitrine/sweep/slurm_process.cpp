@@ -17,7 +17,8 @@ Captured capture(const std::vector<std::string>& argv) {
     if (pipe2(out, O_CLOEXEC) != 0 || pipe2(err, O_CLOEXEC) != 0 || pipe2(status, O_CLOEXEC) != 0)
         throw InternalError(std::string("pipe: ") + std::strerror(errno));
     std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    for (const std::string& a : argv)
+        args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
     const pid_t pid = fork();
     if (pid < 0) throw InternalError(std::string("fork: ") + std::strerror(errno));

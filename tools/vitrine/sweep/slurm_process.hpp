@@ -7,8 +7,8 @@
 namespace vitrine::sweep {
 
 struct Captured {
-    int status = -1;        // exit status (128 + signal when killed)
-    bool notFound = false;  // argv[0] is not on PATH (or not executable)
+    int status = -1;       // exit status (128 + signal when killed)
+    bool notFound = false; // argv[0] is not on PATH (or not executable)
     std::string out, err;
 };
 
