@@ -143,6 +143,15 @@ after = stamps()
 check(all(after[k] == before[k] for k in before if k[0] != "p0004"), "--retry-failed leaves done points alone")
 check(after[("p0004", "error.json")] != before[("p0004", "error.json")], "--retry-failed reran p0004")
 
+# A folder of another sweep is refused rather than "resumed" with the wrong results.
+other = dict(sweep, axes=[{"name": "subpix", "set": "fxaa.params.subpix", "values": [0.25, 0.5, 1.0]}])
+other_file = os.path.join(work, "other.sweep.json")
+with open(other_file, "w") as f:
+    json.dump(other, f)
+rc, log = run(["sweep", other_file, "--out", out])
+check(rc == 1 and "holds the results of another sweep: point p0000" in log, f"another sweep's folder refused: {log}")
+check(stamps() == after, "the refused run changed nothing")
+
 # 4. --collect rebuilds the same table.
 with open(os.path.join(out, "sweep.csv")) as f:
     csv_before = f.read()

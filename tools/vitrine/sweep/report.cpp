@@ -80,20 +80,29 @@ struct Frame {
     double py(double v) const { return kH - kBottom - (v - y.lo) / (y.hi - y.lo) * (kH - kTop - kBottom); }
 };
 
+// Ticks at 1, 2 or 5 times a power of ten, about five across the range.
+std::vector<double> niceTicks(const Range& r) {
+    const double raw = (r.hi - r.lo) / 5.0;
+    const double power = std::pow(10.0, std::floor(std::log10(raw)));
+    const double step = raw / power < 1.5 ? power : raw / power < 3.5 ? 2 * power : raw / power < 7.5 ? 5 * power : 10 * power;
+    std::vector<double> ticks;
+    for (double v = std::ceil(r.lo / step) * step; v <= r.hi + step * 1e-9 && ticks.size() < 12; v += step)
+        ticks.push_back(std::fabs(v) < step * 1e-9 ? 0.0 : v);
+    return ticks;
+}
+
 void axesSvg(std::ostringstream& o, const Frame& f, const std::string& title, const std::string& xLabel,
              const std::string& yLabel, const std::vector<std::string>& categories) {
     o << "<text x='" << Frame::kW / 2 << "' y='16' class='t'>" << escapeHtml(title) << "</text>";
     o << "<rect x='" << Frame::kLeft << "' y='" << Frame::kTop << "' width='" << Frame::kW - Frame::kLeft - Frame::kRight
       << "' height='" << Frame::kH - Frame::kTop - Frame::kBottom << "' class='box'/>";
-    for (int i = 0; i <= 4; ++i) {
-        const double v = f.y.lo + (f.y.hi - f.y.lo) * i / 4.0;
+    for (double v : niceTicks(f.y)) {
         o << "<text x='" << Frame::kLeft - 4 << "' y='" << f.py(v) + 4 << "' class='yt'>" << fmt(v) << "</text>";
         o << "<line x1='" << Frame::kLeft << "' x2='" << Frame::kW - Frame::kRight << "' y1='" << f.py(v) << "' y2='"
           << f.py(v) << "' class='grid'/>";
     }
     if (categories.empty()) {
-        for (int i = 0; i <= 4; ++i) {
-            const double v = f.x.lo + (f.x.hi - f.x.lo) * i / 4.0;
+        for (double v : niceTicks(f.x)) {
             o << "<text x='" << f.px(v) << "' y='" << Frame::kH - Frame::kBottom + 16 << "' class='xt'>" << fmt(v)
               << "</text>";
         }
@@ -130,8 +139,12 @@ std::string metricAxisPlot(const json& table, const std::string& metric, const s
         if (std::find(categories.begin(), categories.end(), valueText(v)) == categories.end())
             categories.push_back(valueText(v));
     size_t missing = 0;
+    std::vector<Dot> levels; // points without a value on this axis (e.g. an extra variant): a dashed level line
     for (const json& row : table["points"]) {
-        if (!row["values"].contains(axis)) continue;
+        if (!row["values"].contains(axis)) {
+            if (const auto y = metricOf(row, column)) levels.push_back({0, *y, row["id"], row["label"], ""});
+            continue;
+        }
         const auto y = metricOf(row, column);
         if (!y) {
             ++missing;
@@ -160,13 +173,24 @@ std::string metricAxisPlot(const json& table, const std::string& metric, const s
         f.x.lo = -0.5;
         f.x.hi = static_cast<double>(categories.size()) - 0.5;
     }
+    for (const Dot& d : levels) yv.push_back(d.y);
     f.y.fit(yv);
     axesSvg(o, f, unitOf(column) + " vs " + axis, axis, unitOf(column), numeric ? std::vector<std::string>{} : categories);
     std::map<std::string, std::vector<const Dot*>> series;
     for (const Dot& d : dots) series[d.series].push_back(&d);
     size_t colour = 0;
     for (auto& [key, members] : series) {
-        const char* c = kPalette[colour++ % 8];
+        const char* c = kPalette[colour % 8];
+        if (series.size() > 1) {
+            // The legend: the other axes' values of this line.
+            std::string text;
+            const json others = json::parse(key);
+            for (const auto& [name, value] : others.items())
+                text += (text.empty() ? "" : ", ") + name + "=" + valueText(value);
+            o << "<text x='" << Frame::kLeft + 6 << "' y='" << Frame::kTop + 13 + 12 * colour << "' fill='" << c
+              << "' class='lg'>" << escapeHtml(text) << "</text>";
+        }
+        ++colour;
         std::sort(members.begin(), members.end(), [](const Dot* a, const Dot* b) { return a->x < b->x; });
         if (members.size() > 1) {
             o << "<polyline fill='none' stroke='" << c << "' stroke-width='1.5' points='";
@@ -178,10 +202,17 @@ std::string metricAxisPlot(const json& table, const std::string& metric, const s
               << "' r='4' fill='" << c << "'><title>" << escapeHtml(d->id + " " + d->label + ": " + fmt(d->y))
               << "</title></circle></a>";
     }
+    for (const Dot& d : levels)
+        o << "<a href='#" << escapeHtml(d.id) << "'><line x1='" << Frame::kLeft << "' x2='" << Frame::kW - Frame::kRight
+          << "' y1='" << f.py(d.y) << "' y2='" << f.py(d.y) << "' class='level'><title>"
+          << escapeHtml(d.id + " " + d.label + ": " + fmt(d.y)) << "</title></line></a><text x='"
+          << Frame::kW - Frame::kRight - 3 << "' y='" << f.py(d.y) - 3 << "' class='ll'>" << escapeHtml(d.label)
+          << "</text>";
     if (dots.empty())
         o << "<text x='" << Frame::kW / 2 << "' y='" << Frame::kH / 2 << "' class='t'>no finished point</text>";
     o << "</svg><figcaption>" << dots.size() << " point(s)";
     if (missing) o << "; " << missing << " without a value (failed or pending)";
+    if (!levels.empty()) o << "; dashed: " << levels.size() << " point(s) outside this axis";
     if (series.size() > 1) o << "; a line joins points that differ only in " << escapeHtml(axis);
     o << "</figcaption></figure>\n";
     return o.str();
@@ -259,7 +290,8 @@ std::string renderSweepReport(const json& table) {
          "svg .box{fill:#fafafa;stroke:#999}svg .grid{stroke:#e4e4e4}svg text{font:11px sans-serif}"
          "svg .t{text-anchor:middle;font-weight:bold}svg .yt{text-anchor:end}svg .xt{text-anchor:middle}"
          "svg .xl{text-anchor:middle}svg .pl{font-size:10px;fill:#444}svg .front{fill:#d62728}"
-         "svg .dominated{fill:#888}table{border-collapse:collapse;font-size:13px}"
+         "svg .dominated{fill:#888}svg .level{stroke:#555;stroke-dasharray:5 3;stroke-width:1.5}"
+         "svg .ll{text-anchor:end;font-size:10px;fill:#333}svg .lg{font-size:10px}table{border-collapse:collapse;font-size:13px}"
          "td,th{border:1px solid #ccc;padding:3px 6px;text-align:right}td.l,th.l{text-align:left}"
          "tr.failed{background:#fde2e2}tr.pending{background:#f3f3f3}img{image-rendering:pixelated;display:block}"
          "</style></head><body>\n";
@@ -273,11 +305,6 @@ std::string renderSweepReport(const json& table) {
 
     std::vector<std::string> axes;
     for (const json& a : table["axes"]) axes.push_back(a["name"]);
-    bool hasExtraAxisValues = false;
-    for (const json& row : table["points"])
-        for (const auto& [k, v] : row["values"].items())
-            if (std::find(axes.begin(), axes.end(), k) == axes.end()) hasExtraAxisValues = true;
-    (void)hasExtraAxisValues;
     o << "<h2>Metrics against each axis</h2>\n";
     for (const json& m : table["metrics"])
         for (const std::string& a : axes) o << metricAxisPlot(table, m, a);
@@ -289,7 +316,7 @@ std::string renderSweepReport(const json& table) {
 
     o << "<h2>Points</h2>\n<table><tr><th class='l'>id</th><th class='l'>label</th><th class='l'>status</th>";
     for (const json& c : table["columns"]) o << "<th>" << escapeHtml(c.get<std::string>()) << "</th>";
-    o << "<th>total ms</th><th class='l'>image</th><th class='l'>FLIP map</th></tr>\n";
+    o << "<th>point s</th><th class='l'>image</th><th class='l'>FLIP map</th></tr>\n";
     for (const json& row : table["points"]) {
         const std::string id = row["id"], status = row["status"];
         const std::string base = "points/" + id + "/";
@@ -315,7 +342,7 @@ std::string renderSweepReport(const json& table) {
             o << "</td>";
         }
         const json phases = row.value("phases_ms", json::object());
-        o << "<td>" << (phases.contains("total_ms") ? fmt(phases["total_ms"].get<double>()) : "") << "</td>";
+        o << "<td>" << (phases.contains("total_ms") ? fmt(phases["total_ms"].get<double>() / 1000.0) : "") << "</td>";
         for (const char* key : {"image", "flip"}) {
             o << "<td class='l'>";
             if (images.contains(key)) {
