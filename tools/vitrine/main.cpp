@@ -57,6 +57,11 @@ commands:
       DIR/points/<id>/ (default out/sweep/<FILE's stem>), DIR/sweep.json, sweep.csv and report.html.
       Resumable: done points are skipped, failed ones too unless --retry-failed. Exit 3: some point failed.
       --point ID|INDEX: run one point in this process (what the driver and Slurm array tasks run).
+  sweep FILE --slurm [--out DIR] [--partition P] [--time T] [--gpus-per-task N] [--sbatch-arg ARG]...
+        [--retry-failed] [--no-wait]
+      The same sweep as a Slurm job array (README "Sweeps on a Slurm cluster"): a reference job, one array task
+      per point still to do (this vitrine binary, DIR on a folder every node sees), and a dependent job running
+      --collect; squeue state shown while waiting. Options also from the sweep file's "slurm" block.
   sweep --collect DIR               Gather DIR/points/*/metrics.json into sweep.json, sweep.csv, report.html.
   devices                           List Vulkan devices.
 
@@ -78,7 +83,8 @@ int main(int argc, char** argv) {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
                                      "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm",
-                                     "jobs", "point", "collect", "devices"},
+                                     "jobs", "point", "collect", "devices",
+                                     "partition", "time", "gpus-per-task", "sbatch-arg"},
                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);

@@ -6,6 +6,7 @@
 #include "tools/vitrine/sweep/collect.hpp"
 #include "tools/vitrine/sweep/driver.hpp"
 #include "tools/vitrine/sweep/point.hpp"
+#include "tools/vitrine/sweep/slurm.hpp"
 #include "tools/vitrine/sweep/sweep_file.hpp"
 
 #include <cstdio>
@@ -26,6 +27,7 @@ int sweepCommand(const Args& args) {
     if (args.positional.size() != 1) throw UserError("sweep: expected one sweep FILE (vitrine-sweep/1 JSON)");
     const fs::path file = args.positional[0];
     const sweep::SweepFile sweep = sweep::parseSweepFile(file);
+    sweep::parseSlurmBlock(sweep.file, sweep.document); // its errors whether or not this run uses --slurm
     const std::vector<sweep::Point> points = sweep::expandPoints(sweep);
     const fs::path outDir = args.get("out", (fs::path("out") / "sweep" / file.stem()).string());
     if (args.has("list")) {
@@ -37,6 +39,7 @@ int sweepCommand(const Args& args) {
         sweep::renderReferences(sweep, points, outDir, args);
         return 0;
     }
+    if (args.has("slurm")) return sweep::runOnSlurm(args, sweep, points, outDir);
     sweep::DriverOptions options;
     options.sweepFile = file;
     options.outDir = outDir;

@@ -155,7 +155,7 @@ SweepFile parseSweepFile(const fs::path& path) {
     const nlohmann::json& d = s.document;
     if (!d.is_object()) c.fail("", "expected a JSON object (a vitrine-sweep/1 file)");
     c.onlyKeys(d, "", {"$schema", "format", "description", "graph", "reference", "output", "frame", "frames", "set",
-                       "axes", "combine", "points", "metrics", "keep"});
+                       "axes", "combine", "points", "metrics", "keep", "slurm"}); // "slurm": sweep/slurm.cpp
     if (!d.contains("format") || d["format"] != kFormat)
         c.fail("/format", std::string("expected \"") + kFormat + "\", got " +
                               (d.contains("format") ? d["format"].dump() : std::string("nothing")));
