@@ -269,17 +269,52 @@ export async function connect(page, from, to) {
     const boxOf = async id => {
         const h = page.locator(tid(id)).first();
         await h.waitFor({ state: 'attached', timeout: 10000 }).catch(() => fail(`no handle [data-testid="${id}"]`));
-        await h.scrollIntoViewIfNeeded().catch(() => {});
-        const b = await h.boundingBox();
+        // Nodes change size while their thumbnails load: wait until the handle stays put.
+        let b = await h.boundingBox();
+        for (let i = 0; i < 50; ++i) {
+            await page.waitForTimeout(100);
+            const c = await h.boundingBox();
+            if (b && c && b.x === c.x && b.y === c.y) break;
+            b = c;
+        }
         if (!b) fail(`handle ${id} is not visible`);
         return { x: b.x + b.width / 2, y: b.y + b.height / 2 };
     };
+    await waitIdle(page, 180000);
     const a = await boxOf(from);
     const b = await boxOf(to);
+    // A handle under another node cannot be reached by a user either: say so instead of dropping elsewhere.
+    for (const [id, p] of [[from, a], [to, b]]) {
+        const top = await page.evaluate(([id, x, y]) => {
+            const e = document.elementFromPoint(x, y);
+            if (!e) return 'nothing';
+            if (e.closest(`[data-testid="${id}"]`)) return null;
+            const node = e.closest('[data-testid^="node-"]');
+            return node ? `node ${node.dataset.testid.slice(5)}` : `<${e.tagName.toLowerCase()} class="${e.className}">`;
+        }, [id, p.x, p.y]);
+        if (top) fail(`handle ${id} is covered by ${top} at (${Math.round(p.x)}, ${Math.round(p.y)}): it cannot be dragged from or onto`);
+    }
     await page.mouse.move(a.x, a.y);
     await page.mouse.down();
     await page.mouse.move((a.x + b.x) / 2, (a.y + b.y) / 2, { steps: 8 });
     await page.mouse.move(b.x, b.y, { steps: 8 });
+    await page.mouse.up();
+}
+
+// Drags node NAME by its title strip to empty canvas below every node, as a user makes room for it.
+export async function moveNodeToFreeSpace(page, name) {
+    const boxes = await page.$$eval('.react-flow__node', els => els.map(e => {
+        const r = e.getBoundingClientRect();
+        return { id: e.querySelector('[data-testid^="node-"]')?.dataset.testid || e.dataset.testid, x: r.x, y: r.y, w: r.width, h: r.height };
+    }));
+    const me = boxes.find(b => b.id === `node-${name}`);
+    if (!me) fail(`no node ${name} to move`);
+    const others = boxes.filter(b => b !== me);
+    const left = Math.min(...others.map(b => b.x));
+    const bottom = Math.max(...others.map(b => b.y + b.h));
+    await page.mouse.move(me.x + 12, me.y + 6);
+    await page.mouse.down();
+    await page.mouse.move(left + 12, bottom + 40 + 6, { steps: 10 });
     await page.mouse.up();
 }
 

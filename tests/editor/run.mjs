@@ -12,7 +12,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import {
     Failure, checkPrerequisites, connect, deleteNode, edgeCount, fail, jsonDiff, launchBrowser, makeServedDir,
-    nodeNames, openGraph, parseArgs, pixelDifference, poll, previewInfo, readJson, resetGraphs, selectNode,
+    moveNodeToFreeSpace, nodeNames, openGraph, parseArgs, pixelDifference, poll, previewInfo, readJson, resetGraphs, selectNode,
     setParam, startServer, thumbnailPixels, tid, waitIdle, waitPreview, waitVisible,
 } from './lib.mjs';
 
@@ -171,6 +171,8 @@ const scenarios = [
             await expectNodes(page, ['grain'], 'palette');
             await poll(async () => (await page.locator(tid('inspector-name')).textContent().catch(() => '')).trim() === 'grain',
                        'palette: the new node grain is not selected', 10000);
+            // Out of the way of the other nodes, as a user would, wherever the palette put it.
+            await moveNodeToFreeSpace(page, 'grain');
             const edges0 = await edgeCount(page);
             await connect(page, 'out-pattern-color', 'in-grain-camera_state');
             await page.waitForTimeout(300);
@@ -306,6 +308,8 @@ async function main() {
             const consoleErrors = [];
             page.on('pageerror', e => pageErrors.push(e.message));
             page.on('console', m => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+            const badResponses = [];
+            page.on('response', r => { if (r.status() >= 400) badResponses.push(`${r.status()} ${r.request().method()} ${r.url().replace(server.url, '/')}`); });
             const t0 = Date.now();
             console.log(`--- ${sc.name}: ${sc.what}`);
             const log = msg => console.log(`    ${msg}`);
@@ -321,6 +325,7 @@ async function main() {
                 failed.push(sc.name);
                 console.log(`FAIL ${sc.name} (${((Date.now() - t0) / 1000).toFixed(1)} s): ${why}`);
                 if (consoleErrors.length) console.log(`    browser console errors: ${consoleErrors.slice(-5).join(' | ')}`);
+                if (badResponses.length) console.log(`    failed requests: ${badResponses.slice(-8).join(' | ')}`);
                 if (pageErrors.length) console.log(`    uncaught page errors: ${pageErrors.slice(-5).join(' | ')}`);
                 await page.screenshot({ path: path.join(out, `${sc.name}-FAIL.png`) }).catch(() => {});
             }
