@@ -191,7 +191,10 @@ export async function edgeCount(page) {
 export async function selectNode(page, name) {
     const node = page.locator(tid(`node-${name}`));
     await node.waitFor({ state: 'visible', timeout: 30000 }).catch(() => fail(`no node ${name} on the canvas`));
-    await node.click({ position: { x: 12, y: 6 } });
+    // 12 x 6 px into the title strip at 100 % zoom; proportionally less on a zoomed-out canvas.
+    const b = await node.boundingBox();
+    if (!b) fail(`node ${name} has no box on the page`);
+    await page.mouse.click(b.x + Math.min(12, b.width * 0.06), b.y + Math.min(6, b.height * 0.035));
     await poll(async () => (await page.locator(tid('inspector-name')).textContent().catch(() => '')).trim() === name,
                async () => `clicking node ${name}: inspector-name shows "${await page.locator(tid('inspector-name')).textContent().catch(() => 'nothing')}"`,
                10000);
@@ -316,6 +319,18 @@ export async function moveNodeToFreeSpace(page, name) {
     await page.mouse.down();
     await page.mouse.move(left + 12, bottom + 40 + 6, { steps: 10 });
     await page.mouse.up();
+}
+
+// Zooms the canvas in by STEPS wheel notches around node NAME (React Flow zooms about the cursor).
+export async function zoomAt(page, name, steps) {
+    const b = await page.locator(tid(`node-${name}`)).boundingBox();
+    if (!b) fail(`no node ${name} to zoom at`);
+    await page.mouse.move(b.x + b.width / 2, b.y + b.height / 2);
+    for (let i = 0; i < steps; ++i) {
+        await page.mouse.wheel(0, -100);
+        await page.waitForTimeout(150);
+    }
+    await page.waitForTimeout(500);
 }
 
 // Deletes a node: the delete-node button when there is one, else the Delete key, on the selected node.

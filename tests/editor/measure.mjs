@@ -8,14 +8,14 @@
 // The time includes the editor's debounce (about 300 ms) and the PNG's transfer and decoding: what a user waits.
 //
 // usage: node tests/editor/measure.mjs --vitrine build/vitrine [--source .] [--out build/editor-measure]
-//                                      [--repeat 5] [--edits 100] [--skip museum]
+//                                      [--repeat 5] [--edits 100] [--skip zoneplate,museum]
 import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import {
     Failure, checkPrerequisites, launchBrowser, makeServedDir, openGraph, parseArgs, previewInfo, rssKiB,
-    selectNode, setParam, startServer, waitIdle, waitPreview,
+    selectNode, setParam, startServer, waitIdle, waitPreview, zoomAt,
 } from './lib.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -83,6 +83,7 @@ async function main() {
         const n = Number(opts.repeat);
         const subpix = Array.from({ length: n }, (_, i) => [0, 0.25, 0.5, 1][i % 4]);
 
+        if (!skip.includes('zoneplate')) {
         console.log('fxaa_zoneplate.json: fxaa.subpix -> preview-tonemap-color');
         await openGraph(page, server.url, 'graphs/fxaa_zoneplate.json', { timeout: 600000 });
         const size = await previewInfo(page, 'preview-tonemap-color');
@@ -104,6 +105,7 @@ async function main() {
             }
         }
         results.rss = rss;
+        }
 
         if (!skip.includes('museum')) {
             console.log('museum.json (first opening bakes or loads the lightmaps)');
@@ -111,6 +113,17 @@ async function main() {
             await openGraph(page, server.url, 'graphs/museum.json', { timeout: 1800000 });
             results.museum_open_ms = Math.round(performance.now() - t0);
             console.log(`  opened and every thumbnail rendered after ${results.museum_open_ms} ms`);
+            // Candidates for the README's screenshot (docs/editor-museum.png), while the Museum is open.
+            await selectNode(page, 'grain');
+            await page.screenshot({ path: path.join(out, 'museum-fit.png') });
+            for (const [i, [at, steps]] of [['tonemap', 3], ['tonemap', 5], ['lighting', 4]].entries()) {
+                await page.locator('.react-flow__controls-fitview').click().catch(() => {});
+                await page.waitForTimeout(500);
+                await zoomAt(page, at, steps);
+                await page.screenshot({ path: path.join(out, `museum-zoom${i}.png`) });
+            }
+            await page.locator('.react-flow__controls-fitview').click().catch(() => {});
+            await page.waitForTimeout(500);
             const m = await previewInfo(page, 'preview-grain-color');
             const mn = Math.max(2, Math.min(n, 3));
             results.museum = {
@@ -118,7 +131,7 @@ async function main() {
                 ao_intensity_to_final: stats(await timeEdits(page, 'ao', 'intensity', [0.3, 0.7, 0.5].slice(0, mn), 'preview-grain-color')),
                 grain_strength_to_final: stats(await timeEdits(page, 'grain', 'strength', [0.02, 0.05, 0.01].slice(0, mn), 'preview-grain-color')),
             };
-            results.rss.push({ edits: 'after museum', kib: rssKiB(server.pid) });
+            results.museum_rss_kib = rssKiB(server.pid);
         }
     } finally {
         await browser.close().catch(() => {});
