@@ -162,6 +162,8 @@ function Editor() {
     };
   }, [loaded, schemas, store, track]);
 
+  useEffect(() => store.prioritize(selected), [store, selected]);
+
   const targets = useMemo(() => errorTargets(errors), [errors]);
   const dirty = loaded ? !deepEqual(loaded.doc, loaded.file.merged) : false;
 
