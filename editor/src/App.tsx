@@ -1,5 +1,5 @@
 import { ReactFlowProvider, useReactFlow } from '@xyflow/react';
-import { useCallback, useEffect, useMemo, useState, useSyncExternalStore } from 'react';
+import { useCallback, useEffect, useMemo, useRef, useState, useSyncExternalStore } from 'react';
 import * as api from './api';
 import { ABPanel } from './components/ABPanel';
 import { EditorContext, PreviewContext } from './components/context';
@@ -50,7 +50,10 @@ function Editor() {
   const [selected, setSelected] = useState<string | null>(null);
   const [status, setStatus] = useState('');
   const [errors, setErrors] = useState<api.ValidationError[]>([]);
-  const [pending, setPending] = useState(0);
+  // Starts at 1: busy until the schemas, the graph list and the ?graph= file are loaded.
+  const [pending, setPending] = useState(1);
+  const [validated, setValidated] = useState<JsonObject | null>(null);
+  const storeDoc = useRef<JsonObject | null>(null);
   const [viewer, setViewer] = useState<string | null>(null);
   const [abOpen, setAbOpen] = useState(false);
   const [files, setFiles] = useState<string[]>([]);
@@ -70,8 +73,9 @@ function Editor() {
 
   const open = useCallback(
     async (path: string, list = schemaList) => {
+      setPending((n) => n + 1);
       try {
-        const file = await track(openFile(path, api.readGraph));
+        const file = await openFile(path, api.readGraph);
         const map = schemaMap(list);
         setLoaded({ file, doc: file.merged, auto: autoLayout(file.merged, map) });
         setDangling([]);
@@ -83,22 +87,26 @@ function Editor() {
         window.history.replaceState(null, '', url);
       } catch (e) {
         setStatus(`cannot open ${path}: ${(e as Error).message}`);
+      } finally {
+        setPending((n) => n - 1);
       }
     },
-    [schemaList, track],
+    [schemaList],
   );
 
   // Start-up: schemas, the graph list, and the file named by ?graph=.
   useEffect(() => {
     void (async () => {
       try {
-        const [list, g] = await track(Promise.all([api.listNodes(), api.listGraphs()]));
+        const [list, g] = await Promise.all([api.listNodes(), api.listGraphs()]);
         setSchemaList(list);
         setGraphs(g);
         const initial = new URLSearchParams(window.location.search).get('graph');
         if (initial) await open(initial, list);
       } catch (e) {
         setStatus(`cannot reach vitrine serve: ${(e as Error).message}`);
+      } finally {
+        setPending((n) => n - 1);
       }
     })();
     // eslint-disable-next-line react-hooks/exhaustive-deps
@@ -137,20 +145,24 @@ function Editor() {
   useEffect(() => {
     if (!loaded || schemas.size === 0) return;
     store.update(loaded.file, loaded.doc, schemas);
+    storeDoc.current = loaded.doc;
     const controller = new AbortController();
     const timer = setTimeout(() => {
-      void track(
-        api
-          .validate({ document: documentForServer(loaded.file, loaded.doc), base: loaded.file.path }, controller.signal)
-          .then(setErrors)
-          .catch(() => undefined),
-      );
+      api
+        .validate({ document: documentForServer(loaded.file, loaded.doc), base: loaded.file.path }, controller.signal)
+        .then((errs) => {
+          setErrors(errs);
+          setValidated(loaded.doc);
+        })
+        .catch(() => undefined);
     }, 300);
     return () => {
       clearTimeout(timer);
       controller.abort();
     };
   }, [loaded, schemas, store, track]);
+
+  useEffect(() => store.prioritize(selected), [store, selected]);
 
   const targets = useMemo(() => errorTargets(errors), [errors]);
   const dirty = loaded ? !deepEqual(loaded.doc, loaded.file.merged) : false;
@@ -228,7 +240,9 @@ function Editor() {
     [edit],
   );
 
-  const busy = pending > 0 || previewsBusy;
+  // Busy until the previews and the server's validation have caught up with the document.
+  const catchingUp = loaded !== null && schemas.size > 0 && (storeDoc.current !== loaded.doc || validated !== loaded.doc);
+  const busy = pending > 0 || previewsBusy || catchingUp;
   const callbacks = useMemo(() => ({ openViewer: (key: string) => setViewer(key) }), []);
   const fileDir = loaded ? dirname(loaded.file.path) : '';
 

@@ -21,6 +21,8 @@ export interface Preview {
 
 export interface Progress {
   stage: string;
+  /** The graph node the server is executing, when its events say so. */
+  node?: string;
   done?: number;
   total?: number;
 }
@@ -124,9 +126,21 @@ export class PreviewStore {
     this.timer = setTimeout(() => void this.pump(), DEBOUNCE_MS);
   }
 
+  private first: string | null = null;
+
+  /** Renders the previews of node `id` (the selected one) before the others. */
+  prioritize(id: string | null): void {
+    this.first = id;
+  }
+
   private next(): [string, Entry] | undefined {
-    for (const [key, e] of this.entries) if (e.shown !== e.wanted) return [key, e];
-    return undefined;
+    let fallback: [string, Entry] | undefined;
+    for (const [key, e] of this.entries)
+      if (e.shown !== e.wanted) {
+        if (this.first !== null && key.startsWith(`${this.first}.`)) return [key, e];
+        fallback ??= [key, e];
+      }
+    return fallback;
   }
 
   private async pump(): Promise<void> {
@@ -174,7 +188,7 @@ export class PreviewStore {
 
   private onEvent(e: JobEvent): void {
     if (!this.running || e.job !== this.running.job) return;
-    this.progress.set(this.running.node, { stage: e.stage, done: e.done, total: e.total });
+    this.progress.set(this.running.node, { stage: e.stage, done: e.done, total: e.total, node: e.node });
     this.emit();
   }
 }

@@ -218,6 +218,7 @@ export function GraphCanvas(props: GraphCanvasProps) {
       deleteKeyCode={['Delete', 'Backspace']}
       colorMode="dark"
       fitView
+      fitViewOptions={{ minZoom: 0.3, maxZoom: 1 }}
       minZoom={0.05}
       proOptions={{ hideAttribution: true }}
     >

@@ -49,6 +49,7 @@ function ProgressBar({ node }: { node: string }) {
       <span>
         {p.stage}
         {p.total ? ` ${p.done ?? 0}/${p.total}` : ''}
+        {p.node && p.node !== node ? ` · ${p.node}` : ''}
       </span>
     </div>
   );

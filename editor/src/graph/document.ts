@@ -240,9 +240,11 @@ export function cardHeight(doc: JsonObject, id: string, schemas: SchemaMap): num
 
 /**
  * Positions for nodes without a stored `ui` position: columns by longest path from the sources (this frame's
- * inputs only), stacked by estimated card height; graph outputs in a last column.
+ * inputs only; a graph output one column right of what it shows), stacked by estimated card height. A long
+ * chain (the museum's ~25 stages) wraps into bands of columns, so that the whole graph is about as wide as
+ * high on screen rather than one very long row.
  */
-export function autoLayout(doc: JsonObject, schemas: SchemaMap): Map<string, Position> {
+export function autoLayout(doc: JsonObject, schemas: SchemaMap, aspect = 1.6): Map<string, Position> {
   const ids = Object.keys(nodesOf(doc));
   const depth = new Map<string, number>();
   const visiting = new Set<string>();
@@ -261,29 +263,41 @@ export function autoLayout(doc: JsonObject, schemas: SchemaMap): Map<string, Pos
     return d;
   };
   ids.forEach(depthOf);
-  const columns = new Map<number, string[]>();
-  for (const id of ids) {
-    const d = depth.get(id) ?? 0;
-    if (!columns.has(d)) columns.set(d, []);
-    columns.get(d)!.push(id);
-  }
-  const colWidth = 280;
-  const pos = new Map<string, Position>();
-  let lastColumn = 0;
-  for (const [d, col] of columns) {
-    lastColumn = Math.max(lastColumn, d);
-    let y = 0;
-    for (const id of col) {
-      pos.set(id, { x: d * colWidth, y });
-      y += cardHeight(doc, id, schemas) + 30;
-    }
-  }
-  let y = 0;
+  const items: { id: string; d: number; h: number }[] = ids.map((id) => ({ id, d: depth.get(id) ?? 0, h: cardHeight(doc, id, schemas) }));
   for (const name of Object.keys(outputsOf(doc))) {
     const r = parseRef(outputsOf(doc)[name]);
-    const from = r ? pos.get(r.node) : undefined;
-    pos.set(`${OUTPUT_PREFIX}${name}`, { x: (lastColumn + 1) * colWidth, y: from ? Math.max(from.y, y) : y });
-    y = (from ? Math.max(from.y, y) : y) + 80;
+    items.push({ id: `${OUTPUT_PREFIX}${name}`, d: r && depth.has(r.node) ? depth.get(r.node)! + 1 : 0, h: 40 });
+  }
+  const columns: { id: string; h: number }[][] = [];
+  for (const it of items) (columns[it.d] ??= []).push(it);
+  const colHeight = (c: { h: number }[] | undefined) => (c ?? []).reduce((sum, it) => sum + it.h + 30, 0);
+  const colWidth = 280;
+  const bandGap = 80;
+  const layers = columns.length;
+  // Columns per band: the count whose bounding box is closest to the wanted aspect ratio.
+  let perBand = layers;
+  let best = Infinity;
+  for (let n = 1; n <= layers; n++) {
+    let height = 0;
+    for (let b = 0; b < layers; b += n) height += Math.max(...columns.slice(b, b + n).map(colHeight)) + bandGap;
+    const score = Math.abs(Math.log((n * colWidth) / Math.max(height, 1) / aspect));
+    if (score < best) {
+      best = score;
+      perBand = n;
+    }
+  }
+  const pos = new Map<string, Position>();
+  let bandY = 0;
+  for (let b = 0; b < layers; b += perBand) {
+    const band = columns.slice(b, b + perBand);
+    band.forEach((col, i) => {
+      let y = bandY;
+      for (const it of col ?? []) {
+        pos.set(it.id, { x: i * colWidth, y });
+        y += it.h + 30;
+      }
+    });
+    bandY += Math.max(...band.map(colHeight)) + bandGap;
   }
   return pos;
 }

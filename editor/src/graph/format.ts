@@ -115,11 +115,14 @@ export function detectIndent(text: string): string {
   return m ? m[1] : '  ';
 }
 
-function compact(v: Json): string {
-  if (Array.isArray(v)) return `[${v.map(compact).join(', ')}]`;
+/** One-line JSON; `reuse` may supply the original text of an unchanged value (e.g. `1.0` stays `1.0`). */
+function compact(v: Json, ptr = '', reuse?: (v: Json, ptr: string) => string | undefined): string {
+  const old = reuse?.(v, ptr);
+  if (old !== undefined && !old.includes('\n')) return old;
+  if (Array.isArray(v)) return `[${v.map((x, i) => compact(x, `${ptr}/${i}`, reuse)).join(', ')}]`;
   if (isObject(v))
     return `{${Object.entries(v)
-      .map(([k, x]) => `${JSON.stringify(k)}: ${compact(x)}`)
+      .map(([k, x]) => `${JSON.stringify(k)}: ${compact(x, `${ptr}/${pointerToken(k)}`, reuse)}`)
       .join(', ')}}`;
   return JSON.stringify(v);
 }
@@ -135,19 +138,26 @@ export function formatJson(value: Json, options: FormatOptions = {}): string {
     }
   }
   const unit = options.indent ?? (original ? detectIndent(original) : '  ');
-  const width = options.width ?? 120;
+  // Lines as long as the file's longest (at least 120 columns): edits keep the author's layout.
+  // (Lines holding a single string, like a long description, do not count.)
+  const structural = (original ?? '').split('\n').filter((l) => !/^\s*"[^"]*": "(?:[^"\\]|\\.)*",?$/.test(l));
+  const width = options.width ?? Math.min(200, Math.max(120, ...structural.map((l) => l.length)));
   const lineIndentAt = (pos: number): string => {
     const lineStart = original!.lastIndexOf('\n', pos - 1) + 1;
     return /^[ \t]*/.exec(original!.slice(lineStart))![0];
   };
 
+  const reuse = (v: Json, ptr: string): string | undefined => {
+    const old = spans?.get(ptr);
+    return old && deepEqual(old.value, v) ? original!.slice(old.start, old.end) : undefined;
+  };
   const fmt = (v: Json, ptr: string, indent: string, column: number): string => {
     const old = spans?.get(ptr);
     if (old && deepEqual(old.value, v)) {
       const text = original!.slice(old.start, old.end);
       if (!text.includes('\n') || lineIndentAt(old.start) === indent) return text;
     }
-    const one = compact(v);
+    const one = compact(v, ptr, spans ? reuse : undefined);
     const container = Array.isArray(v) ? v.length > 0 : isObject(v) && Object.keys(v).length > 0;
     if (!container || (ptr !== '' && column + one.length <= width)) return one;
     const inner = indent + unit;
