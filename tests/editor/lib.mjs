@@ -143,7 +143,7 @@ export async function poll(fn, what, timeout = 30000, interval = 100) {
         } catch (e) {
             last = e;
         }
-        if (Date.now() > end) fail(`${typeof what === 'function' ? what(last) : what} (waited ${timeout / 1000} s)`);
+        if (Date.now() > end) fail(`${typeof what === 'function' ? await what(last) : what} (waited ${timeout / 1000} s)`);
         await new Promise(r => setTimeout(r, interval));
     }
 }
@@ -187,10 +187,45 @@ export async function edgeCount(page) {
     return page.locator('.react-flow__edge').count();
 }
 
+// Pans the canvas (dragging empty background, as a user does) until node NAME is inside it.
+export async function bringIntoView(page, name) {
+    const node = page.locator(tid(`node-${name}`));
+    for (let k = 0; k < 8; ++k) {
+        const c = await page.locator('.react-flow').first().boundingBox();
+        const b = await node.boundingBox();
+        if (!c || !b) fail(`node ${name} or the canvas has no box on the page`);
+        const m = 20;
+        if (b.x >= c.x + m && b.y >= c.y + m && b.x + Math.min(b.width, 200) <= c.x + c.width - m &&
+            b.y + Math.min(b.height, 60) <= c.y + c.height - m) return;
+        const clamp = (v, r) => Math.max(-r, Math.min(r, v));
+        const dx = clamp(c.x + c.width / 2 - (b.x + Math.min(b.width, 200) / 2), c.width / 2 - 40);
+        const dy = clamp(c.y + c.height / 2 - (b.y + Math.min(b.height, 60) / 2), c.height / 2 - 40);
+        // An empty spot of the pane from which the drag stays inside the canvas.
+        const start = await page.evaluate(([c, dx, dy]) => {
+            for (let gy = 0.1; gy < 0.95; gy += 0.05)
+                for (let gx = 0.1; gx < 0.95; gx += 0.05) {
+                    const x = c.x + gx * c.width, y = c.y + gy * c.height;
+                    if (x + dx < c.x + 10 || x + dx > c.x + c.width - 10 || y + dy < c.y + 10 || y + dy > c.y + c.height - 10) continue;
+                    const e = document.elementFromPoint(x, y);
+                    if (e && e.classList.contains('react-flow__pane')) return { x, y };
+                }
+            return null;
+        }, [c, dx, dy]);
+        if (!start) fail(`cannot pan node ${name} into view: no empty background to drag`);
+        await page.mouse.move(start.x, start.y);
+        await page.mouse.down();
+        await page.mouse.move(start.x + dx, start.y + dy, { steps: 10 });
+        await page.mouse.up();
+        await page.waitForTimeout(200);
+    }
+    fail(`node ${name} is still outside the canvas after panning`);
+}
+
 // Selects a node by clicking its title strip (not its thumbnail, which opens the viewer).
 export async function selectNode(page, name) {
     const node = page.locator(tid(`node-${name}`));
     await node.waitFor({ state: 'visible', timeout: 30000 }).catch(() => fail(`no node ${name} on the canvas`));
+    await bringIntoView(page, name);
     // 12 x 6 px into the title strip at 100 % zoom; proportionally less on a zoomed-out canvas.
     const b = await node.boundingBox();
     if (!b) fail(`node ${name} has no box on the page`);
@@ -323,6 +358,7 @@ export async function moveNodeToFreeSpace(page, name) {
 
 // Zooms the canvas in by STEPS wheel notches around node NAME (React Flow zooms about the cursor).
 export async function zoomAt(page, name, steps) {
+    await bringIntoView(page, name);
     const b = await page.locator(tid(`node-${name}`)).boundingBox();
     if (!b) fail(`no node ${name} to zoom at`);
     await page.mouse.move(b.x + b.width / 2, b.y + b.height / 2);

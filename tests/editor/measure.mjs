@@ -116,7 +116,7 @@ async function main() {
             // Candidates for the README's screenshot (docs/editor-museum.png), while the Museum is open.
             await selectNode(page, 'grain');
             await page.screenshot({ path: path.join(out, 'museum-fit.png') });
-            for (const [i, [at, steps]] of [['tonemap', 3], ['tonemap', 5], ['lighting', 4]].entries()) {
+            for (const [i, [at, steps]] of [['lens', 3], ['lens', 5], ['lighting', 4]].entries()) {
                 await page.locator('.react-flow__controls-fitview').click().catch(() => {});
                 await page.waitForTimeout(500);
                 await zoomAt(page, at, steps);

@@ -233,6 +233,48 @@ const scenarios = [
         },
     },
     {
+        name: 'viewer',
+        what: 'a click on a thumbnail opens the large viewer; its channel control re-renders (alpha: all white)',
+        async run(page, log) {
+            await openGraph(page, server.url, ZONEPLATE);
+            await waitPreview(page, 'preview-tonemap-color');
+            await page.locator(tid('preview-tonemap-color')).click();
+            await waitVisible(page, 'viewer', 'viewer: clicking the tonemap thumbnail', 10000);
+            const ready = async () => page.locator(tid('viewer-image')).evaluate(e => e.dataset.state !== 'loading' &&
+                                                                                        e.complete && e.naturalWidth > 0);
+            await poll(ready, 'viewer: viewer-image shows no image', 120000);
+            const rgb = await thumbnailPixels(page, 'viewer-image');
+            await page.locator(tid('viewer-channel')).selectOption('a');
+            await poll(async () => (await ready()) && pixelDifference(rgb, await thumbnailPixels(page, 'viewer-image')).mean > 20,
+                       'viewer: choosing channel "a" did not change the image (an opaque image\'s alpha is white)', 120000);
+            const a = await thumbnailPixels(page, 'viewer-image');
+            let dark = 0;
+            for (let i = 0; i < a.data.length; i += 4) if (a.data[i] < 250) ++dark;
+            log(`viewer ${a.width}x${a.height}; channel a: ${dark} of ${a.data.length / 4} pixels below 250`);
+            if (dark > a.data.length / 400) fail(`viewer: the alpha channel of the tone-mapped plate is not white (${dark} pixels)`);
+            await page.locator(tid('viewer-close')).click();
+            await poll(async () => !(await page.locator(tid('viewer')).isVisible().catch(() => false)), 'viewer: viewer-close did not close it', 10000);
+        },
+    },
+    {
+        name: 'prev_links',
+        what: "museum.json's @prev history links are drawn dashed and labelled @prev",
+        async run(page, log) {
+            await page.route('**/api/render', route => route.abort());
+            await openGraph(page, server.url, 'graphs/museum.json', { idle: false });
+            const expected = (fs.readFileSync(originalOf('graphs/museum.json'), 'utf8').match(/"[A-Za-z_0-9]+\.[A-Za-z_0-9]+@prev"/g) || []).length;
+            const drawn = await poll(async () => page.locator('.vitrine-edge-prev').count(), 'prev_links: no .vitrine-edge-prev wire', 30000);
+            const labels = await page.locator('.react-flow__edge-text, .react-flow__edgelabel-renderer').allTextContents();
+            const labelled = labels.join(' ').split('@prev').length - 1;
+            log(`${drawn} @prev wires drawn (${expected} "…@prev" references in the file), ${labelled} labels`);
+            if (drawn !== expected) fail(`prev_links: ${drawn} @prev wires drawn, the file has ${expected}`);
+            if (labelled < 1) fail('prev_links: no @prev label on the history wires');
+            const dashed = await page.locator('.vitrine-edge-prev path, path.vitrine-edge-prev').first()
+                .evaluate(e => getComputedStyle(e).strokeDasharray).catch(() => 'none');
+            if (!dashed || dashed === 'none') fail(`prev_links: the @prev wire is not dashed (stroke-dasharray ${dashed})`);
+        },
+    },
+    {
         name: 'ab',
         what: 'A/B of fxaa_zoneplate vs no_fxaa shows both images, the FLIP map and a FLIP value; A vs A gives 0',
         async run(page, log) {
