@@ -58,7 +58,7 @@ function Editor() {
   const [abOpen, setAbOpen] = useState(false);
   const [files, setFiles] = useState<string[]>([]);
   const store = useMemo(() => new PreviewStore(), []);
-  useEffect(() => () => store.dispose(), [store]);
+  useEffect(() => store.connect(), [store]);
   const previewsBusy = useSyncExternalStore(store.subscribe, () => store.busy());
 
   const track = useCallback(async <T,>(work: Promise<T>): Promise<T> => {
@@ -276,6 +276,7 @@ function Editor() {
                   onSelect={setSelected}
                   onStatus={setStatus}
                   onDanglingOutputs={setDangling}
+                  focus={new URLSearchParams(window.location.search).get('focus')}
                 />
               ) : (
                 <div className="empty">Open a graph from the list above.</div>

@@ -13,8 +13,10 @@ import {
   type Node,
   type NodeChange,
   type OnSelectionChangeParams,
+  useNodesInitialized,
+  useReactFlow,
 } from '@xyflow/react';
-import { useCallback, useEffect, useMemo, useState } from 'react';
+import { useCallback, useEffect, useMemo, useRef, useState } from 'react';
 import {
   edgesOf,
   nodesOf,
@@ -52,6 +54,8 @@ export interface GraphCanvasProps {
   onSelect(id: string | null): void;
   onStatus(message: string): void;
   onDanglingOutputs(names: string[]): void;
+  /** A node to centre on once the nodes are measured (the `?focus=` URL param), with its neighbours. */
+  focus?: string | null;
 }
 
 type FlowNode = Node<NodeCardData, 'vitrine'> | Node<OutputCardData, 'graphOutput'>;
@@ -70,11 +74,10 @@ export function GraphCanvas(props: GraphCanvasProps) {
   useEffect(() => {
     setFlowNodes((previous) => {
       const old = new Map(previous.map((n) => [n.id, n]));
-      const connected = new Map<string, string[]>();
       const next: FlowNode[] = [];
       for (const id of Object.keys(nodesOf(doc))) {
         const type = nodeType(doc, id);
-        const data: NodeCardData = { id, type, schema: schemas.get(type), error: nodeErrors.get(id), connected: connected.get(id) ?? [] };
+        const data: NodeCardData = { id, type, schema: schemas.get(type), error: nodeErrors.get(id) };
         const prev = old.get(id);
         const position = prev?.dragging ? prev.position : positionOf(id);
         next.push({ ...(prev ?? {}), id, type: 'vitrine', position, data } as FlowNode);
@@ -118,6 +121,20 @@ export function GraphCanvas(props: GraphCanvasProps) {
       return next;
     });
   }, []);
+
+  const flow = useReactFlow();
+  const initialized = useNodesInitialized();
+  const focused = useRef(false);
+  useEffect(() => {
+    if (!initialized || focused.current || !props.focus || !nodesOf(doc)[props.focus]) return;
+    focused.current = true;
+    const near = new Set([props.focus]);
+    for (const e of edgesOf(doc)) {
+      if (e.target === props.focus) near.add(e.source);
+      if (e.source === props.focus) near.add(e.target);
+    }
+    void flow.fitView({ nodes: [...near].map((id) => ({ id })), maxZoom: 1, padding: 0.1 });
+  }, [initialized, doc, flow, props.focus]);
 
   const onNodesChange = useCallback((changes: NodeChange<FlowNode>[]) => {
     setFlowNodes((nodes) => applyNodeChanges(changes.filter((c) => c.type !== 'remove'), nodes));

@@ -10,7 +10,6 @@ export interface NodeCardData extends Record<string, unknown> {
   type: string;
   schema?: NodeSchema;
   error?: string;
-  connected: string[];
 }
 
 export type NodeCardNode = Node<NodeCardData, 'vitrine'>;

@@ -268,8 +268,25 @@ export function autoLayout(doc: JsonObject, schemas: SchemaMap, aspect = 1.6): M
     const r = parseRef(outputsOf(doc)[name]);
     items.push({ id: `${OUTPUT_PREFIX}${name}`, d: r && depth.has(r.node) ? depth.get(r.node)! + 1 : 0, h: 40 });
   }
+  const layerItems: { id: string; h: number }[][] = [];
+  for (const it of items) (layerItems[it.d] ??= []).push(it);
+  // A layer taller than `maxColumn` (the museum's dozen debug views) is split into several columns.
+  const maxColumn = 1100;
   const columns: { id: string; h: number }[][] = [];
-  for (const it of items) (columns[it.d] ??= []).push(it);
+  for (const layer of layerItems) {
+    let col: { id: string; h: number }[] = [];
+    let height = 0;
+    for (const it of layer ?? []) {
+      if (col.length > 0 && height + it.h > maxColumn) {
+        columns.push(col);
+        col = [];
+        height = 0;
+      }
+      col.push(it);
+      height += it.h + 30;
+    }
+    columns.push(col);
+  }
   const colHeight = (c: { h: number }[] | undefined) => (c ?? []).reduce((sum, it) => sum + it.h + 30, 0);
   const colWidth = 280;
   const bandGap = 80;
