@@ -18,12 +18,13 @@ import {
 } from '@xyflow/react';
 import { useCallback, useEffect, useMemo, useRef, useState } from 'react';
 import {
+  checkConnection,
   edgesOf,
+  formatRef,
   nodesOf,
   nodeType,
   OUTPUT_PREFIX,
   outputsOf,
-  readsThisFrame,
   removeNodes,
   setInput,
   setNodePosition,
@@ -157,32 +158,20 @@ export function GraphCanvas(props: GraphCanvasProps) {
   const onConnect = useCallback(
     (c: Connection) => {
       if (!c.sourceHandle || !c.targetHandle) return;
-      const sourceKind = schemas.get(nodeType(doc, c.source))?.outputs.find((o) => o.name === c.sourceHandle)?.kind;
-      if (c.target.startsWith(OUTPUT_PREFIX)) {
-        const name = c.target.slice(OUTPUT_PREFIX.length);
-        if (sourceKind !== 'texture') {
-          onStatus(`refused: graph output '${name}' takes a texture, but ${c.source}.${c.sourceHandle} is a ${sourceKind}`);
-          return;
-        }
-        onEdit((d) => setOutput(d, name, { node: c.source, port: c.sourceHandle!, prev: false }));
-        props.onDanglingOutputs(danglingOutputs.filter((n) => n !== name));
-        onStatus(`connected ${c.source}.${c.sourceHandle} → output ${name}`);
+      const r = checkConnection(doc, schemas, c.source, c.sourceHandle, c.target, c.targetHandle);
+      if (!r.ok) {
+        onStatus(r.message);
         return;
       }
-      const input = schemas.get(nodeType(doc, c.target))?.inputs.find((i) => i.name === c.targetHandle);
-      if (!input || !sourceKind) return;
-      if (input.kind !== sourceKind) {
-        onStatus(`refused: input ${c.target}.${input.name} takes a ${input.kind}, but ${c.source}.${c.sourceHandle} is a ${sourceKind}`);
-        return;
+      const output = r.output;
+      if (output !== undefined) {
+        onEdit((d) => setOutput(d, output, r.ref));
+        props.onDanglingOutputs(danglingOutputs.filter((n) => n !== output));
+        onStatus(`connected ${formatRef(r.ref)} → output ${output}`);
+      } else {
+        onEdit((d) => setInput(d, r.target, r.port, r.ref));
+        onStatus(`connected ${formatRef(r.ref)} → ${r.target}.${r.port}`);
       }
-      // A wire back into a node this one (already) feeds reads last frame's value: an @prev history link.
-      const prev = c.source === c.target || readsThisFrame(doc, c.source, c.target);
-      if (prev && sourceKind !== 'texture') {
-        onStatus(`refused: ${c.source}.${c.sourceHandle} → ${c.target}.${input.name} would form a cycle, and only textures keep last frame's value`);
-        return;
-      }
-      onEdit((d) => setInput(d, c.target, input.name, { node: c.source, port: c.sourceHandle!, prev }));
-      onStatus(`connected ${c.source}.${c.sourceHandle}${prev ? '@prev' : ''} → ${c.target}.${input.name}`);
     },
     [doc, schemas, onEdit, onStatus, danglingOutputs, props],
   );

@@ -212,6 +212,44 @@ export function readsThisFrame(doc: JsonObject, reader: string, node: string): b
   return false;
 }
 
+export type ConnectResult =
+  | { ok: true; ref: PortRef; target: string; port: string; output?: string }
+  | { ok: false; message: string };
+
+/**
+ * What a wire from `source.sourcePort` to `target.targetPort` means (target `output:NAME` is a graph output):
+ * the kinds must match; a wire back into a node that (already) feeds the source reads last frame's value, an
+ * `@prev` history link, which only textures have.
+ */
+export function checkConnection(
+  doc: JsonObject,
+  schemas: SchemaMap,
+  source: string,
+  sourcePort: string,
+  target: string,
+  targetPort: string,
+): ConnectResult {
+  const sourceKind = schemas.get(nodeType(doc, source))?.outputs.find((o) => o.name === sourcePort)?.kind;
+  if (!sourceKind) return { ok: false, message: `refused: ${source} has no output '${sourcePort}'` };
+  if (target.startsWith(OUTPUT_PREFIX)) {
+    const name = target.slice(OUTPUT_PREFIX.length);
+    if (sourceKind !== 'texture')
+      return { ok: false, message: `refused: graph output '${name}' takes a texture, but ${source}.${sourcePort} is a ${sourceKind}` };
+    return { ok: true, ref: { node: source, port: sourcePort, prev: false }, target, port: 'value', output: name };
+  }
+  const input = schemas.get(nodeType(doc, target))?.inputs.find((i) => i.name === targetPort);
+  if (!input) return { ok: false, message: `refused: ${target} has no input '${targetPort}'` };
+  if (input.kind !== sourceKind)
+    return { ok: false, message: `refused: input ${target}.${input.name} takes a ${input.kind}, but ${source}.${sourcePort} is a ${sourceKind}` };
+  const prev = source === target || readsThisFrame(doc, source, target);
+  if (prev && sourceKind !== 'texture')
+    return {
+      ok: false,
+      message: `refused: ${source}.${sourcePort} → ${target}.${input.name} would form a cycle, and only textures keep last frame's value`,
+    };
+  return { ok: true, ref: { node: source, port: sourcePort, prev }, target, port: input.name };
+}
+
 /** The document without editor state (`ui` blocks), as the renderer sees it. */
 export function stripUi(doc: JsonObject): JsonObject {
   const out: JsonObject = { ...doc };
