@@ -2,11 +2,23 @@
 
 #include <unistd.h>
 
+#include <vector>
+
 namespace vitrine {
 
 namespace {
 LogLevel gLevel = LogLevel::Info;
+thread_local ProgressObserver tObserver;
+thread_local std::vector<const std::string*> tNodes;
+} // namespace
+
+ScopedProgressObserver::ScopedProgressObserver(ProgressObserver observer) : mPrevious(std::move(tObserver)) {
+    tObserver = std::move(observer);
 }
+ScopedProgressObserver::~ScopedProgressObserver() { tObserver = std::move(mPrevious); }
+
+ScopedProgressNode::ScopedProgressNode(const std::string& node) { tNodes.push_back(&node); }
+ScopedProgressNode::~ScopedProgressNode() { tNodes.pop_back(); }
 
 void setLogLevel(LogLevel level) { gLevel = level; }
 LogLevel logLevel() { return gLevel; }
@@ -19,8 +31,9 @@ void log(LogLevel level, const std::string& message) {
 
 Progress::Progress(std::string label, size_t total)
     : mLabel(std::move(label)), mTotal(total), mTerminal(isatty(STDERR_FILENO) != 0),
-      mStart(std::chrono::steady_clock::now()), mLastDraw(mStart) {
+      mStart(std::chrono::steady_clock::now()), mLastDraw(mStart), mLastNotify(mStart) {
     if (gLevel <= LogLevel::Info && mTotal > 1) draw(true);
+    notify(true);
 }
 
 Progress::~Progress() { finish(); }
@@ -29,15 +42,25 @@ void Progress::advance(size_t steps) {
     mDone += steps;
     if (mDone > mTotal) mDone = mTotal;
     draw(false);
+    notify(false);
 }
 
 void Progress::finish() {
     if (mFinished) return;
     mFinished = true;
-    if (gLevel > LogLevel::Info || mTotal <= 1) return;
     mDone = mTotal;
+    notify(true);
+    if (gLevel > LogLevel::Info || mTotal <= 1) return;
     draw(true);
     if (mTerminal) std::fputc('\n', stderr);
+}
+
+void Progress::notify(bool force) {
+    if (!tObserver) return;
+    auto now = std::chrono::steady_clock::now();
+    if (!force && now - mLastNotify < std::chrono::milliseconds(100) && mDone != mTotal) return;
+    mLastNotify = now;
+    tObserver(tNodes.empty() ? std::string() : *tNodes.front(), mLabel, mDone, mTotal);
 }
 
 void Progress::draw(bool force) {

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <string>
 
 namespace vitrine {
@@ -30,6 +31,7 @@ public:
 
 private:
     void draw(bool force);
+    void notify(bool force);
 
     std::string mLabel;
     size_t mTotal;
@@ -39,6 +41,35 @@ private:
     bool mFinished = false;
     std::chrono::steady_clock::time_point mStart;
     std::chrono::steady_clock::time_point mLastDraw;
+    std::chrono::steady_clock::time_point mLastNotify;
+};
+
+// Who else hears of long work: `vitrine serve` forwards a bake's progress to its clients. The observer is per thread
+// (the thread that does the work calls it), given the id of the graph node doing the work (the outermost one when
+// a node runs a graph of its own, as ibl.capture does; "" outside any node), the Progress label and its counts.
+// Called at most every 100 ms per Progress, and at its start and end.
+using ProgressObserver =
+    std::function<void(const std::string& node, const std::string& label, size_t done, size_t total)>;
+
+class ScopedProgressObserver {
+public:
+    explicit ScopedProgressObserver(ProgressObserver observer);
+    ~ScopedProgressObserver();
+    ScopedProgressObserver(const ScopedProgressObserver&) = delete;
+    ScopedProgressObserver& operator=(const ScopedProgressObserver&) = delete;
+
+private:
+    ProgressObserver mPrevious;
+};
+
+// Marks the graph node this thread works for while it lives (the compiler around a node's setup, the executor around
+// its execute). `node` must outlive the guard.
+class ScopedProgressNode {
+public:
+    explicit ScopedProgressNode(const std::string& node);
+    ~ScopedProgressNode();
+    ScopedProgressNode(const ScopedProgressNode&) = delete;
+    ScopedProgressNode& operator=(const ScopedProgressNode&) = delete;
 };
 
 } // namespace vitrine

@@ -1,6 +1,7 @@
 #include "core/graph/compiler.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/log.hpp"
 #include "core/gpu/formats.hpp"
 #include "core/graph/json_util.hpp"
 #include "core/graph/order.hpp"
@@ -197,7 +198,10 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
 
         Setup setup(g, p, decl);
         auto setupStart = std::chrono::steady_clock::now();
-        p.node->setup(setup);
+        {
+            ScopedProgressNode working(decl.id);
+            p.node->setup(setup);
+        }
         p.setupMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - setupStart).count();
         for (const auto& u : p.uses)
             if (u.output && !g.resources[u.resource].isTexture() && !g.resources[u.resource].object)

@@ -561,6 +561,7 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
         flush();
         mProfiler->beginScope(cmd, pi);
         PassContext ctx(*this, pi, cmd);
+        ScopedProgressNode working(pass.id);
         pass.node->execute(ctx);
         mProfiler->endScope(cmd, pi);
     }

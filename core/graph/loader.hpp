@@ -28,6 +28,12 @@ void applySet(nlohmann::json& document, const std::string& assignment);
 // Every error names the file, the JSON pointer and what was expected.
 GraphDesc validateGraph(const nlohmann::json& document, const std::string& file, const NodeRegistry& registry);
 
+// Phase 2 reporting every error it can find rather than the first: each param, input, output and top-level key is
+// checked on its own (a reference to a node whose declaration failed is not reported again). Empty when
+// validateGraph() would succeed. `vitrine serve` answers /api/validate with these, for the editor to mark them all.
+std::vector<std::string> validateGraphErrors(const nlohmann::json& document, const std::string& file,
+                                             const NodeRegistry& registry);
+
 // Phases 1 and 2.
 GraphDesc loadGraph(const std::filesystem::path& file, const std::vector<std::string>& sets = {});
 

@@ -16,8 +16,9 @@ using nlohmann::json;
 
 class Validator {
 public:
-    Validator(const json& doc, const std::string& file, const NodeRegistry& registry)
-        : mDoc(doc), mFile(file), mRegistry(registry) {}
+    Validator(const json& doc, const std::string& file, const NodeRegistry& registry,
+              std::vector<std::string>* collect = nullptr)
+        : mDoc(doc), mFile(file), mRegistry(registry), mCollect(collect) {}
 
     GraphDesc run() {
         GraphDesc g;
@@ -26,21 +27,45 @@ public:
         if (!mDoc.is_object()) fail("", "expected a JSON object (a vitrine graph)");
         static const std::set<std::string> kTop = {"$schema", "format", "description", "frame", "nodes", "outputs", "ui", "extends"};
         for (const auto& [key, value] : mDoc.items())
-            if (!kTop.count(key))
-                fail("/" + pointerToken(key), "unknown key; expected one of $schema, format, description, frame, nodes, outputs, ui");
-        if (auto it = mDoc.find("format"); it != mDoc.end() && *it != "vitrine-graph/1")
-            fail("/format", "expected \"vitrine-graph/1\", got " + brief(*it));
-        if (mDoc.contains("frame")) g.frame = frame(mDoc["frame"]);
+            attempt([&] {
+                if (!kTop.count(key))
+                    fail("/" + pointerToken(key), "unknown key; expected one of $schema, format, description, frame, nodes, outputs, ui");
+            });
+        attempt([&] {
+            if (auto it = mDoc.find("format"); it != mDoc.end() && *it != "vitrine-graph/1")
+                fail("/format", "expected \"vitrine-graph/1\", got " + brief(*it));
+        });
+        if (mDoc.contains("frame")) attempt([&] { g.frame = frame(mDoc["frame"]); });
         if (!mDoc.contains("nodes")) fail("/nodes", "missing; a graph needs an object of nodes keyed by id");
         const json& nodes = mDoc["nodes"];
         if (!nodes.is_object()) fail("/nodes", "expected an object keyed by node id, got " + brief(nodes));
-        for (const auto& [id, value] : nodes.items()) g.nodes.push_back(node(id, value));
-        for (auto& n : g.nodes) inputs(g, n, nodes[n.id]);
-        outputs(g);
+        for (const auto& [id, value] : nodes.items())
+            if (!attempt([&] { g.nodes.push_back(node(id, value)); })) mBroken.insert(id);
+        for (auto& n : g.nodes) attempt([&] { inputs(g, n, nodes[n.id]); });
+        attempt([&] { outputs(g); });
         return g;
     }
 
 private:
+    // Runs one independent check. Collecting (validateGraphErrors), its error is recorded and the checks after it
+    // go on; otherwise it propagates. False when it failed.
+    template <typename F>
+    bool attempt(F&& check) const {
+        if (!mCollect) {
+            check();
+            return true;
+        }
+        try {
+            check();
+            return true;
+        } catch (const UserError& e) {
+            mCollect->push_back(e.what());
+            return false;
+        } catch (const Skip&) {
+            return false;
+        }
+    }
+
     [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
         throw UserError(mFile + ": " + (pointer.empty() ? "/" : pointer) + ": " + message);
     }
@@ -76,8 +101,10 @@ private:
         if (!std::regex_match(id, kId)) fail(ptr, "node ids are letters, digits and '_', not starting with a digit");
         if (!value.is_object()) fail(ptr, "expected an object {type, params, in}, got " + brief(value));
         for (const auto& [key, v] : value.items())
-            if (key != "type" && key != "params" && key != "in" && key != "ui" && key != "doc")
-                fail(ptr + "/" + pointerToken(key), "unknown key; expected type, params, in, ui or doc");
+            attempt([&] {
+                if (key != "type" && key != "params" && key != "in" && key != "ui" && key != "doc")
+                    fail(ptr + "/" + pointerToken(key), "unknown key; expected type, params, in, ui or doc");
+            });
         auto type = value.find("type");
         if (type == value.end()) fail(ptr + "/type", "missing; every node needs a type (see `vitrine nodes`)");
         if (!type->is_string()) fail(ptr + "/type", "expected a node type name, got " + brief(*type));
@@ -90,13 +117,15 @@ private:
         if (auto p = value.find("params"); p != value.end()) {
             if (!p->is_object()) fail(ptr + "/params", "expected an object of params, got " + brief(*p));
             given = &*p;
-            for (const auto& [key, v] : p->items()) {
-                const ParamSpec* spec = n.schema->findParam(key);
-                std::string pptr = ptr + "/params/" + pointerToken(key);
-                if (!spec) fail(pptr, "node type " + n.schema->type + " has no param '" + key + "'" + listParams(*n.schema));
-                std::string expected = checkParam(*spec, v);
-                if (!expected.empty()) fail(pptr, "expected " + expected + ", got " + brief(v));
-            }
+            for (const auto& [key, v] : p->items())
+                attempt([&] {
+                    const ParamSpec* spec = n.schema->findParam(key);
+                    std::string pptr = ptr + "/params/" + pointerToken(key);
+                    if (!spec)
+                        fail(pptr, "node type " + n.schema->type + " has no param '" + key + "'" + listParams(*n.schema));
+                    std::string expected = checkParam(*spec, v);
+                    if (!expected.empty()) fail(pptr, "expected " + expected + ", got " + brief(v));
+                });
         }
         for (const auto& spec : n.schema->params)
             n.params[spec.name] = given && given->contains(spec.name) ? (*given)[spec.name] : spec.defaultValue;
@@ -130,6 +159,7 @@ private:
 
     const OutputPort& resolve(const GraphDesc& g, const PortRef& r, const std::string& ptr) const {
         int idx = g.findNode(r.node);
+        if (idx < 0 && mBroken.count(r.node)) throw Skip{}; // its own error is already recorded
         if (idx < 0) fail(ptr, "no node '" + r.node + "' in the graph (referenced as \"" + r.text() + "\")");
         const NodeSchema& s = *g.nodes[idx].schema;
         const OutputPort* out = s.findOutput(r.port);
@@ -145,7 +175,7 @@ private:
         const std::string ptr = "/nodes/" + pointerToken(n.id) + "/in";
         if (auto in = value.find("in"); in != value.end()) {
             if (!in->is_object()) fail(ptr, "expected an object {port: \"node.port\"}, got " + brief(*in));
-            for (const auto& [port, ref] : in->items()) {
+            for (const auto& [port, ref] : in->items()) attempt([&] {
                 std::string pptr = ptr + "/" + pointerToken(port);
                 const InputPort* ip = n.schema->findInput(port);
                 if (!ip) {
@@ -165,19 +195,19 @@ private:
                     fail(pptr, r.text() + ": only textures keep last frame's value; a " + toString(out.kind) +
                                    " is always the current frame's");
                 n.inputs[port] = r;
-            }
+            });
         }
         for (const auto& ip : n.schema->inputs)
-            if (!ip.optional && !n.inputs.count(ip.name))
-                fail(ptr + "/" + pointerToken(ip.name), "missing required input '" + ip.name + "' (" + toString(ip.kind) +
-                                                             ": " + ip.doc + ")");
+            if (!ip.optional && !n.inputs.count(ip.name) && !(mCollect && value.contains("in") && value["in"].contains(ip.name)))
+                attempt([&] { fail(ptr + "/" + pointerToken(ip.name), "missing required input '" + ip.name + "' (" + toString(ip.kind) +
+                                                             ": " + ip.doc + ")"); });
     }
 
     void outputs(GraphDesc& g) const {
         auto it = mDoc.find("outputs");
         if (it == mDoc.end() || !it->is_object() || it->empty())
             fail("/outputs", "expected a non-empty object {name: \"node.port\"}; without outputs nothing is rendered");
-        for (const auto& [name, ref] : it->items()) {
+        for (const auto& [name, ref] : it->items()) attempt([&] {
             std::string ptr = "/outputs/" + pointerToken(name);
             static const std::regex kName(R"([A-Za-z0-9_][A-Za-z0-9_./-]*)");
             if (!std::regex_match(name, kName) || name.find("..") != std::string::npos)
@@ -186,12 +216,16 @@ private:
             const OutputPort& out = resolve(g, r, ptr);
             if (out.kind != PortKind::Texture) fail(ptr, r.text() + " is a " + std::string(toString(out.kind)) + "; outputs must be textures");
             g.outputs.push_back({name, r});
-        }
+        });
     }
+
+    struct Skip {}; // a check that depends on a node whose declaration already failed (collecting only)
 
     const json& mDoc;
     std::string mFile;
     const NodeRegistry& mRegistry;
+    std::vector<std::string>* mCollect;
+    std::set<std::string> mBroken; // nodes whose declaration failed (collecting only)
 };
 
 } // namespace
@@ -204,6 +238,17 @@ int GraphDesc::findNode(const std::string& id) const {
 
 GraphDesc validateGraph(const nlohmann::json& document, const std::string& file, const NodeRegistry& registry) {
     return Validator(document, file, registry).run();
+}
+
+std::vector<std::string> validateGraphErrors(const nlohmann::json& document, const std::string& file,
+                                             const NodeRegistry& registry) {
+    std::vector<std::string> errors;
+    try {
+        Validator(document, file, registry, &errors).run();
+    } catch (const UserError& e) {
+        errors.push_back(e.what()); // a structural error after which nothing else can be checked
+    }
+    return errors;
 }
 
 } // namespace vitrine

@@ -10,7 +10,7 @@ const opt = (name, fallback) => {
 };
 const [url, out] = args;
 if (!url || !out) {
-  console.error('usage: node scripts/screenshot.mjs URL OUT.png [--wait-idle S] [--width W] [--height H] [--click SELECTOR]');
+  console.error('usage: node scripts/screenshot.mjs URL OUT.png [--wait-idle S] [--width W] [--height H] [--click SELECTOR] [--overview OUT2.png]');
   process.exit(2);
 }
 const browser = await chromium.launch({ executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', args: ['--no-sandbox'] });
@@ -33,4 +33,11 @@ if (click) {
   await page.waitForTimeout(Number(opt('--after-click-ms', 3000)));
 }
 await page.screenshot({ path: out });
+// --overview OUT2.png: also the whole graph (React Flow's fit-view control).
+const overview = opt('--overview', undefined);
+if (overview) {
+  await page.click('.react-flow__controls-fitview');
+  await page.waitForTimeout(800);
+  await page.screenshot({ path: overview });
+}
 await browser.close();

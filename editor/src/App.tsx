@@ -58,7 +58,7 @@ function Editor() {
   const [abOpen, setAbOpen] = useState(false);
   const [files, setFiles] = useState<string[]>([]);
   const store = useMemo(() => new PreviewStore(), []);
-  useEffect(() => () => store.dispose(), [store]);
+  useEffect(() => store.connect(), [store]);
   const previewsBusy = useSyncExternalStore(store.subscribe, () => store.busy());
 
   const track = useCallback(async <T,>(work: Promise<T>): Promise<T> => {
@@ -243,6 +243,19 @@ function Editor() {
   // Busy until the previews and the server's validation have caught up with the document.
   const catchingUp = loaded !== null && schemas.size > 0 && (storeDoc.current !== loaded.doc || validated !== loaded.doc);
   const busy = pending > 0 || previewsBusy || catchingUp;
+
+  // Ctrl/Cmd+S saves. (No beforeunload prompt: the dirty mark says it, and a prompt would block scripted
+  // navigation in browser tests.)
+  useEffect(() => {
+    const onKey = (e: KeyboardEvent) => {
+      if ((e.ctrlKey || e.metaKey) && e.key === 's') {
+        e.preventDefault();
+        void save();
+      }
+    };
+    window.addEventListener('keydown', onKey);
+    return () => window.removeEventListener('keydown', onKey);
+  }, [save]);
   const callbacks = useMemo(() => ({ openViewer: (key: string) => setViewer(key) }), []);
   const fileDir = loaded ? dirname(loaded.file.path) : '';
 
@@ -276,6 +289,7 @@ function Editor() {
                   onSelect={setSelected}
                   onStatus={setStatus}
                   onDanglingOutputs={setDangling}
+                  focus={new URLSearchParams(window.location.search).get('focus')}
                 />
               ) : (
                 <div className="empty">Open a graph from the list above.</div>

@@ -46,15 +46,13 @@ export class PreviewStore {
   private file: OpenFile | undefined;
   private doc: JsonObject | undefined;
   private generation = 0;
-  private stopEvents: () => void;
-
-  constructor() {
-    this.stopEvents = subscribeEvents((e) => this.onEvent(e));
-  }
-
-  dispose(): void {
-    this.stopEvents();
-    clearTimeout(this.timer);
+  /** Listens to the server's job events (for progress) until the returned function is called. */
+  connect(): () => void {
+    const stop = subscribeEvents((e) => this.onEvent(e));
+    return () => {
+      stop();
+      clearTimeout(this.timer);
+    };
   }
 
   subscribe = (fn: Listener): (() => void) => {

@@ -7,11 +7,24 @@ import { readdirSync, readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { applyMergePatch, deepEqual, diffMergePatch } from '../src/graph/mergePatch';
 import { formatJson, parseWithSpans, pointerTokens } from '../src/graph/format';
-import { edgesOf, removeNodes, setInput, setParam, uniqueNodeId, addNode, autoLayout, stripUi } from '../src/graph/document';
+import {
+  addNode,
+  autoLayout,
+  checkConnection,
+  edgesOf,
+  removeNodes,
+  setInput,
+  setNodePosition,
+  setOutputPosition,
+  setParam,
+  storedPosition,
+  stripUi,
+  uniqueNodeId,
+} from '../src/graph/document';
 import { newVariantText, openFile, serializeForSave, variantJson, documentForServer } from '../src/graph/files';
 import { dirname, join as pjoin, relative } from '../src/graph/paths';
 import { checkParam } from '../src/graph/schema';
-import type { Json, JsonObject, ParamSchema } from '../src/graph/types';
+import type { Json, JsonObject, NodeSchema, ParamSchema } from '../src/graph/types';
 
 const REPO = join(process.cwd(), '..');
 const read = async (p: string) => readFileSync(join(REPO, p), 'utf8');
@@ -173,4 +186,58 @@ test('client-side param checks follow the schema', () => {
   const v: ParamSchema = { name: 'c', type: 'vec3', default: [0, 0, 0] };
   assert.equal(checkParam(v, [1, 2, 3]), null);
   assert.ok(checkParam(v, [1, 2]));
+});
+
+// A few node schemas, written out as `vitrine nodes --json` gives them.
+const SCHEMAS = new Map(
+  [
+    { type: 'pattern.zoneplate', inputs: [], outputs: [{ name: 'color', kind: 'texture' }], params: [] },
+    { type: 'aa.fxaa', inputs: [{ name: 'color', kind: 'texture' }], outputs: [{ name: 'color', kind: 'texture' }], params: [] },
+    {
+      type: 'post.tonemap',
+      inputs: [
+        { name: 'color', kind: 'texture' },
+        { name: 'camera_state', kind: 'buffer', optional: true },
+      ],
+      outputs: [{ name: 'color', kind: 'texture' }],
+      params: [],
+    },
+    { type: 'scene.museum', inputs: [], outputs: [{ name: 'scene', kind: 'scene' }, { name: 'camera', kind: 'camera' }], params: [] },
+  ].map((s) => [s.type, s as NodeSchema]),
+);
+
+test('connections: kinds must match, a wire back upstream is an @prev link (textures only)', async () => {
+  const file = await openFile('graphs/fxaa_zoneplate.json', read);
+  const doc = addNode(file.merged, 'scene', 'scene.museum', { x: 0, y: 0 });
+  const ok = checkConnection(doc, SCHEMAS, 'pattern', 'color', 'tonemap', 'color');
+  assert.deepEqual(ok, { ok: true, ref: { node: 'pattern', port: 'color', prev: false }, target: 'tonemap', port: 'color' });
+  const kind = checkConnection(doc, SCHEMAS, 'scene', 'scene', 'fxaa', 'color');
+  assert.equal(kind.ok, false);
+  assert.match((kind as { message: string }).message, /takes a texture, but scene.scene is a scene/);
+  const buffer = checkConnection(doc, SCHEMAS, 'pattern', 'color', 'tonemap', 'camera_state');
+  assert.equal(buffer.ok, false);
+  // tonemap reads fxaa this frame: tonemap.color → fxaa.color closes a cycle, so it reads last frame's value.
+  const back = checkConnection(doc, SCHEMAS, 'tonemap', 'color', 'fxaa', 'color');
+  assert.deepEqual(back.ok && back.ref, { node: 'tonemap', port: 'color', prev: true });
+  const self = checkConnection(doc, SCHEMAS, 'fxaa', 'color', 'fxaa', 'color');
+  assert.deepEqual(self.ok && self.ref, { node: 'fxaa', port: 'color', prev: true });
+  const output = checkConnection(doc, SCHEMAS, 'fxaa', 'color', 'output:final', 'value');
+  assert.equal(output.ok && output.output, 'final');
+  assert.equal(checkConnection(doc, SCHEMAS, 'scene', 'camera', 'output:final', 'value').ok, false);
+  const prevDoc = setInput(doc, 'fxaa', 'color', { node: 'tonemap', port: 'color', prev: true });
+  assert.deepEqual(((prevDoc.nodes as JsonObject).fxaa as JsonObject).in, { color: 'tonemap.color@prev' });
+});
+
+test('moved nodes keep their positions in the ui block across save and open', async () => {
+  const path = 'graphs/fxaa_zoneplate.json';
+  const file = await openFile(path, read);
+  let doc = setNodePosition(file.merged, 'fxaa', { x: 300.4, y: -20 });
+  doc = setOutputPosition(doc, 'final', { x: 900, y: 0 });
+  const text = serializeForSave(file, doc);
+  const again = await openFile(path, async () => text);
+  assert.deepEqual(storedPosition(again.merged, 'fxaa'), { x: 300, y: -20 });
+  assert.deepEqual(storedPosition(again.merged, 'output:final'), { x: 900, y: 0 });
+  assert.equal(storedPosition(again.merged, 'pattern'), undefined);
+  // The renderer never sees them.
+  assert.deepEqual(stripUi(again.merged), file.merged);
 });

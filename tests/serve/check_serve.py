@@ -205,6 +205,15 @@ def main():
     check("graphs/link_out.json" not in listed and not any(p.startswith("linkdir") for p in listed),
           "GET /api/graphs leaves out files behind symlinks out of DIR")
 
+    r, body = server.json("GET", "/api/files?ext=png,.GLTF")
+    files = body.get("files", [])
+    check(r.status == 200 and "images/inside.png" in files and "scene/evil.gltf" in files and
+          not any(f.endswith(".json") for f in files), f"GET /api/files?ext= lists those extensions ({files[:6]})")
+    check(not any(f.startswith("linkdir") for f in files) and "graphs/link_out.json" not in files,
+          "GET /api/files leaves out files behind symlinks out of DIR")
+    r, body = server.json("GET", "/api/files")
+    check(r.status == 200 and "graphs/fxaa_zoneplate.json" in body.get("files", []), "GET /api/files lists every file")
+
     # GET -> PUT round trip, byte-identical; new files; malformed bodies.
     r, payload = server.request("GET", "/api/graphs/graphs/fxaa_zoneplate.json")
     check(r.status == 200 and payload == zoneplate_bytes, "GET a graph returns its bytes")
@@ -295,6 +304,43 @@ def main():
     r, _ = server.request("GET", "/api/images/999999")
     check(r.status == 404, "unknown image: 404")
 
+    def wait_image(url):
+        for _ in range(1200):
+            r, payload = server.request("GET", url)
+            if r.status != 202:
+                return r, payload
+            time.sleep(0.1)
+        return r, payload
+
+    # Several outputs of one run at once (the editor's thumbnails): each the same PNG as rendering it alone.
+    r, body = server.json("POST", "/api/render", {"graph": "graphs/fxaa_zoneplate.json", "width": 160, "height": 90,
+                                                  "outputs": ["final", "pattern.color"]})
+    urls = body.get("images", {}) if r.status == 200 else {}
+    check(r.status == 200 and sorted(urls) == ["final", "pattern.color"], f"render of two outputs at once ({body})")
+    if sorted(urls) == ["final", "pattern.color"]:
+        _, final = server.request("GET", urls["final"])
+        _, pattern = server.request("GET", urls["pattern.color"])
+        check(final == png1 and pattern == png3, "each of several outputs equals its render alone")
+    r, body = server.json("POST", "/api/render", {"graph": "graphs/fxaa_zoneplate.json", "outputs": ["nope"]})
+    check(r.status == 400 and body.get("pointer") == "/outputs/0", f"an unknown preview output: 400 ({body})")
+    r, body = server.json("POST", "/api/render", {"graph": "graphs/fxaa_zoneplate.json", "outputs": []})
+    check(r.status == 400 and body.get("pointer") == "/outputs", "an empty outputs list: 400")
+
+    # A tagged render replaces the queued one with the same tag that has not started (a newer edit's previews).
+    busy = {"graph": "graphs/fxaa_zoneplate.json", "width": 1280, "height": 720, "frames": 16, "async": True}
+    r, blocker = server.json("POST", "/api/render", busy)
+    first = {"graph": "graphs/fxaa_zoneplate.json", "width": 64, "height": 32, "async": True, "tag": "previews",
+             "outputs": ["final", "pattern.color"]}
+    r1, old = server.json("POST", "/api/render", first)
+    r2, new = server.json("POST", "/api/render", dict(first, set=["fxaa.params.subpix=0.0"]))
+    check(r1.status == 202 and r2.status == 202 and len(old.get("images", {})) == 2, "tagged async renders: 202")
+    ra, body = server.json("GET", old.get("images", {}).get("final", "/api/images/0"))
+    check(ra.status == 409 and body.get("superseded") is True, f"the superseded render's image: 409 ({ra.status})")
+    rb, payload = wait_image(new.get("images", {}).get("pattern.color", "/api/images/0"))
+    check(rb.status == 200 and png_size(payload) == (64, 32), "the newer tagged render is done")
+    rc, _ = wait_image(blocker.get("url", "/api/images/0"))
+    check(rc.status == 200, "the untagged render before them is done")
+
     # Validate.
     r, body = server.json("POST", "/api/validate", {"graph": "graphs/fxaa_zoneplate.json"})
     check(r.status == 200 and body.get("ok") is True and body.get("passes") == 3, "validate a good graph")
@@ -306,6 +352,14 @@ def main():
     r, body = server.json("POST", "/api/validate", {"document": bad, "base": "graphs/fxaa_zoneplate.json"})
     check(body.get("ok") is False and body["errors"][0].get("pointer") == "/nodes/fxaa/params/subpix",
           f"validate points at a wrong param ({body})")
+    # Every error at once, each with its pointer (the editor marks them all).
+    bad["nodes"]["fxaa"]["params"] = {"subpix": "lots", "edge_threshold_min": -1}
+    bad["nodes"]["fxaa"]["in"] = {"color": "pattern.nope"}
+    r, body = server.json("POST", "/api/validate", {"document": bad, "base": "graphs/fxaa_zoneplate.json"})
+    pointers = sorted(e.get("pointer") for e in body.get("errors", []))
+    check(body.get("ok") is False and pointers == ["/nodes/fxaa/in/color", "/nodes/fxaa/params/edge_threshold_min",
+                                                   "/nodes/fxaa/params/subpix"],
+          f"validate reports every error with its pointer ({pointers})")
     r, body = server.json("POST", "/api/validate", {"graph": "graphs/image_outside.json"})
     check(body.get("ok") is False and "refused" in body["errors"][0]["error"], "validate reports a path outside DIR")
 

@@ -117,6 +117,18 @@ int runCommand(const Args& args) {
 }
 
 int validateCommand(const Args& args) {
+    {
+        // Every error the document has at once (each param, input and output checked on its own), as the editor
+        // shows them; with one, the compile below reports it (and what only compiling finds).
+        const std::string file = graphArg(args);
+        nlohmann::json document = loadGraphDocument(file, setsWithFrames(args, 0, args.has("write-all"), file));
+        std::vector<std::string> errors = validateGraphErrors(document, file, NodeRegistry::global());
+        if (errors.size() > 1) {
+            for (const std::string& e : errors) log(LogLevel::Error, e);
+            log(LogLevel::Error, std::to_string(errors.size()) + " errors");
+            return 1;
+        }
+    }
     CompiledGraph graph = compileFromArgs(args);
     std::printf("%s: ok: %zu passes, %zu textures, %zu output(s)", graphArg(args).c_str(), graph.passes.size(),
                 graph.resources.size(), graph.outputs.size());

@@ -1,16 +1,12 @@
 // A/B: two graphs or variants (or the current edits) compared by the server (`vitrine compare`'s metrics and
 // FLIP map), shown as a split view with a slider.
 import { useState } from 'react';
-import { compare, type CompareResult, type GraphListEntry, type GraphRef } from '../api';
+import { compare, fetchImage, type CompareResult, type GraphListEntry, type GraphRef } from '../api';
 import { isObject, type Json } from '../graph/types';
 
 const CURRENT = '(current edits)';
 
-async function blobUrl(url: string): Promise<string> {
-  const res = await fetch(url);
-  if (!res.ok) throw new Error(`${url}: ${res.status}`);
-  return URL.createObjectURL(await res.blob());
-}
+const blobUrl = async (url: string): Promise<string> => URL.createObjectURL(await fetchImage(url));
 
 function metric(v: Json | undefined): string {
   return typeof v === 'number' ? String(Number(v.toPrecision(5))) : v === null ? '∞' : '–';
@@ -85,6 +81,8 @@ export function ABPanel(props: {
               <img data-testid="ab-image-a" src={result.a} alt="A" />
               <img data-testid="ab-image-b" src={result.b} alt="B" style={{ clipPath: `inset(0 0 0 ${split}%)` }} />
               <div className="split-line" style={{ left: `${split}%` }} />
+              <span className="split-label left">A</span>
+              <span className="split-label right">B</span>
             </div>
             <input type="range" min={0} max={100} data-testid="ab-slider" value={split} onChange={(e) => setSplit(Number(e.target.value))} />
             <div className="ab-side">

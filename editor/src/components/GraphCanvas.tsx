@@ -13,15 +13,18 @@ import {
   type Node,
   type NodeChange,
   type OnSelectionChangeParams,
+  useNodesInitialized,
+  useReactFlow,
 } from '@xyflow/react';
-import { useCallback, useEffect, useMemo, useState } from 'react';
+import { useCallback, useEffect, useMemo, useRef, useState } from 'react';
 import {
+  checkConnection,
   edgesOf,
+  formatRef,
   nodesOf,
   nodeType,
   OUTPUT_PREFIX,
   outputsOf,
-  readsThisFrame,
   removeNodes,
   setInput,
   setNodePosition,
@@ -52,6 +55,8 @@ export interface GraphCanvasProps {
   onSelect(id: string | null): void;
   onStatus(message: string): void;
   onDanglingOutputs(names: string[]): void;
+  /** A node to centre on once the nodes are measured (the `?focus=` URL param), with its neighbours. */
+  focus?: string | null;
 }
 
 type FlowNode = Node<NodeCardData, 'vitrine'> | Node<OutputCardData, 'graphOutput'>;
@@ -70,11 +75,10 @@ export function GraphCanvas(props: GraphCanvasProps) {
   useEffect(() => {
     setFlowNodes((previous) => {
       const old = new Map(previous.map((n) => [n.id, n]));
-      const connected = new Map<string, string[]>();
       const next: FlowNode[] = [];
       for (const id of Object.keys(nodesOf(doc))) {
         const type = nodeType(doc, id);
-        const data: NodeCardData = { id, type, schema: schemas.get(type), error: nodeErrors.get(id), connected: connected.get(id) ?? [] };
+        const data: NodeCardData = { id, type, schema: schemas.get(type), error: nodeErrors.get(id) };
         const prev = old.get(id);
         const position = prev?.dragging ? prev.position : positionOf(id);
         next.push({ ...(prev ?? {}), id, type: 'vitrine', position, data } as FlowNode);
@@ -119,6 +123,20 @@ export function GraphCanvas(props: GraphCanvasProps) {
     });
   }, []);
 
+  const flow = useReactFlow();
+  const initialized = useNodesInitialized();
+  const focused = useRef(false);
+  useEffect(() => {
+    if (!initialized || focused.current || !props.focus || !nodesOf(doc)[props.focus]) return;
+    focused.current = true;
+    const near = new Set([props.focus]);
+    for (const e of edgesOf(doc)) {
+      if (e.target === props.focus) near.add(e.source);
+      if (e.source === props.focus) near.add(e.target);
+    }
+    void flow.fitView({ nodes: [...near].map((id) => ({ id })), maxZoom: 1, padding: 0.1 });
+  }, [initialized, doc, flow, props.focus]);
+
   const onNodesChange = useCallback((changes: NodeChange<FlowNode>[]) => {
     setFlowNodes((nodes) => applyNodeChanges(changes.filter((c) => c.type !== 'remove'), nodes));
   }, []);
@@ -140,32 +158,20 @@ export function GraphCanvas(props: GraphCanvasProps) {
   const onConnect = useCallback(
     (c: Connection) => {
       if (!c.sourceHandle || !c.targetHandle) return;
-      const sourceKind = schemas.get(nodeType(doc, c.source))?.outputs.find((o) => o.name === c.sourceHandle)?.kind;
-      if (c.target.startsWith(OUTPUT_PREFIX)) {
-        const name = c.target.slice(OUTPUT_PREFIX.length);
-        if (sourceKind !== 'texture') {
-          onStatus(`refused: graph output '${name}' takes a texture, but ${c.source}.${c.sourceHandle} is a ${sourceKind}`);
-          return;
-        }
-        onEdit((d) => setOutput(d, name, { node: c.source, port: c.sourceHandle!, prev: false }));
-        props.onDanglingOutputs(danglingOutputs.filter((n) => n !== name));
-        onStatus(`connected ${c.source}.${c.sourceHandle} → output ${name}`);
+      const r = checkConnection(doc, schemas, c.source, c.sourceHandle, c.target, c.targetHandle);
+      if (!r.ok) {
+        onStatus(r.message);
         return;
       }
-      const input = schemas.get(nodeType(doc, c.target))?.inputs.find((i) => i.name === c.targetHandle);
-      if (!input || !sourceKind) return;
-      if (input.kind !== sourceKind) {
-        onStatus(`refused: input ${c.target}.${input.name} takes a ${input.kind}, but ${c.source}.${c.sourceHandle} is a ${sourceKind}`);
-        return;
+      const output = r.output;
+      if (output !== undefined) {
+        onEdit((d) => setOutput(d, output, r.ref));
+        props.onDanglingOutputs(danglingOutputs.filter((n) => n !== output));
+        onStatus(`connected ${formatRef(r.ref)} → output ${output}`);
+      } else {
+        onEdit((d) => setInput(d, r.target, r.port, r.ref));
+        onStatus(`connected ${formatRef(r.ref)} → ${r.target}.${r.port}`);
       }
-      // A wire back into a node this one (already) feeds reads last frame's value: an @prev history link.
-      const prev = c.source === c.target || readsThisFrame(doc, c.source, c.target);
-      if (prev && sourceKind !== 'texture') {
-        onStatus(`refused: ${c.source}.${c.sourceHandle} → ${c.target}.${input.name} would form a cycle, and only textures keep last frame's value`);
-        return;
-      }
-      onEdit((d) => setInput(d, c.target, input.name, { node: c.source, port: c.sourceHandle!, prev }));
-      onStatus(`connected ${c.source}.${c.sourceHandle}${prev ? '@prev' : ''} → ${c.target}.${input.name}`);
     },
     [doc, schemas, onEdit, onStatus, danglingOutputs, props],
   );

@@ -10,7 +10,6 @@ export interface NodeCardData extends Record<string, unknown> {
   type: string;
   schema?: NodeSchema;
   error?: string;
-  connected: string[];
 }
 
 export type NodeCardNode = Node<NodeCardData, 'vitrine'>;
@@ -80,7 +79,7 @@ export const NodeCard = memo(function NodeCard({ data, selected }: NodeProps<Nod
           </div>
         ))}
         {schema?.outputs.map((output) => (
-          <div className="port port-out" key={output.name} title={`${output.kind}: ${output.doc ?? ''}`}>
+          <div className="port port-out" key={output.name} title={`${output.kind}${output.format ? ` (${output.format})` : ''}: ${output.doc ?? ''}`}>
             <span>{output.name}</span>
             <Handle
               type="source"

@@ -25,6 +25,16 @@ export function Viewer(props: { file: OpenFile; doc: JsonObject; output: string;
       return;
     }
     let cancelled = false;
+    // Busy (and the image "loading") from the change on, through the debounce, until the new image is shown.
+    let released = false;
+    const release = () => {
+      if (!released) {
+        released = true;
+        onBusy(false);
+      }
+    };
+    setLoading(true);
+    onBusy(true);
     const view = uniqueNodeId(doc, 'debug.view');
     const [node, port] = output.split('.');
     const viewed: JsonObject = {
@@ -35,8 +45,6 @@ export function Viewer(props: { file: OpenFile; doc: JsonObject; output: string;
       },
     };
     const timer = setTimeout(async () => {
-      setLoading(true);
-      onBusy(true);
       try {
         const job = await startRender({ document: documentForServer(file, viewed), base: file.path }, { output: `${view}.color`, width: 960, height: 540 });
         const blob = await fetchImage(job.url);
@@ -51,12 +59,13 @@ export function Viewer(props: { file: OpenFile; doc: JsonObject; output: string;
         if (!cancelled) setError((e as Error).message);
       } finally {
         if (!cancelled) setLoading(false);
-        onBusy(false);
+        release();
       }
     }, 200);
     return () => {
       cancelled = true;
       clearTimeout(timer);
+      release();
     };
   }, [file, doc, output, channel, min, max, onBusy]);
 

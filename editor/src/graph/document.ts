@@ -212,6 +212,44 @@ export function readsThisFrame(doc: JsonObject, reader: string, node: string): b
   return false;
 }
 
+export type ConnectResult =
+  | { ok: true; ref: PortRef; target: string; port: string; output?: string }
+  | { ok: false; message: string };
+
+/**
+ * What a wire from `source.sourcePort` to `target.targetPort` means (target `output:NAME` is a graph output):
+ * the kinds must match; a wire back into a node that (already) feeds the source reads last frame's value, an
+ * `@prev` history link, which only textures have.
+ */
+export function checkConnection(
+  doc: JsonObject,
+  schemas: SchemaMap,
+  source: string,
+  sourcePort: string,
+  target: string,
+  targetPort: string,
+): ConnectResult {
+  const sourceKind = schemas.get(nodeType(doc, source))?.outputs.find((o) => o.name === sourcePort)?.kind;
+  if (!sourceKind) return { ok: false, message: `refused: ${source} has no output '${sourcePort}'` };
+  if (target.startsWith(OUTPUT_PREFIX)) {
+    const name = target.slice(OUTPUT_PREFIX.length);
+    if (sourceKind !== 'texture')
+      return { ok: false, message: `refused: graph output '${name}' takes a texture, but ${source}.${sourcePort} is a ${sourceKind}` };
+    return { ok: true, ref: { node: source, port: sourcePort, prev: false }, target, port: 'value', output: name };
+  }
+  const input = schemas.get(nodeType(doc, target))?.inputs.find((i) => i.name === targetPort);
+  if (!input) return { ok: false, message: `refused: ${target} has no input '${targetPort}'` };
+  if (input.kind !== sourceKind)
+    return { ok: false, message: `refused: input ${target}.${input.name} takes a ${input.kind}, but ${source}.${sourcePort} is a ${sourceKind}` };
+  const prev = source === target || readsThisFrame(doc, source, target);
+  if (prev && sourceKind !== 'texture')
+    return {
+      ok: false,
+      message: `refused: ${source}.${sourcePort} → ${target}.${input.name} would form a cycle, and only textures keep last frame's value`,
+    };
+  return { ok: true, ref: { node: source, port: sourcePort, prev }, target, port: input.name };
+}
+
 /** The document without editor state (`ui` blocks), as the renderer sees it. */
 export function stripUi(doc: JsonObject): JsonObject {
   const out: JsonObject = { ...doc };
@@ -268,8 +306,25 @@ export function autoLayout(doc: JsonObject, schemas: SchemaMap, aspect = 1.6): M
     const r = parseRef(outputsOf(doc)[name]);
     items.push({ id: `${OUTPUT_PREFIX}${name}`, d: r && depth.has(r.node) ? depth.get(r.node)! + 1 : 0, h: 40 });
   }
+  const layerItems: { id: string; h: number }[][] = [];
+  for (const it of items) (layerItems[it.d] ??= []).push(it);
+  // A layer taller than `maxColumn` (the museum's dozen debug views) is split into several columns.
+  const maxColumn = 1100;
   const columns: { id: string; h: number }[][] = [];
-  for (const it of items) (columns[it.d] ??= []).push(it);
+  for (const layer of layerItems) {
+    let col: { id: string; h: number }[] = [];
+    let height = 0;
+    for (const it of layer ?? []) {
+      if (col.length > 0 && height + it.h > maxColumn) {
+        columns.push(col);
+        col = [];
+        height = 0;
+      }
+      col.push(it);
+      height += it.h + 30;
+    }
+    columns.push(col);
+  }
   const colHeight = (c: { h: number }[] | undefined) => (c ?? []).reduce((sum, it) => sum + it.h + 30, 0);
   const colWidth = 280;
   const bandGap = 80;

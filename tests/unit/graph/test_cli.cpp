@@ -176,6 +176,17 @@ TEST(GraphCli, CycleErrorListsTheNodesOnTheCycle) {
         EXPECT_TRUE(edges.count({names[i], names[i + 1]})) << names[i] << " -> " << names[i + 1] << " in " << r.output;
 }
 
+TEST(GraphCli, ValidateListsEveryIndependentError) {
+    // Two errors in different nodes, given by --set on a good graph: both reported, each with its pointer.
+    CliResult r = vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json") +
+                          " --set fxaa.params.subpix=lots --set tonemap.params.exposure=bright");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("fxaa_zoneplate.json: /nodes/fxaa/params/subpix: expected"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("fxaa_zoneplate.json: /nodes/tonemap/params/exposure: expected"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("2 errors"), std::string::npos) << r.output;
+}
+
 TEST(GraphCli, ShippedGraphsValidate) {
     CliResult full = vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json"));
     EXPECT_EQ(full.status, 0) << full.output;

@@ -380,5 +380,38 @@ TEST(GraphCompile, RegistryRejectsBadDefaultsAndDuplicates) {
     EXPECT_EQ(testRegistry().find("test.p"), nullptr);
 }
 
+// validateGraphErrors (what `vitrine serve` answers /api/validate with): every independent error at once, each naming
+// its own pointer, and nothing reported twice for a node whose declaration failed.
+TEST(GraphValidate, EveryErrorIsReportedWithItsOwnPointer) {
+    json doc = {{"nodes",
+                 {{"a", {{"type", "test.source"}, {"colour", 1}}},
+                  {"b", {{"type", "test.filter"}, {"in", {{"in", "a.nope"}}}}},
+                  {"c", {{"type", "test.merge"}, {"in", {{"a", "a.out"}, {"b", "ghost.out"}, {"x", "a.out"}}}}},
+                  {"d", {{"type", "test.nosuch"}}},
+                  {"e", {{"type", "test.filter"}, {"in", {{"in", "d.out"}}}}}}},
+                {"outputs", {{"final", "c.out"}, {"bad", "a.missing"}}}};
+    std::vector<std::string> errors = validateGraphErrors(doc, "test.json", testRegistry());
+    std::set<std::string> pointers;
+    for (const std::string& e : errors) {
+        std::smatch m;
+        ASSERT_TRUE(std::regex_search(e, m, std::regex("^test\\.json: (/[^:]*): "))) << e;
+        pointers.insert(m[1]);
+    }
+    EXPECT_EQ(pointers, (std::set<std::string>{"/nodes/a/colour", "/nodes/b/in/in", "/nodes/c/in/b", "/nodes/c/in/x",
+                                               "/nodes/d/type", "/outputs/bad"}));
+    EXPECT_EQ(errors.size(), pointers.size()) << "an error reported twice";
+
+    // The first of them is the one validateGraph throws.
+    try {
+        validateGraph(doc, "test.json", testRegistry());
+        ADD_FAILURE() << "validateGraph accepted the graph";
+    } catch (const UserError& e) {
+        EXPECT_EQ(errors.front(), e.what());
+    }
+    EXPECT_TRUE(validateGraphErrors(diamond(), "test.json", testRegistry()).empty());
+    // A structural error after which nothing else can be checked is the only one.
+    EXPECT_EQ(validateGraphErrors(json{{"nodes", 3}}, "test.json", testRegistry()).size(), 1u);
+}
+
 } // namespace
 } // namespace vitrine

@@ -200,6 +200,7 @@ void Api::install(httplib::Server& server) {
                    res.set_content(graphJsonSchema(NodeRegistry::global()).dump(2) + "\n", "application/json");
                }));
     server.Get("/api/graphs", bind(&Api::listGraphs));
+    server.Get("/api/files", bind(&Api::listFiles));
     server.Get("/api/graphs/(.+)", bind(&Api::getGraph));
     server.Put("/api/graphs/(.+)", bind(&Api::putGraph));
     server.Post("/api/validate", bind(&Api::validate));

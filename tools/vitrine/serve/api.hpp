@@ -63,6 +63,7 @@ private:
 
     // api_files.cpp
     void listGraphs(const httplib::Request& req, httplib::Response& res);
+    void listFiles(const httplib::Request& req, httplib::Response& res);
     void getGraph(const httplib::Request& req, httplib::Response& res);
     void putGraph(const httplib::Request& req, httplib::Response& res);
     void staticFile(const httplib::Request& req, httplib::Response& res);
@@ -72,8 +73,22 @@ private:
         uint32_t width = 0, height = 0, frames = 0; // 0: the graph's own
         std::string output;
     };
+    // The document a request names (a file under DIR or sent inline), merged (extends, "set") and edited for the
+    // preview (size, frames, the output): not yet validated.
+    struct PreparedDocument {
+        nlohmann::json document;
+        std::filesystem::path file; // the file it is or stands for
+        std::string label;          // how errors name it
+        std::string output;
+        std::vector<std::string> previews; // "outputs": [...] asked for several at once
+    };
+    PreparedDocument prepareDocument(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
+    PreparedGraph prepare(const PreparedDocument& document, const std::string& pointer);
     PreparedGraph prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
-    RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph);
+    // Publishes a node's long work (a bake) as `stage: "node"` events of the job.
+    NodeProgressFn nodeProgress(const std::string& job, const std::string& kind, const std::string& file);
+    RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph,
+                           const std::string& tag = {});
     void validate(const httplib::Request& req, httplib::Response& res);
     void render(const httplib::Request& req, httplib::Response& res);
     void compare(const httplib::Request& req, httplib::Response& res);

@@ -107,6 +107,45 @@ void Api::listGraphs(const httplib::Request&, httplib::Response& res) {
     replyJson(res, 200, body);
 }
 
+void Api::listFiles(const httplib::Request& req, httplib::Response& res) {
+    // For the editor's path pickers: regular files under DIR, optionally only some extensions ("?ext=.cube,.png").
+    std::vector<std::string> extensions;
+    if (req.has_param("ext")) {
+        std::stringstream list(req.get_param_value("ext"));
+        for (std::string e; std::getline(list, e, ',');) {
+            if (e.empty()) continue;
+            if (e[0] != '.') e = "." + e;
+            std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+            extensions.push_back(e);
+        }
+    }
+    std::vector<std::string> files;
+    std::error_code ec;
+    size_t seen = 0;
+    bool truncated = false;
+    fs::recursive_directory_iterator it(mSandbox.root(), fs::directory_options::skip_permission_denied, ec), end;
+    for (; !ec && it != end; it.increment(ec)) {
+        if (++seen > kMaxListedFiles) {
+            truncated = true;
+            break;
+        }
+        const fs::directory_entry& entry = *it;
+        if (entry.is_directory(ec)) {
+            if (skippedDirectory(entry.path())) it.disable_recursion_pending();
+            continue;
+        }
+        if (!entry.is_regular_file(ec) || !mSandbox.contains(entry.path())) continue;
+        std::string ext = entry.path().extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+        if (!extensions.empty() && std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) continue;
+        files.push_back(mSandbox.relative(fs::weakly_canonical(entry.path())));
+    }
+    std::sort(files.begin(), files.end());
+    nlohmann::json body = {{"files", files}};
+    if (truncated) body["truncated"] = true;
+    replyJson(res, 200, body);
+}
+
 void Api::getGraph(const httplib::Request& req, httplib::Response& res) {
     const std::string relative = req.matches[1];
     const fs::path path = mSandbox.resolve(relative);

@@ -45,7 +45,8 @@ nlohmann::json specOf(const nlohmann::json& value, const std::string& pointer) {
 
 } // namespace
 
-PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults) {
+Api::PreparedDocument Api::prepareDocument(const nlohmann::json& spec, const std::string& pointer,
+                                           const Defaults& defaults) {
     // Where the document comes from: a file under the served directory, or the request itself (the editor's unsaved
     // graph; `base` is the file it stands for, from whose directory its relative paths and `extends` resolve).
     nlohmann::json document;
@@ -106,16 +107,58 @@ PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointe
         document["frame"]["frames"] = frames;
         document["frame"]["write"] = {frames - 1};
     }
+    // "outputs": several outputs of one run at once (the editor's thumbnails), each a graph output's name or any
+    // node's texture output "node.port"; they become the graph outputs preview_0, preview_1, ...
+    std::vector<std::string> previews;
+    if (spec.contains("outputs")) {
+        const nlohmann::json& list = spec["outputs"];
+        const std::string at = pointer + "/outputs";
+        if (!output.empty() && spec.contains("output"))
+            throw HttpError(400, "request body: " + at + ": give \"output\" or \"outputs\", not both",
+                            {{"pointer", at}});
+        if (!list.is_array() || list.empty() || list.size() > 256)
+            throw HttpError(400, "request body: " + at + ": expected an array of 1 to 256 outputs (\"node.port\")",
+                            {{"pointer", at}});
+        if (!document.contains("outputs") || !document["outputs"].is_object())
+            throw UserError(label + ": /outputs: expected an object {name: \"node.port\"}");
+        nlohmann::json outputs = nlohmann::json::object();
+        for (size_t i = 0; i < list.size(); ++i) {
+            const std::string item = pointer + "/outputs/" + std::to_string(i);
+            if (!list[i].is_string())
+                throw HttpError(400, "request body: " + item + ": expected \"node.port\" or an output's name",
+                                {{"pointer", item}});
+            const std::string ref = list[i].get<std::string>();
+            const auto named = document["outputs"].find(ref);
+            if (named != document["outputs"].end()) outputs["preview_" + std::to_string(i)] = *named;
+            else if (ref.find('.') != std::string::npos) outputs["preview_" + std::to_string(i)] = ref;
+            else
+                throw HttpError(400, "request body: " + item + ": \"" + ref +
+                                         "\" is neither a graph output nor \"node.port\"",
+                                {{"pointer", item}});
+            previews.push_back(ref);
+        }
+        document["outputs"] = outputs;
+        output.clear();
+    }
     // "node.port" that is not a graph output: any node's texture output as a preview.
-    if (!output.empty() && output.find('.') != std::string::npos && document.contains("outputs") &&
+    else if (!output.empty() && output.find('.') != std::string::npos && document.contains("outputs") &&
         document["outputs"].is_object() && !document["outputs"].contains(output)) {
         document["outputs"] = {{"preview", output}};
         output = "preview";
     }
 
+    return {std::move(document), std::move(file), std::move(label), std::move(output), std::move(previews)};
+}
+
+PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults) {
+    return prepare(prepareDocument(spec, pointer, defaults), pointer);
+}
+
+PreparedGraph Api::prepare(const PreparedDocument& doc, const std::string& pointer) {
+    const std::string& label = doc.label;
     PreparedGraph prepared;
-    prepared.desc = validateGraph(document, label, NodeRegistry::global());
-    prepared.desc.directory = file.parent_path();
+    prepared.desc = validateGraph(doc.document, label, NodeRegistry::global());
+    prepared.desc.directory = doc.file.parent_path();
     const FrameSettings& frame = prepared.desc.frame;
     if (static_cast<uint64_t>(frame.width) * frame.height > kMaxPixels)
         throw HttpError(400,
@@ -123,21 +166,39 @@ PreparedGraph Api::prepare(const nlohmann::json& spec, const std::string& pointe
                             " is larger than vitrine serve renders (at most 4096x4096 pixels); ask for a preview "
                             "size with \"width\" and \"height\"",
                         {{"pointer", pointer + "/width"}});
-    prepared.output = cli::pickOutput(prepared.desc, output);
+    mSandbox.checkPathParams(prepared.desc);
+    if (!doc.previews.empty()) {
+        prepared.previews = doc.previews;
+        return prepared;
+    }
+    prepared.output = cli::pickOutput(prepared.desc, doc.output);
     std::erase_if(prepared.desc.outputs, [&](const OutputDecl& o) { return o.name != prepared.output; });
     nlohmann::json kept = {{prepared.output, prepared.desc.document["outputs"][prepared.output]}};
     prepared.desc.document["outputs"] = kept;
-    mSandbox.checkPathParams(prepared.desc);
     return prepared;
 }
 
-RenderResult Api::renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph) {
+NodeProgressFn Api::nodeProgress(const std::string& job, const std::string& kind, const std::string& file) {
+    return [this, job, kind, file](const std::string& node, const std::string& label, size_t done, size_t total) {
+        mEvents.publish("job", {{"job", job},
+                                {"kind", kind},
+                                {"graph", file},
+                                {"stage", "node"},
+                                {"node", node},
+                                {"label", label},
+                                {"done", done},
+                                {"total", total}});
+    };
+}
+
+RenderResult Api::renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph,
+                            const std::string& tag) {
     const std::string file = graph.desc.file;
     auto progress = [&, job, kind, file](const std::string& stage, uint32_t done, uint32_t total) {
         mEvents.publish(
             "job", {{"job", job}, {"kind", kind}, {"graph", file}, {"stage", stage}, {"done", done}, {"total", total}});
     };
-    return mGpu.render(graph, progress);
+    return mGpu.render(graph, progress, nodeProgress(job, kind, file), tag);
 }
 
 void Api::validate(const httplib::Request& req, httplib::Response& res) {
@@ -145,8 +206,16 @@ void Api::validate(const httplib::Request& req, httplib::Response& res) {
     // As `vitrine validate`: the graph is loaded and compiled (every node's setup runs), nothing is rendered. The
     // compile runs on the GPU thread, after the jobs before it, because node setups build scenes and load files.
     try {
-        Defaults defaults;
-        PreparedGraph prepared = prepare(request, "", defaults);
+        PreparedDocument doc = prepareDocument(request, "", Defaults{});
+        // Every error the document has, each with its pointer, so that the editor marks them all at once.
+        std::vector<std::string> errors = validateGraphErrors(doc.document, doc.label, NodeRegistry::global());
+        if (!errors.empty()) {
+            nlohmann::json bodies = nlohmann::json::array();
+            for (const std::string& e : errors) bodies.push_back(userErrorBody(e));
+            replyJson(res, 200, {{"ok", false}, {"errors", bodies}});
+            return;
+        }
+        PreparedGraph prepared = prepare(doc, "");
         std::promise<nlohmann::json> done;
         std::future<nlohmann::json> result = done.get_future();
         mGpu.post([&] {
@@ -172,56 +241,108 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
     const auto start = std::chrono::steady_clock::now();
     const nlohmann::json request = parseRequestBody(req.body);
     const bool async = optionalBool(request, "async", false);
+    // A render with a tag replaces the queued one with the same tag that has not started yet (the editor tags its
+    // previews: only the latest edit's are worth rendering).
+    const std::string tag = optionalString(request, "tag");
     PreparedGraph prepared = prepare(request, "", Defaults{});
     const std::string job = newJobId();
-    mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"graph", prepared.desc.file}, {"stage", "queued"}});
+    const std::string file = prepared.desc.file;
+    mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"graph", file}, {"stage", "queued"}});
+
+    // Where a finished job's images go: the image store, and the answer's {"images": {output: url}}.
+    auto publishImages = [this](const PreparedGraph& graph, const RenderResult& r, const std::vector<std::string>& ids) {
+        nlohmann::json urls = nlohmann::json::object();
+        for (size_t i = 0; i < graph.previews.size(); ++i) {
+            const auto it = r.images.find("preview_" + std::to_string(i));
+            if (it == r.images.end()) throw InternalError("render: preview " + graph.previews[i] + " was not written");
+            const std::string id = ids.empty() ? mImages.reserve() : ids[i];
+            mImages.fulfil(id, pngString(it->second), it->second.width, it->second.height);
+            urls[graph.previews[i]] = "/api/images/" + id;
+        }
+        return urls;
+    };
 
     if (async) {
         // The job runs on the GPU thread after the queue; the client fetches /api/images/ID (202 until it is done).
-        const std::string id = mImages.reserve();
+        std::vector<std::string> ids(std::max<size_t>(prepared.previews.size(), 1));
+        for (auto& id : ids) id = mImages.reserve();
         auto shared = std::make_shared<PreparedGraph>(std::move(prepared));
-        mGpu.post([this, shared, job, id, start] {
-            try {
-                const std::string file = shared->desc.file;
-                RenderResult r = mGpu.renderNow(*shared, [&](const std::string& stage, uint32_t done, uint32_t total) {
+        auto progress = [this, job, file](const std::string& stage, uint32_t done, uint32_t total) {
+            mEvents.publish("job", {{"job", job},
+                                    {"kind", "render"},
+                                    {"graph", file},
+                                    {"stage", stage},
+                                    {"done", done},
+                                    {"total", total}});
+        };
+        auto fail = [this, ids, job](int status, const nlohmann::json& body, const std::string& stage) {
+            for (const auto& id : ids) mImages.fail(id, status, body);
+            mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", stage}, {"error", body.value("error", "")}});
+        };
+        mGpu.post(
+            [this, shared, job, ids, start, progress, fail, publishImages, file] {
+                try {
+                    RenderResult r = mGpu.renderNow(*shared, progress, nodeProgress(job, "render", file));
+                    if (shared->previews.empty())
+                        mImages.fulfil(ids[0], pngString(r.image), r.image.width, r.image.height);
+                    else
+                        publishImages(*shared, r, ids);
                     mEvents.publish("job", {{"job", job},
                                             {"kind", "render"},
-                                            {"graph", file},
-                                            {"stage", stage},
-                                            {"done", done},
-                                            {"total", total}});
-                });
-                mImages.fulfil(id, pngString(r.image), r.image.width, r.image.height);
-                mEvents.publish("job", {{"job", job},
-                                        {"kind", "render"},
-                                        {"stage", "done"},
-                                        {"image", id},
-                                        {"ms", msSince(start)},
-                                        {"warm", r.warm}});
-            } catch (const UserError& e) {
-                mImages.fail(id, 422, userErrorBody(e.what()));
-                mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
-            } catch (const std::exception& e) {
-                mImages.fail(id, 500, {{"error", std::string("internal error: ") + e.what()}});
-                mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
-            }
-        });
-        replyJson(res, 202, {{"job", job}, {"image", id}, {"url", "/api/images/" + id}});
+                                            {"stage", "done"},
+                                            {"image", ids[0]},
+                                            {"ms", msSince(start)},
+                                            {"warm", r.warm}});
+                } catch (const UserError& e) {
+                    fail(422, userErrorBody(e.what()), "error");
+                } catch (const std::exception& e) {
+                    fail(500, {{"error", std::string("internal error: ") + e.what()}}, "error");
+                }
+            },
+            tag,
+            [fail, tag] {
+                fail(409,
+                     {{"error", "superseded: a newer request with tag \"" + tag + "\" came before this one started"},
+                      {"superseded", true}},
+                     "superseded");
+            });
+        nlohmann::json answer = {{"job", job}, {"image", ids[0]}, {"url", "/api/images/" + ids[0]}};
+        if (!shared->previews.empty()) {
+            nlohmann::json urls = nlohmann::json::object();
+            for (size_t i = 0; i < shared->previews.size(); ++i) urls[shared->previews[i]] = "/api/images/" + ids[i];
+            answer = {{"job", job}, {"images", urls}};
+        }
+        replyJson(res, 202, answer);
         return;
     }
 
     try {
-        RenderResult r = renderJob(job, "render", prepared);
+        RenderResult r = renderJob(job, "render", prepared, tag);
         const double ms = msSince(start);
         mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "done"}, {"ms", ms}, {"warm", r.warm}});
         res.set_header("X-Vitrine-Job", job);
-        res.set_header("X-Vitrine-Output", prepared.output);
-        res.set_header("X-Vitrine-Width", std::to_string(r.image.width));
-        res.set_header("X-Vitrine-Height", std::to_string(r.image.height));
         res.set_header("X-Vitrine-Warm", r.warm ? "1" : "0");
         res.set_header("X-Vitrine-Ms", std::to_string(ms));
         res.set_header("X-Vitrine-Validation-Messages", std::to_string(r.validationMessages));
+        if (!prepared.previews.empty()) {
+            replyJson(res, 200,
+                      {{"job", job},
+                       {"images", publishImages(prepared, r, {})},
+                       {"width", r.image.width},
+                       {"height", r.image.height},
+                       {"ms", ms},
+                       {"warm", r.warm},
+                       {"validation_messages", r.validationMessages}});
+            return;
+        }
+        res.set_header("X-Vitrine-Output", prepared.output);
+        res.set_header("X-Vitrine-Width", std::to_string(r.image.width));
+        res.set_header("X-Vitrine-Height", std::to_string(r.image.height));
         res.set_content(pngString(r.image), "image/png");
+    } catch (const HttpError& e) {
+        mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", e.status() == 409 ? "superseded" : "error"},
+                                {"error", e.what()}});
+        throw;
     } catch (const std::exception& e) {
         mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", "error"}, {"error", e.what()}});
         throw;

@@ -3,6 +3,7 @@
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/graph/executor.hpp"
+#include "tools/vitrine/serve/http_util.hpp"
 
 namespace vitrine::serve {
 
@@ -95,13 +96,21 @@ size_t GpuWorker::queued() const {
     return mJobs.size();
 }
 
-void GpuWorker::post(std::function<void()> job) {
+void GpuWorker::post(std::function<void()> job, const std::string& tag, std::function<void()> cancel) {
+    std::vector<std::function<void()>> superseded;
     {
         std::lock_guard lock(mMutex);
         if (mStopping) throw InternalError("vitrine serve is stopping; the GPU queue takes no more work");
-        mJobs.push_back(std::move(job));
+        if (!tag.empty())
+            std::erase_if(mJobs, [&](Job& queued) {
+                if (queued.tag != tag) return false;
+                if (queued.cancel) superseded.push_back(std::move(queued.cancel));
+                return true;
+            });
+        mJobs.push_back({std::move(job), tag, std::move(cancel)});
     }
     mWake.notify_one();
+    for (auto& c : superseded) c(); // outside the lock: a cancel may publish events or fulfil promises
 }
 
 void GpuWorker::loop() {
@@ -111,7 +120,7 @@ void GpuWorker::loop() {
             std::unique_lock lock(mMutex);
             mWake.wait(lock, [&] { return mStopping || !mJobs.empty(); });
             if (mJobs.empty()) break; // stopping, and every job posted before has run
-            job = std::move(mJobs.front());
+            job = std::move(mJobs.front().run);
             mJobs.pop_front();
         }
         job();
@@ -121,22 +130,33 @@ void GpuWorker::loop() {
     mCtx.reset();
 }
 
-RenderResult GpuWorker::render(const PreparedGraph& graph, const ProgressFn& progress) {
+RenderResult GpuWorker::render(const PreparedGraph& graph, const ProgressFn& progress,
+                              const NodeProgressFn& nodeProgress, const std::string& tag) {
     std::promise<RenderResult> promise;
     std::future<RenderResult> result = promise.get_future();
-    // The caller waits for the future, so the job may refer to its arguments.
-    post([&] {
-        try {
-            promise.set_value(renderNow(graph, progress));
-        } catch (...) {
-            promise.set_exception(std::current_exception());
-        }
-    });
+    // The caller waits for the future, so the job may refer to its arguments. Either the job runs or it is
+    // cancelled (superseded), never both: a cancelled job has left the queue.
+    post(
+        [&] {
+            try {
+                promise.set_value(renderNow(graph, progress, nodeProgress));
+            } catch (...) {
+                promise.set_exception(std::current_exception());
+            }
+        },
+        tag,
+        [&] {
+            promise.set_exception(std::make_exception_ptr(
+                HttpError(409, "superseded: a newer request with tag \"" + tag + "\" came before this one started",
+                          {{"superseded", true}})));
+        });
     return result.get();
 }
 
-RenderResult GpuWorker::renderNow(const PreparedGraph& graph, const ProgressFn& progress) {
+RenderResult GpuWorker::renderNow(const PreparedGraph& graph, const ProgressFn& progress,
+                                  const NodeProgressFn& nodeProgress) {
     RenderResult out;
+    ScopedProgressObserver observer(nodeProgress);
     WarmGraphs::Entry* entry = nullptr;
     try {
         if (!mCtx) mCtx = std::make_unique<Context>(mOptions);
@@ -151,7 +171,10 @@ RenderResult GpuWorker::renderNow(const PreparedGraph& graph, const ProgressFn& 
         options.frames = frames;
         options.write = {frames - 1};
         options.progress = false;
-        options.onOutput = [&](uint32_t, const std::string&, const Image& image) { out.image = image; };
+        options.onOutput = [&](uint32_t, const std::string& name, const Image& image) {
+            out.image = image;
+            out.images[name] = image;
+        };
         uint32_t done = 0;
         options.stop = [&] {
             progress("rendering", ++done, frames);

@@ -11,6 +11,7 @@
 #include <functional>
 #include <future>
 #include <list>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -30,7 +31,10 @@ namespace vitrine::serve {
 // kept) and validated. WarmGraphs is keyed on its document, directory and file.
 struct PreparedGraph {
     GraphDesc desc;     // validated, its paths checked against the served directory
-    std::string output; // the one graph output left in it
+    std::string output; // the one graph output left in it ("" with previews)
+    // A request for several outputs at once ("outputs": [...], the editor's thumbnails): what it asked for, in order;
+    // preview i is the graph output "preview_i".
+    std::vector<std::string> previews;
 };
 
 // Compiled graphs with their executors (pipelines, images, uploaded scenes, baked resources) kept between requests,
@@ -54,9 +58,13 @@ private:
 
 // What a render job reports while it runs, on the GPU thread: "compiling", then "rendering" with frames done/total.
 using ProgressFn = std::function<void(const std::string& stage, uint32_t done, uint32_t total)>;
+// Long work inside one node (a bake, the probe capture), on the GPU thread: the node's id, what it does, its counts.
+using NodeProgressFn =
+    std::function<void(const std::string& node, const std::string& label, size_t done, size_t total)>;
 
 struct RenderResult {
-    Image image;
+    Image image;                         // the output at the last frame (with previews: the last one written)
+    std::map<std::string, Image> images; // every graph output at the last frame, by name
     bool warm = false;             // the compiled graph was kept from an earlier request
     size_t validationMessages = 0; // Vulkan validation messages during this job (with --validate)
 };
@@ -71,11 +79,16 @@ public:
 
     // Renders the frames of `graph` and returns its one output at the last frame. Blocks the calling thread until
     // the job has run on the GPU thread; rethrows what it threw.
-    RenderResult render(const PreparedGraph& graph, const ProgressFn& progress);
+    // A job posted with a `tag` replaces the queued job with the same tag that has not started (the editor's preview
+    // of a document it has edited since): that one fails with HttpError 409 "superseded".
+    RenderResult render(const PreparedGraph& graph, const ProgressFn& progress, const NodeProgressFn& nodeProgress = {},
+                        const std::string& tag = {});
     // Runs `job` on the GPU thread after the jobs before it (fire and forget: `job` handles its own errors).
-    void post(std::function<void()> job);
+    // With a `tag`, a queued job with the same tag that has not started is dropped and its `cancel` called.
+    void post(std::function<void()> job, const std::string& tag = {}, std::function<void()> cancel = {});
     // render() for a job already on the GPU thread.
-    RenderResult renderNow(const PreparedGraph& graph, const ProgressFn& progress);
+    RenderResult renderNow(const PreparedGraph& graph, const ProgressFn& progress,
+                           const NodeProgressFn& nodeProgress = {});
     // Runs the jobs already posted, then frees the device and ends the thread; later posts throw. Idempotent.
     void stop();
 
@@ -96,7 +109,12 @@ private:
 
     mutable std::mutex mMutex;
     std::condition_variable mWake;
-    std::deque<std::function<void()>> mJobs;
+    struct Job {
+        std::function<void()> run;
+        std::string tag;
+        std::function<void()> cancel;
+    };
+    std::deque<Job> mJobs;
     bool mStopping = false;
     std::thread mThread;
 };
