@@ -20,6 +20,15 @@ packages=(
 if [ "${1:-}" = "--fuzz" ]; then
     packages+=(clang libclang-rt-dev)
 fi
+# The graph editor (editor/): its browser tests drive Debian's Chromium (tests/editor/); Node.js >= 18 builds it.
+# Debian's nodejs (18.20 on bookworm) and npm only when no node >= 18 is installed (e.g. NodeSource's, which
+# bundles npm and conflicts with Debian's npm package).
+packages+=(chromium)
+if ! node -e 'process.exit(Number(process.versions.node.split(".")[0]) >= 18 ? 0 : 1)' 2>/dev/null; then
+    packages+=(nodejs npm)
+elif ! command -v npm >/dev/null; then
+    packages+=(npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -28,15 +37,29 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
     echo "install-deps: all ${#packages[@]} packages present"
-    exit 0
+else
+    sudo=""
+    if [ "$(id -u)" -ne 0 ]; then
+        command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+        sudo="sudo"
+    fi
+    echo "install-deps: installing ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    $sudo apt-get update -qq
+    $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-sudo=""
-if [ "$(id -u)" -ne 0 ]; then
-    command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
-    sudo="sudo"
+# The editor's npm packages, exactly as its committed lockfile pins them (npm ci), only when the lockfile changed
+# since the last install (the stamp holds its hash and the node version). Nothing here downloads a browser.
+editor="$(dirname "$0")/../editor"
+if [ -f "$editor/package-lock.json" ]; then
+    want="$(sha256sum < "$editor/package-lock.json" | cut -d' ' -f1) node $(node --version)"
+    stamp="$editor/node_modules/.vitrine-install-stamp"
+    if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
+        echo "install-deps: editor/node_modules is current"
+    else
+        echo "install-deps: npm ci in editor/ (from package-lock.json)"
+        (cd "$editor" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund)
+        echo "$want" > "$stamp"
+    fi
 fi
-echo "install-deps: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

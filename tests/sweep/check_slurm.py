@@ -137,6 +137,21 @@ def main():
             check(r.returncode == 0, f"second --slurm exit 0 (got {r.returncode}): {r.stderr[-2000:]}")
             check("0 to submit" in r.stdout and "no array" in r.stdout, f"second --slurm submits no array: {r.stdout}")
 
+            # Another sweep's folder is refused before anything is submitted (resume would trust its results).
+            with open(sweep_file) as f:
+                other = json.load(f)
+            other["axes"][0]["values"] = list(reversed(other["axes"][0]["values"]))
+            for key in ("graph", "reference"):  # relative to the sweep file, which moves to `work`
+                if isinstance(other.get(key), str):
+                    other[key] = os.path.join(os.path.dirname(os.path.abspath(sweep_file)), other[key])
+            other_file = os.path.join(work, "other.sweep.json")
+            with open(other_file, "w") as f:
+                json.dump(other, f)
+            r = run(["sweep", other_file, "--out", out, "--slurm"], env)
+            check(r.returncode == 1 and "holds the results of another sweep" in r.stderr and
+                  not os.path.exists(os.path.join(out, "slurm", "3")),
+                  f"--slurm refuses another sweep's folder: {r.returncode} {r.stderr[-800:]}")
+
             # --no-wait: returns at once; the jobs finish on their own.
             out2 = os.path.join(work, "nowait")
             r = run(["sweep", sweep_file, "--out", out2, "--slurm", "--no-wait"], env)

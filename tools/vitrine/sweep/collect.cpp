@@ -47,6 +47,21 @@ std::vector<std::string> columnsOf(const std::string& metric) {
 
 } // namespace
 
+void checkSamePlan(const fs::path& outDir, const nlohmann::json& plan) {
+    std::ifstream in(outDir / "sweep-plan.json");
+    if (!in) return;
+    const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
+    if (!old.is_object() || !old.contains("points") || !old["points"].is_array()) return;
+    for (const auto& o : old["points"])
+        for (const auto& n : plan["points"])
+            if (o.value("id", "") == n["id"] &&
+                (o.value("graph", "") != n["graph"] || o.value("sets", nlohmann::json()) != n["sets"] ||
+                 o.value("frames", "") != n["frames"]))
+                throw UserError(outDir.string() + " holds the results of another sweep: point " +
+                                n["id"].get<std::string>() + " was '" + o.value("label", "") + "' there, is '" +
+                                n["label"].get<std::string>() + "' here; choose another --out or delete it");
+}
+
 void writePlan(const fs::path& outDir, const nlohmann::json& plan) {
     std::error_code ec;
     fs::create_directories(outDir / "points", ec);

@@ -16,6 +16,10 @@ struct CollectSummary {
     size_t pending = 0;
 };
 
+// Resuming (locally or on Slurm) trusts the files in DIR/points/: throws UserError when DIR's plan gave one of
+// `plan`'s ids to another point (another sweep's results).
+void checkSamePlan(const std::filesystem::path& outDir, const nlohmann::json& plan);
+
 // Writes the plan: the sweep file, its axes and metrics, and every point's id, label and values.
 void writePlan(const std::filesystem::path& outDir, const nlohmann::json& plan);
 

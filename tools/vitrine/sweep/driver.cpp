@@ -151,19 +151,7 @@ nlohmann::json planOf(const SweepFile& sweep, const std::vector<Point>& points) 
 
 int runSweep(const SweepFile& sweep, const std::vector<Point>& points, const DriverOptions& options) {
     const nlohmann::json plan = planOf(sweep, points);
-    // Resuming trusts the files in DIR/points/: refuse a folder whose plan gave an id to another point.
-    if (std::ifstream in(options.outDir / "sweep-plan.json"); in) {
-        const nlohmann::json old = nlohmann::json::parse(in, nullptr, false);
-        if (old.is_object() && old.contains("points") && old["points"].is_array())
-            for (const auto& o : old["points"])
-                for (const auto& n : plan["points"])
-                    if (o.value("id", "") == n["id"] &&
-                        (o.value("graph", "") != n["graph"] || o.value("sets", nlohmann::json()) != n["sets"] ||
-                         o.value("frames", "") != n["frames"]))
-                        throw UserError(options.outDir.string() + " holds the results of another sweep: point " +
-                                        n["id"].get<std::string>() + " was '" + o.value("label", "") + "' there, is '" +
-                                        n["label"].get<std::string>() + "' here; choose another --out or delete it");
-    }
+    checkSamePlan(options.outDir, plan);
     writePlan(options.outDir, plan);
     std::vector<const Point*> todo;
     size_t done = 0, failedBefore = 0;

@@ -267,6 +267,8 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
     if (args.has("validate")) passThrough.push_back("--validate");
     if (args.has("device")) passThrough.insert(passThrough.end(), {"--device", args.get("device")});
 
+    const nlohmann::json plan = planOf(sweep, points);
+    checkSamePlan(outDir, plan); // before trusting any point's files
     std::vector<const Point*> todo;
     size_t done = 0, failedBefore = 0;
     for (const Point& p : points) {
@@ -278,7 +280,7 @@ int runOnSlurm(const cli::Args& args, const SweepFile& sweep, const std::vector<
         else
             todo.push_back(&p);
     }
-    writePlan(outDir, planOf(sweep, points));
+    writePlan(outDir, plan);
     for (const Point* p : todo)
         fs::remove(outDir / "points" / p->id / "error.json", ec);
 

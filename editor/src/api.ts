@@ -1,0 +1,182 @@
+// The `vitrine serve` JSON API (README "Serving graphs"). Every request carries the access token when the page
+// was opened with `?token=T` (the server also keeps it as a cookie).
+import type { Json, JsonObject, NodeSchema } from './graph/types';
+
+const token = new URLSearchParams(window.location.search).get('token');
+
+function headers(extra: Record<string, string> = {}): Record<string, string> {
+  return token ? { ...extra, Authorization: `token ${token}` } : extra;
+}
+
+export class ApiError extends Error {
+  constructor(
+    readonly status: number,
+    message: string,
+    readonly body: JsonObject = {},
+  ) {
+    super(message);
+  }
+  get pointer(): string | undefined {
+    return typeof this.body.pointer === 'string' ? this.body.pointer : undefined;
+  }
+}
+
+async function failure(res: Response): Promise<ApiError> {
+  let body: JsonObject = {};
+  try {
+    body = (await res.json()) as JsonObject;
+  } catch {
+    /* not JSON */
+  }
+  const message = typeof body.error === 'string' ? body.error : `${res.status} ${res.statusText}`;
+  return new ApiError(res.status, message, body);
+}
+
+async function getJson<T>(url: string): Promise<T> {
+  const res = await fetch(url, { headers: headers() });
+  if (!res.ok) throw await failure(res);
+  return (await res.json()) as T;
+}
+
+async function postJson(url: string, body: JsonObject, signal?: AbortSignal): Promise<Response> {
+  return fetch(url, {
+    method: 'POST',
+    headers: headers({ 'Content-Type': 'application/json' }),
+    body: JSON.stringify(body),
+    signal,
+  });
+}
+
+export interface GraphListEntry {
+  path: string;
+  kind: 'graph' | 'variant';
+  extends?: string;
+  description?: string;
+}
+
+export const listGraphs = async (): Promise<GraphListEntry[]> =>
+  (await getJson<{ graphs: GraphListEntry[] }>('/api/graphs')).graphs;
+
+export const listNodes = (): Promise<NodeSchema[]> => getJson<NodeSchema[]>('/api/nodes');
+
+export async function readGraph(path: string): Promise<string> {
+  const res = await fetch(`/api/graphs/${path.split('/').map(encodeURIComponent).join('/')}`, { headers: headers() });
+  if (!res.ok) throw await failure(res);
+  return res.text();
+}
+
+export async function writeGraph(path: string, text: string): Promise<void> {
+  const res = await fetch(`/api/graphs/${path.split('/').map(encodeURIComponent).join('/')}`, {
+    method: 'PUT',
+    headers: headers({ 'Content-Type': 'application/json' }),
+    body: text,
+  });
+  if (!res.ok) throw await failure(res);
+}
+
+/** A graph for a request: a file under DIR, or a document sent inline standing for the file `base`. */
+export type GraphRef = { graph: string } | { document: JsonObject; base?: string };
+
+export interface ValidationError {
+  error: string;
+  file?: string;
+  pointer?: string;
+}
+
+export async function validate(graph: GraphRef, signal?: AbortSignal): Promise<ValidationError[]> {
+  const res = await postJson('/api/validate', graph as JsonObject, signal);
+  let body: JsonObject = {};
+  try {
+    body = (await res.json()) as JsonObject;
+  } catch {
+    /* empty */
+  }
+  if (res.ok && body.ok === true) return [];
+  if (Array.isArray(body.errors)) return body.errors as unknown as ValidationError[];
+  if (typeof body.error === 'string')
+    return [{ error: body.error, file: body.file as string | undefined, pointer: body.pointer as string | undefined }];
+  return [{ error: `${res.status} ${res.statusText}` }];
+}
+
+export interface RenderJob {
+  job: string;
+  image: string;
+  url: string;
+}
+
+/** Starts an asynchronous render (`"async": true`); fetch the image with `fetchImage`. */
+export async function startRender(
+  graph: GraphRef,
+  options: { output: string; width: number; height: number; frames?: number },
+  signal?: AbortSignal,
+): Promise<RenderJob> {
+  const res = await postJson('/api/render', { ...(graph as JsonObject), ...options, async: true }, signal);
+  if (res.status !== 202 && !res.ok) throw await failure(res);
+  return (await res.json()) as RenderJob;
+}
+
+const sleep = (ms: number) => new Promise((r) => setTimeout(r, ms));
+
+/** The PNG at `url` once it is ready (the server answers 202 while it is pending). */
+export async function fetchImage(url: string, signal?: AbortSignal): Promise<Blob> {
+  for (let wait = 50; ; wait = Math.min(wait * 1.5, 500)) {
+    const res = await fetch(url, { headers: headers(), signal });
+    if (res.status === 200) return res.blob();
+    if (res.status !== 202) throw await failure(res);
+    await sleep(wait);
+  }
+}
+
+export interface CompareResult {
+  metrics: JsonObject;
+  images: { a: string; b: string; diff: string; flip: string };
+}
+
+export async function compare(
+  a: GraphRef | string,
+  b: GraphRef | string,
+  options: { width: number; height: number; output?: string },
+): Promise<CompareResult> {
+  const res = await postJson('/api/compare', { a: a as Json, b: b as Json, ...options });
+  if (!res.ok) throw await failure(res);
+  return (await res.json()) as CompareResult;
+}
+
+export interface JobEvent {
+  job: string;
+  kind: string;
+  graph?: string;
+  stage: 'queued' | 'compiling' | 'rendering' | 'done' | 'error' | string;
+  done?: number;
+  total?: number;
+  node?: string;
+  ms?: number;
+  error?: string;
+}
+
+/** Server-sent job events; returns a function that stops listening. */
+export function subscribeEvents(onJob: (e: JobEvent) => void): () => void {
+  if (typeof EventSource === 'undefined') return () => undefined;
+  const url = token ? `/api/events?token=${encodeURIComponent(token)}` : '/api/events';
+  const source = new EventSource(url);
+  source.addEventListener('job', (ev) => {
+    try {
+      onJob(JSON.parse((ev as MessageEvent<string>).data) as JobEvent);
+    } catch {
+      /* ignore malformed events */
+    }
+  });
+  return () => source.close();
+}
+
+/** Files under DIR for path pickers: `GET /api/files` when the server has it, else none. */
+export async function listFiles(): Promise<string[] | null> {
+  try {
+    const res = await fetch('/api/files', { headers: headers() });
+    if (!res.ok) return null;
+    const body = (await res.json()) as { files?: string[] };
+    return Array.isArray(body.files) ? body.files : null;
+  } catch {
+    return null;
+  }
+}
