@@ -200,12 +200,16 @@ export class PreviewStore {
       );
       batch.id = job.job;
       urls = job.images;
-      // Every image of a job is stored at once: wait for the first, then take the others.
+      // Events of the job that came before its id was known (the GPU thread may begin it before the answer).
+      for (const e of this.early.get(job.job) ?? []) this.onEvent(e);
+      this.early.delete(job.job);
+      // Every image of a job is stored at once: wait for the first, then take the others together, and show
+      // them all in one update (one re-render of the canvas, not one per thumbnail).
       const [first, ...rest] = keys;
-      const results: [string, Blob][] = [[first, await fetchImage(urls[first])]];
-      for (const key of rest) results.push([key, await fetchImage(urls[key])]);
+      const head = await fetchImage(urls[first]);
+      const blobs = [head, ...(await Promise.all(rest.map((key) => fetchImage(urls![key]))))];
       const ms = performance.now() - started;
-      for (const [key, blob] of results) this.finish(generation, batch, key, wanted.get(key)!, { url: URL.createObjectURL(blob), ms });
+      keys.forEach((key, i) => this.finish(generation, batch, key, wanted.get(key)!, { url: URL.createObjectURL(blobs[i]), ms }, false));
     } catch (e) {
       if (isSuperseded(e)) {
         // A newer edit's job replaced this one: it renders these previews (those still wanted).
@@ -241,7 +245,14 @@ export class PreviewStore {
   }
 
   /** A result (image or error) for `key` rendered at signature `wanted`. */
-  private finish(generation: number, batch: Batch, key: string, wanted: string, result: { url?: string; ms?: number; error?: string }): void {
+  private finish(
+    generation: number,
+    batch: Batch,
+    key: string,
+    wanted: string,
+    result: { url?: string; ms?: number; error?: string },
+    emit = true,
+  ): void {
     const current = this.entries.get(key);
     if (generation !== this.generation || !current) {
       if (result.url) URL.revokeObjectURL(result.url);
@@ -257,7 +268,7 @@ export class PreviewStore {
       shown: wanted,
       pending: current.pending?.job === batch ? undefined : current.pending,
     });
-    this.emit();
+    if (emit) this.emit();
   }
 
   /** `batch` will not render `key` (superseded): it is stale again unless another job covers it. */
@@ -295,9 +306,18 @@ export class PreviewStore {
     this.statusText = `previews (${running.keys.length}): ${p.stage}${frames}${node}`;
   }
 
+  /** Recent events of jobs not (yet) known, by job id. */
+  private early = new Map<string, JobEvent[]>();
+
   private onEvent(e: JobEvent): void {
     const batch = [...this.batches].find((b) => b.id !== undefined && b.id === e.job);
-    if (!batch) return;
+    if (!batch) {
+      if ([...this.batches].some((b) => b.id === undefined)) {
+        if (!this.early.has(e.job) && this.early.size >= 32) this.early.clear();
+        this.early.set(e.job, [...(this.early.get(e.job) ?? []), e]);
+      }
+      return;
+    }
     if (e.stage !== 'queued') batch.started = true;
     if (e.stage === 'node' && e.node) {
       // Long work inside one node: on that node (with its label), and in the status line.
