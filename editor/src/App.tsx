@@ -60,6 +60,7 @@ function Editor() {
   const store = useMemo(() => new PreviewStore(), []);
   useEffect(() => store.connect(), [store]);
   const previewsBusy = useSyncExternalStore(store.subscribe, () => store.busy());
+  const previewStatus = useSyncExternalStore(store.subscribe, () => store.status());
 
   const track = useCallback(async <T,>(work: Promise<T>): Promise<T> => {
     setPending((n) => n + 1);
@@ -310,6 +311,7 @@ function Editor() {
           </div>
           <footer className="statusbar">
             <span data-testid="status">{status}</span>
+            {previewStatus && <span className="preview-status" data-testid="preview-status">{previewStatus}</span>}
             {targets.general.length > 0 && <span className="general-error">{targets.general.join(' · ')}</span>}
             {errors.length > 0 && <span className="error-count">{errors.length} validation error{errors.length > 1 ? 's' : ''}</span>}
           </footer>

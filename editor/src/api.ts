@@ -115,6 +115,24 @@ export async function startRender(
   return (await res.json()) as RenderJob;
 }
 
+export interface RenderBatch {
+  job: string;
+  /** "node.port" -> image URL (202 until the job is done, 409 when a newer job with the same tag replaced it). */
+  images: Record<string, string>;
+}
+
+/** Starts one asynchronous render of several outputs ("node.port"): compiled and rendered once. A render with
+ *  the same `tag` replaces this one while it is still queued. */
+export async function startRenderBatch(
+  graph: GraphRef,
+  options: { outputs: string[]; width: number; height: number; tag?: string },
+  signal?: AbortSignal,
+): Promise<RenderBatch> {
+  const res = await postJson('/api/render', { ...(graph as JsonObject), ...options, async: true }, signal);
+  if (res.status !== 202 && !res.ok) throw await failure(res);
+  return (await res.json()) as RenderBatch;
+}
+
 const sleep = (ms: number) => new Promise((r) => setTimeout(r, ms));
 
 /** The PNG at `url` once it is ready (the server answers 202 while it is pending). */
@@ -149,7 +167,9 @@ export interface JobEvent {
   stage: 'queued' | 'compiling' | 'rendering' | 'done' | 'error' | string;
   done?: number;
   total?: number;
+  /** For stage "node": the graph node doing long work, and what (e.g. "baking lightmap (...)"). */
   node?: string;
+  label?: string;
   ms?: number;
   error?: string;
 }
@@ -169,10 +189,11 @@ export function subscribeEvents(onJob: (e: JobEvent) => void): () => void {
   return () => source.close();
 }
 
-/** Files under DIR for path pickers: `GET /api/files` when the server has it, else none. */
-export async function listFiles(): Promise<string[] | null> {
+/** Files under DIR for path pickers: `GET /api/files[?ext=.cube,.png]` when the server has it, else none. */
+export async function listFiles(extensions: string[] = []): Promise<string[] | null> {
   try {
-    const res = await fetch('/api/files', { headers: headers() });
+    const query = extensions.length ? `?ext=${extensions.map(encodeURIComponent).join(',')}` : '';
+    const res = await fetch(`/api/files${query}`, { headers: headers() });
     if (!res.ok) return null;
     const body = (await res.json()) as { files?: string[] };
     return Array.isArray(body.files) ? body.files : null;

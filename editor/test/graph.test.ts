@@ -23,7 +23,7 @@ import {
 } from '../src/graph/document';
 import { newVariantText, openFile, serializeForSave, variantJson, documentForServer } from '../src/graph/files';
 import { dirname, join as pjoin, relative } from '../src/graph/paths';
-import { checkParam } from '../src/graph/schema';
+import { checkParam, hasExtension, pathExtensions } from '../src/graph/schema';
 import type { Json, JsonObject, NodeSchema, ParamSchema } from '../src/graph/types';
 
 const REPO = join(process.cwd(), '..');
@@ -240,4 +240,16 @@ test('moved nodes keep their positions in the ui block across save and open', as
   assert.equal(storedPosition(again.merged, 'pattern'), undefined);
   // The renderer never sees them.
   assert.deepEqual(stripUi(again.merged), file.merged);
+});
+
+test('path pickers ask for the extensions a path param documents', () => {
+  const spec = (doc: string) => ({ name: 'p', type: 'path', doc }) as unknown as Parameters<typeof pathExtensions>[0];
+  assert.deepEqual(pathExtensions(spec('LUT file OCIO can read (.cube, .3dl, .csp, ...): a bare file name is one of data/luts/ (warm_film.cube)')), ['.3dl', '.csp', '.cube']);
+  assert.deepEqual(pathExtensions(spec('The .gltf or .glb file (relative to the graph file)')), ['.glb', '.gltf']);
+  assert.deepEqual(pathExtensions(spec('Reflection probes from a JSON file {"probes": [...]} (relative to the graph file)')), ['.json']);
+  assert.deepEqual(pathExtensions(spec('Image file, relative to the graph file')), ['.bmp', '.exr', '.hdr', '.jpeg', '.jpg', '.png', '.tga']);
+  assert.deepEqual(pathExtensions(spec('Anything')), []);
+  assert.equal(hasExtension('data/luts/Warm.CUBE', ['.cube']), true);
+  assert.equal(hasExtension('data/luts/warm.png', ['.cube']), false);
+  assert.equal(hasExtension('x.bin', []), true);
 });

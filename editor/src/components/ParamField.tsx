@@ -2,7 +2,8 @@
 // for bools, one entry per component for vectors (plus a swatch for colours), a text entry with a picker of
 // DIR's files for paths.
 import { useEffect, useState } from 'react';
-import { checkParam, isColorParam, vectorSize } from '../graph/schema';
+import { listFiles } from '../api';
+import { checkParam, hasExtension, isColorParam, pathExtensions, vectorSize } from '../graph/schema';
 import type { Json, ParamSchema } from '../graph/types';
 
 export interface ParamFieldProps {
@@ -27,6 +28,53 @@ function toHex(v: Json[]): string {
 
 function fromHex(hex: string): number[] {
   return [1, 3, 5].map((i) => Math.round((parseInt(hex.slice(i, i + 2), 16) / 255) * 1000) / 1000);
+}
+
+const fileLists = new Map<string, Promise<string[] | null>>();
+
+/** Files under DIR a path param can take: `GET /api/files?ext=` with the extensions its doc names (asked once per
+ *  set of extensions), else `fallback` (paths found in the served graphs) filtered the same way. */
+function usePathFiles(spec: ParamSchema, fallback: string[]): string[] {
+  const extensions = pathExtensions(spec);
+  const key = extensions.join(',');
+  const [files, setFiles] = useState<string[] | null>(null);
+  useEffect(() => {
+    let live = true;
+    if (!fileLists.has(key)) fileLists.set(key, listFiles(extensions));
+    void fileLists.get(key)!.then((list) => live && setFiles(list));
+    return () => {
+      live = false;
+    };
+    // eslint-disable-next-line react-hooks/exhaustive-deps
+  }, [key]);
+  return files ?? fallback.filter((f) => hasExtension(f, extensions));
+}
+
+/** A path: a text entry, and a picker of the files under DIR with the extensions the param takes. */
+function PathPicker(props: {
+  id: string;
+  spec: ParamSchema;
+  value: Json;
+  files: string[];
+  pathValue(dirRelative: string): string;
+  onChange(value: Json | undefined): void;
+}) {
+  const { id, spec, value, pathValue, onChange } = props;
+  const files = usePathFiles(spec, props.files);
+  const extensions = pathExtensions(spec).join(' ');
+  return (
+    <div className="col">
+      <input type="text" data-testid={id} value={String(value ?? '')} onChange={(e) => onChange(e.target.value)} />
+      <select data-testid={`${id}-pick`} value="" title={extensions ? `files ${extensions} under DIR` : 'files under DIR'} onChange={(e) => e.target.value && onChange(pathValue(e.target.value))}>
+        <option value="">{files.length ? `Pick a file under DIR${extensions ? ` (${extensions})` : ''}…` : 'no files known'}</option>
+        {files.map((f) => (
+          <option key={f} value={f}>
+            {f}
+          </option>
+        ))}
+      </select>
+    </div>
+  );
 }
 
 /** A numeric text entry that keeps what is typed (even while it is not a number yet). */
@@ -115,17 +163,7 @@ export function ParamField(props: ParamFieldProps) {
       break;
     case 'path':
       widget = (
-        <div className="col">
-          <input type="text" data-testid={id} value={String(value ?? '')} onChange={(e) => onChange(e.target.value)} />
-          <select data-testid={`${id}-pick`} value="" onChange={(e) => e.target.value && onChange(pathValue(e.target.value))}>
-            <option value="">{files.length ? 'Pick a file under DIR…' : 'no files known'}</option>
-            {files.map((f) => (
-              <option key={f} value={f}>
-                {f}
-              </option>
-            ))}
-          </select>
-        </div>
+        <PathPicker id={id} spec={spec} value={value} files={files} pathValue={pathValue} onChange={onChange} />
       );
       break;
     default: {

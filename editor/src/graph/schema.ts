@@ -74,3 +74,26 @@ export function paramErrors(schema: NodeSchema | undefined, params: Json | undef
   }
   return errors;
 }
+
+const FILE_EXTENSIONS = new Set(['cube', '3dl', 'csp', 'spi1d', 'spi3d', 'clf', 'hdr', 'exr', 'png', 'jpg', 'jpeg', 'tga', 'bmp', 'ktx', 'ktx2', 'gltf', 'glb', 'json']);
+const IMAGE_EXTENSIONS = ['png', 'jpg', 'jpeg', 'exr', 'hdr', 'tga', 'bmp'];
+
+/** The file extensions a path param takes (for the picker's `GET /api/files?ext=`), from what its doc names
+ *  (".cube, .3dl", ".gltf or .glb", "JSON file", "Image file"); empty: any file. */
+export function pathExtensions(spec: ParamSchema): string[] {
+  const doc = spec.doc ?? '';
+  const found = new Set<string>();
+  for (const m of doc.matchAll(/\.([A-Za-z0-9]{2,5})\b/g)) {
+    const ext = m[1].toLowerCase();
+    if (FILE_EXTENSIONS.has(ext)) found.add(ext);
+  }
+  if (/\bJSON\b/.test(doc)) found.add('json');
+  if (found.size === 0 && /\bimage\b/i.test(doc)) for (const e of IMAGE_EXTENSIONS) found.add(e);
+  return [...found].sort().map((e) => `.${e}`);
+}
+
+/** Whether `path` ends with one of `extensions` (any when empty; case-insensitive). */
+export function hasExtension(path: string, extensions: string[]): boolean {
+  const lower = path.toLowerCase();
+  return extensions.length === 0 || extensions.some((e) => lower.endsWith(e));
+}
