@@ -107,7 +107,7 @@ export interface RenderJob {
 /** Starts an asynchronous render (`"async": true`); fetch the image with `fetchImage`. */
 export async function startRender(
   graph: GraphRef,
-  options: { output: string; width: number; height: number; frames?: number },
+  options: { output: string; width: number; height: number; frames?: number; display?: 'thumbnail' },
   signal?: AbortSignal,
 ): Promise<RenderJob> {
   const res = await postJson('/api/render', { ...(graph as JsonObject), ...options, async: true }, signal);
@@ -125,7 +125,7 @@ export interface RenderBatch {
  *  the same `tag` replaces this one while it is still queued. */
 export async function startRenderBatch(
   graph: GraphRef,
-  options: { outputs: string[]; width: number; height: number; tag?: string },
+  options: { outputs: string[]; width: number; height: number; tag?: string; display?: 'thumbnail' },
   signal?: AbortSignal,
 ): Promise<RenderBatch> {
   const res = await postJson('/api/render', { ...(graph as JsonObject), ...options, async: true }, signal);

@@ -196,7 +196,13 @@ export class PreviewStore {
     try {
       const job = await startRenderBatch(
         { document, base: file.path },
-        { outputs: keys, width: PREVIEW_WIDTH, height: PREVIEW_HEIGHT, tag: `previews:${file.path}` },
+        {
+          outputs: keys,
+          width: PREVIEW_WIDTH,
+          height: PREVIEW_HEIGHT,
+          tag: `previews:${file.path}`,
+          display: 'thumbnail',
+        },
       );
       batch.id = job.job;
       urls = job.images;
@@ -236,7 +242,10 @@ export class PreviewStore {
   ): Promise<void> {
     const started = performance.now();
     try {
-      const job = await startRender({ document, base: file.path }, { output: key, width: PREVIEW_WIDTH, height: PREVIEW_HEIGHT });
+      const job = await startRender(
+        { document, base: file.path },
+        { output: key, width: PREVIEW_WIDTH, height: PREVIEW_HEIGHT, display: 'thumbnail' },
+      );
       const blob = await fetchImage(job.url);
       this.finish(generation, batch, key, wanted, { url: URL.createObjectURL(blob), ms: performance.now() - started });
     } catch (e) {

@@ -321,6 +321,18 @@ def main():
         _, final = server.request("GET", urls["final"])
         _, pattern = server.request("GET", urls["pattern.color"])
         check(final == png1 and pattern == png3, "each of several outputs equals its render alone")
+    # "display": "thumbnail" exposes HDR values instead of clipping them to white; values up to 1 are left alone.
+    bright = json.loads(zoneplate_bytes)
+    bright["nodes"]["tonemap"]["params"] = {"operator": "reinhard", "inverse": True}  # [0, 1] -> [0, inf)
+    hdr = {"document": bright, "base": "graphs/fxaa_zoneplate.json", "width": 160, "height": 90}
+    r, clipped = render(hdr)
+    r2, thumb = render(dict(hdr, display="thumbnail"))
+    _, plain_thumb = render({"graph": "graphs/fxaa_zoneplate.json", "width": 160, "height": 90,
+                             "display": "thumbnail"})
+    check(r.status == 200 and r2.status == 200 and thumb != clipped and plain_thumb == png1,
+          "display=thumbnail tone-maps an HDR output and leaves a display-range one as it is")
+    r, body = server.json("POST", "/api/render", dict(hdr, display="fancy"))
+    check(r.status == 400 and body.get("pointer") == "/display", "an unknown display: 400")
     r, body = server.json("POST", "/api/render", {"graph": "graphs/fxaa_zoneplate.json", "outputs": ["nope"]})
     check(r.status == 400 and body.get("pointer") == "/outputs/0", f"an unknown preview output: 400 ({body})")
     r, body = server.json("POST", "/api/render", {"graph": "graphs/fxaa_zoneplate.json", "outputs": []})

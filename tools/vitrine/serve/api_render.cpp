@@ -25,6 +25,43 @@ constexpr uint32_t kMaxSide = 8192;
 constexpr uint64_t kMaxPixels = 4096ull * 4096ull;
 constexpr uint32_t kMaxFrames = 4096;
 
+// "display": "thumbnail": what a preview of any texture shows. A texture whose green and blue are zero everywhere
+// (a single-channel one: AO, depth, CoC) becomes grey; one with values above 1 (scene-referred HDR, hundreds of cd/m²)
+// is exposed so that its log-average luminance sits at 0.18 and compressed with Reinhard's L / (1 + L) on luminance,
+// instead of clipping to white. Display only: the data the nodes exchange is untouched.
+Image thumbnail(Image image) {
+    const size_t n = static_cast<size_t>(image.width) * image.height;
+    float* px = image.pixels.data();
+    bool single = true;
+    float peak = 0.0f;
+    for (size_t i = 0; i < n; ++i) {
+        const float* p = px + 4 * i;
+        single = single && p[1] == 0.0f && p[2] == 0.0f;
+        for (int c = 0; c < 3; ++c)
+            if (std::isfinite(p[c])) peak = std::max(peak, p[c]);
+    }
+    if (single)
+        for (size_t i = 0; i < n; ++i) px[4 * i + 1] = px[4 * i + 2] = px[4 * i];
+    if (peak <= 1.0f) return image;
+    double logSum = 0.0;
+    size_t counted = 0;
+    auto luminance = [](const float* p) { return 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; };
+    for (size_t i = 0; i < n; ++i) {
+        const float l = luminance(px + 4 * i);
+        if (!std::isfinite(l) || l <= 0.0f) continue;
+        logSum += std::log(1e-4 + l);
+        ++counted;
+    }
+    const float scale = counted ? 0.18f / static_cast<float>(std::exp(logSum / counted)) : 1.0f;
+    for (size_t i = 0; i < n; ++i) {
+        float* p = px + 4 * i;
+        const float l = luminance(p) * scale;
+        const float k = l > 0.0f && std::isfinite(l) ? scale / (1.0f + l) : 0.0f;
+        for (int c = 0; c < 3; ++c) p[c] = std::isfinite(p[c]) ? std::max(p[c], 0.0f) * k : 0.0f;
+    }
+    return image;
+}
+
 std::string pngString(const Image& image) {
     std::vector<unsigned char> png = encodePng(image);
     return std::string(reinterpret_cast<const char*>(png.data()), png.size());
@@ -244,19 +281,27 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
     // A render with a tag replaces the queued one with the same tag that has not started yet (the editor tags its
     // previews: only the latest edit's are worth rendering).
     const std::string tag = optionalString(request, "tag");
+    const std::string display = optionalString(request, "display");
+    if (!display.empty() && display != "thumbnail")
+        throw HttpError(400, "request body: /display: expected \"thumbnail\" (or leave it out), got \"" + display + "\"",
+                        {{"pointer", "/display"}});
+    auto png = [thumb = display == "thumbnail"](const Image& image) {
+        return pngString(thumb ? thumbnail(image) : image);
+    };
     PreparedGraph prepared = prepare(request, "", Defaults{});
     const std::string job = newJobId();
     const std::string file = prepared.desc.file;
     mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"graph", file}, {"stage", "queued"}});
 
     // Where a finished job's images go: the image store, and the answer's {"images": {output: url}}.
-    auto publishImages = [this](const PreparedGraph& graph, const RenderResult& r, const std::vector<std::string>& ids) {
+    auto publishImages = [this, png](const PreparedGraph& graph, const RenderResult& r,
+                                     const std::vector<std::string>& ids) {
         nlohmann::json urls = nlohmann::json::object();
         for (size_t i = 0; i < graph.previews.size(); ++i) {
             const auto it = r.images.find("preview_" + std::to_string(i));
             if (it == r.images.end()) throw InternalError("render: preview " + graph.previews[i] + " was not written");
             const std::string id = ids.empty() ? mImages.reserve() : ids[i];
-            mImages.fulfil(id, pngString(it->second), it->second.width, it->second.height);
+            mImages.fulfil(id, png(it->second), it->second.width, it->second.height);
             urls[graph.previews[i]] = "/api/images/" + id;
         }
         return urls;
@@ -280,11 +325,11 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
             mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", stage}, {"error", body.value("error", "")}});
         };
         mGpu.post(
-            [this, shared, job, ids, start, progress, fail, publishImages, file] {
+            [this, shared, job, ids, start, progress, fail, publishImages, file, png] {
                 try {
                     RenderResult r = mGpu.renderNow(*shared, progress, nodeProgress(job, "render", file));
                     if (shared->previews.empty())
-                        mImages.fulfil(ids[0], pngString(r.image), r.image.width, r.image.height);
+                        mImages.fulfil(ids[0], png(r.image), r.image.width, r.image.height);
                     else
                         publishImages(*shared, r, ids);
                     mEvents.publish("job", {{"job", job},
@@ -338,7 +383,7 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
         res.set_header("X-Vitrine-Output", prepared.output);
         res.set_header("X-Vitrine-Width", std::to_string(r.image.width));
         res.set_header("X-Vitrine-Height", std::to_string(r.image.height));
-        res.set_content(pngString(r.image), "image/png");
+        res.set_content(png(r.image), "image/png");
     } catch (const HttpError& e) {
         mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", e.status() == 409 ? "superseded" : "error"},
                                 {"error", e.what()}});
