@@ -4,8 +4,8 @@
 #include "shaders/forward/transparent.h"
 #include "core/base/error.hpp"
 #include "core/gpu/context.hpp"
+#include "core/gpu/descriptors.hpp"
 #include "core/gpu/raster.hpp"
-#include "core/gpu/vk_check.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "nodes/bake/baked_lighting.hpp"
@@ -95,6 +95,8 @@ bool linearFilterable(Context& ctx, VkFormat format) {
 // Set 0 of the pipelines (set 1 is the scene's): binding 0 the uniforms, 1-5 the sampled inputs. Without a
 // volume, binding 5 holds sky_sh instead (the shader never reads it when the volume's counts are zero).
 constexpr std::array<const char*, 5> kSampled = {"shadow_map", "sky_sh", "sky", "color", "volume"};
+// The samplers of the node's DescriptorSets.
+enum SamplerIndex : size_t { kLinear = 0, kNearest };
 
 class Transparent final : public Node {
 public:
@@ -152,21 +154,9 @@ public:
         mFrontFaces = RasterPipeline();
         mBackFaces = RasterPipeline();
         mUniforms = GpuBuffer();
-        if (mDevice) {
-            VkDevice device = mDevice;
-            VkDescriptorSetLayout layout = std::exchange(mSetLayout, VK_NULL_HANDLE);
-            VkDescriptorPool pool = std::exchange(mPool, VK_NULL_HANDLE);
-            VkSampler linear = std::exchange(mLinear, VK_NULL_HANDLE),
-                      nearest = std::exchange(mNearest, VK_NULL_HANDLE);
-            mContext->destroyLater([device, layout, pool, linear, nearest] {
-                vkDestroyDescriptorSetLayout(device, layout, nullptr);
-                vkDestroyDescriptorPool(device, pool, nullptr);
-                vkDestroySampler(device, linear, nullptr);
-                vkDestroySampler(device, nearest, nullptr);
-            });
-            mDevice = VK_NULL_HANDLE;
-            mSet = VK_NULL_HANDLE;
-        }
+        mSets = DescriptorSets();
+        mSet = VK_NULL_HANDLE;
+        mDevice = VK_NULL_HANDLE;
     }
 
     ~Transparent() override { releaseGpu(); }
@@ -206,29 +196,17 @@ private:
         }
         std::memcpy(mUniforms.mapped(), &u, sizeof(u));
 
-        VkDescriptorBufferInfo bi{mUniforms.buffer(), 0, sizeof(TransparentUniforms)};
-        VkDescriptorImageInfo ii[kSampled.size()];
-        VkWriteDescriptorSet w[1 + kSampled.size()];
-        w[0] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-        w[0].dstSet = mSet;
-        w[0].dstBinding = 0;
-        w[0].descriptorCount = 1;
-        w[0].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-        w[0].pBufferInfo = &bi;
+        DescriptorWrites w(mSet);
+        w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, {mUniforms.buffer(), 0, sizeof(TransparentUniforms)});
         for (uint32_t i = 0; i < kSampled.size(); ++i) {
             const std::string port = std::string(kSampled[i]) == "volume" && !mBaked ? "sky_sh" : kSampled[i];
             const GpuImage& image = ctx.input(port);
-            ii[i] = {std::string(kSampled[i]) == "sky" && linearFilterable(ctx.gpu(), image.desc().format) ? mLinear
-                                                                                                           : mNearest,
-                     image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-            w[i + 1] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-            w[i + 1].dstSet = mSet;
-            w[i + 1].dstBinding = i + 1;
-            w[i + 1].descriptorCount = 1;
-            w[i + 1].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-            w[i + 1].pImageInfo = &ii[i];
+            const bool linear = std::string(kSampled[i]) == "sky" && linearFilterable(ctx.gpu(), image.desc().format);
+            w.image(
+                i + 1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                {mSets.sampler(linear ? kLinear : kNearest), image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
         }
-        vkUpdateDescriptorSets(mDevice, static_cast<uint32_t>(std::size(w)), w, 0, nullptr);
+        w.update(mDevice);
     }
 
     void create(ExecuteContext& ctx, GpuScene& gpu) {
@@ -236,38 +214,17 @@ private:
         if (!c.dualSourceBlend())
             throw UserError("forward.transparent needs the dualSrcBlend feature, which device '" + c.deviceInfo().name +
                             "' lacks");
-        mContext = &c;
         mDevice = c.device();
         VkDescriptorSetLayoutBinding b[1 + kSampled.size()];
         b[0] = {0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
         for (uint32_t i = 0; i < kSampled.size(); ++i)
             b[i + 1] = {i + 1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
-        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-        li.bindingCount = static_cast<uint32_t>(std::size(b));
-        li.pBindings = b;
-        VK_CHECK(vkCreateDescriptorSetLayout(mDevice, &li, nullptr, &mSetLayout));
-        VkDescriptorPoolSize sizes[2] = {
-            {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-            {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, static_cast<uint32_t>(kSampled.size())}};
-        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-        pi.maxSets = 1;
-        pi.poolSizeCount = 2;
-        pi.pPoolSizes = sizes;
-        VK_CHECK(vkCreateDescriptorPool(mDevice, &pi, nullptr, &mPool));
-        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-        ai.descriptorPool = mPool;
-        ai.descriptorSetCount = 1;
-        ai.pSetLayouts = &mSetLayout;
-        VK_CHECK(vkAllocateDescriptorSets(mDevice, &ai, &mSet));
         // Linear filtering for the sky's cube map; everything else is read with texelFetch (and the shadow map's
         // depth format may not be filterable).
-        VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-        si.magFilter = si.minFilter = VK_FILTER_LINEAR;
-        si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-        si.maxLod = VK_LOD_CLAMP_NONE;
-        VK_CHECK(vkCreateSampler(mDevice, &si, nullptr, &mLinear));
-        si.magFilter = si.minFilter = VK_FILTER_NEAREST;
-        VK_CHECK(vkCreateSampler(mDevice, &si, nullptr, &mNearest));
+        const SamplerDesc samplers[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST},
+                                        {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST}}; // kLinear, kNearest
+        mSets = DescriptorSets(c, b, 1, samplers, "forward.transparent.set");
+        mSet = mSets.allocate();
         mUniforms = GpuBuffer(c, sizeof(TransparentUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                               "forward.transparent.uniforms");
 
@@ -275,7 +232,7 @@ private:
         ShaderDefines defines = {{"VITRINE_SCENE_TEXTURES", std::to_string(std::max(1u, gpu.textureCount()))},
                                  {"VITRINE_SCENE_SET", "1"}};
         RasterPipelineDesc d;
-        d.setLayouts = {mSetLayout, gpu.setLayout()};
+        d.setLayouts = {mSets.layout(), gpu.setLayout()};
         d.pushConstantSize = sizeof(SceneDrawPush);
         d.colorFormats = {ctx.output("color").desc().format};
         d.depthFormat = ctx.input("depth").desc().format;
@@ -319,12 +276,9 @@ private:
     std::shared_ptr<ShadowCascadesObject> mCascades;
     std::shared_ptr<BakedLightingObject> mBaked;
     bool mSort = true;
-    Context* mContext = nullptr;
     VkDevice mDevice = VK_NULL_HANDLE;
-    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    DescriptorSets mSets;
     VkDescriptorSet mSet = VK_NULL_HANDLE;
-    VkSampler mLinear = VK_NULL_HANDLE, mNearest = VK_NULL_HANDLE;
     GpuBuffer mUniforms;
     RasterPipeline mCopy, mFrontFaces, mBackFaces;
 };

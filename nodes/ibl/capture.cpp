@@ -8,8 +8,8 @@
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
+#include "core/gpu/descriptors.hpp"
 #include "core/gpu/transfer.hpp"
-#include "core/gpu/vk_check.hpp"
 #include "core/graph/executor.hpp"
 #include "core/scene/hash.hpp"
 #include "core/shader/compiler.hpp"
@@ -294,20 +294,7 @@ public:
 
     void releaseGpu() override {
         mDone = false;
-        if (mCtx && mPool) {
-            Context* c = mCtx;
-            VkDescriptorPool pool = mPool;
-            VkDescriptorSetLayout layout = mSetLayout;
-            VkSampler sampler = mSampler;
-            c->destroyLater([c, pool, layout, sampler] {
-                vkDestroyDescriptorPool(c->device(), pool, nullptr);
-                vkDestroyDescriptorSetLayout(c->device(), layout, nullptr);
-                vkDestroySampler(c->device(), sampler, nullptr);
-            });
-        }
-        mPool = VK_NULL_HANDLE;
-        mSetLayout = VK_NULL_HANDLE;
-        mSampler = VK_NULL_HANDLE;
+        mSets = DescriptorSets();
         mSource = GpuImage();
     }
 
@@ -370,58 +357,28 @@ private:
         return faces;
     }
 
-    void ensureSets(Context& gpu) {
-        if (mPool) return;
-        mCtx = &gpu;
-        std::array<VkDescriptorSetLayoutBinding, 2> bindings{};
-        bindings[0] = {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-        bindings[1] = {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-        li.bindingCount = 2;
-        li.pBindings = bindings.data();
-        VK_CHECK(vkCreateDescriptorSetLayout(gpu.device(), &li, nullptr, &mSetLayout));
-        const std::array<VkDescriptorPoolSize, 2> sizes = {
-            VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16},
-            VkDescriptorPoolSize{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 16}};
-        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-        pi.maxSets = 16;
-        pi.poolSizeCount = 2;
-        pi.pPoolSizes = sizes.data();
-        VK_CHECK(vkCreateDescriptorPool(gpu.device(), &pi, nullptr, &mPool));
-        VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-        si.magFilter = si.minFilter = VK_FILTER_LINEAR;
-        si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
-        si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-        si.maxLod = VK_LOD_CLAMP_NONE;
-        VK_CHECK(vkCreateSampler(gpu.device(), &si, nullptr, &mSampler));
-    }
-
     // One descriptor set per output mip: the source (its cube-array view, or mip m's array view) and mip m of cubes.
     VkDescriptorSet mipSet(ExecuteContext& ctx, VkImageView source, uint32_t mip) {
-        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-        ai.descriptorPool = mPool;
-        ai.descriptorSetCount = 1;
-        ai.pSetLayouts = &mSetLayout;
-        VkDescriptorSet set;
-        VK_CHECK(vkAllocateDescriptorSets(ctx.gpu().device(), &ai, &set));
-        VkDescriptorImageInfo src{mSampler, source, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-        VkDescriptorImageInfo dst{VK_NULL_HANDLE, ctx.output("cubes").mipView(mip), VK_IMAGE_LAYOUT_GENERAL};
-        std::array<VkWriteDescriptorSet, 2> w{};
-        for (uint32_t i = 0; i < 2; ++i) {
-            w[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-            w[i].dstSet = set;
-            w[i].dstBinding = i;
-            w[i].descriptorCount = 1;
-            w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-            w[i].pImageInfo = i == 0 ? &src : &dst;
-        }
-        vkUpdateDescriptorSets(ctx.gpu().device(), 2, w.data(), 0, nullptr);
+        const VkDescriptorSet set = mSets.allocate();
+        DescriptorWrites(set)
+            .image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                   {mSets.sampler(0), source, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL})
+            .image(1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+                   {VK_NULL_HANDLE, ctx.output("cubes").mipView(mip), VK_IMAGE_LAYOUT_GENERAL})
+            .update(ctx.gpu().device());
         return set;
     }
 
+    // Frees the previous pass's sets, making the layout, a pool for 16 sets (one per mip) and the sampler first.
     void resetSets(Context& gpu) {
-        ensureSets(gpu);
-        VK_CHECK(vkResetDescriptorPool(gpu.device(), mPool, 0));
+        if (!mSets) {
+            const VkDescriptorSetLayoutBinding bindings[] = {
+                {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+                {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+            const SamplerDesc sampler[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR}};
+            mSets = DescriptorSets(gpu, bindings, 16, sampler, "ibl.capture.prefilter");
+        }
+        mSets.reset();
     }
 
     void prefilter(ExecuteContext& ctx, std::vector<Image> faces) {
@@ -437,7 +394,7 @@ private:
         mSource = GpuImage(ctx.gpu(), d, "ibl.capture.source");
         uploadAll(ctx.gpu(), mSource, boxMips(std::move(faces), sourceMips));
         resetSets(ctx.gpu());
-        const std::array<VkDescriptorSetLayout, 1> layouts = {mSetLayout};
+        const std::array<VkDescriptorSetLayout, 1> layouts = {mSets.layout()};
         for (uint32_t m = 0; m < mMips; ++m) {
             const VkDescriptorSet set = mipSet(ctx, mSource.view(), m);
             gpu_types::IblPrefilterPush push{};
@@ -474,7 +431,7 @@ private:
         mSource = GpuImage(ctx.gpu(), d, "ibl.capture.cached");
         uploadAll(ctx.gpu(), mSource, mips);
         resetSets(ctx.gpu());
-        const std::array<VkDescriptorSetLayout, 1> layouts = {mSetLayout};
+        const std::array<VkDescriptorSetLayout, 1> layouts = {mSets.layout()};
         for (uint32_t m = 0; m < mMips; ++m) {
             const VkDescriptorSet set = mipSet(ctx, mSource.mipView(m), m);
             gpu_types::IblPrefilterPush push{};
@@ -505,10 +462,7 @@ private:
     bool mUseCache = true, mRecapture = false, mDone = false, mFromCache = false;
     double mCaptureMs = 0.0;
     PipelineId mLutPipeline = 0, mPrefilterPipeline = 0, mCopyPipeline = 0;
-    Context* mCtx = nullptr;
-    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
-    VkSampler mSampler = VK_NULL_HANDLE;
+    DescriptorSets mSets;
     GpuImage mSource;
 };
 

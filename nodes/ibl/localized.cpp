@@ -6,6 +6,7 @@
 #include "shaders/ibl/localized.h"
 #include "core/base/error.hpp"
 #include "core/gpu/context.hpp"
+#include "core/gpu/descriptors.hpp"
 #include "core/gpu/raster.hpp"
 #include "core/gpu/vk_check.hpp"
 #include "core/graph/registry.hpp"
@@ -143,6 +144,9 @@ enum Binding : uint32_t {
     kBindingCount
 };
 
+// The samplers of the node's DescriptorSets.
+enum SamplerIndex : size_t { kLinear = 0, kNearest };
+
 class Localized final : public Node {
 public:
     void setup(SetupContext& ctx) override {
@@ -204,21 +208,11 @@ public:
         mNormalized = RasterPipeline();
         mResolve = RasterPipeline();
         mUniforms = GpuBuffer();
+        mSets = DescriptorSets();
+        mSet = VK_NULL_HANDLE;
         if (mDevice) {
             releaseCubeView();
-            VkDevice device = mDevice;
-            VkDescriptorSetLayout layout = std::exchange(mSetLayout, VK_NULL_HANDLE);
-            VkDescriptorPool pool = std::exchange(mPool, VK_NULL_HANDLE);
-            VkSampler linear = std::exchange(mLinear, VK_NULL_HANDLE),
-                      nearest = std::exchange(mNearest, VK_NULL_HANDLE);
-            mContext->destroyLater([device, layout, pool, linear, nearest] {
-                vkDestroyDescriptorSetLayout(device, layout, nullptr);
-                vkDestroyDescriptorPool(device, pool, nullptr);
-                vkDestroySampler(device, linear, nullptr);
-                vkDestroySampler(device, nearest, nullptr);
-            });
             mDevice = VK_NULL_HANDLE;
-            mSet = VK_NULL_HANDLE;
         }
     }
 
@@ -285,30 +279,18 @@ private:
             {kSky, &ctx.input("sky"), read},
             {kSkySh, &ctx.input("sky_sh"), read},
         }};
-        VkDescriptorBufferInfo bi{mUniforms.buffer(), 0, sizeof(LocalizedUniforms)};
-        std::array<VkDescriptorImageInfo, kBindingCount - 1> ii{};
-        std::array<VkWriteDescriptorSet, kBindingCount> w{};
-        w[0] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-        w[0].dstSet = mSet;
-        w[0].dstBinding = kUniforms;
-        w[0].descriptorCount = 1;
-        w[0].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-        w[0].pBufferInfo = &bi;
+        DescriptorWrites w(mSet);
+        w.buffer(kUniforms, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, {mUniforms.buffer(), 0, sizeof(LocalizedUniforms)});
         for (size_t i = 0; i < images.size(); ++i) {
             // Cubes and the LUT are filtered (between mips too); the rest is read with texelFetch, and the sky at its
             // texels where its format is not filterable (RGBA32F on lavapipe), as the executor binds it.
             bool linear = (images[i].binding == kCubes || images[i].binding == kBrdfLut || images[i].binding == kSky) &&
                           filterable(ctx.gpu(), images[i].image->desc().format);
             VkImageView view = images[i].binding == kCubes ? cubeArrayView(*images[i].image) : images[i].image->view();
-            ii[i] = {linear ? mLinear : mNearest, view, images[i].layout};
-            w[i + 1] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-            w[i + 1].dstSet = mSet;
-            w[i + 1].dstBinding = images[i].binding;
-            w[i + 1].descriptorCount = 1;
-            w[i + 1].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-            w[i + 1].pImageInfo = &ii[i];
+            w.image(images[i].binding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                    {mSets.sampler(linear ? kLinear : kNearest), view, images[i].layout});
         }
-        vkUpdateDescriptorSets(mDevice, static_cast<uint32_t>(w.size()), w.data(), 0, nullptr);
+        w.update(mDevice);
     }
 
     // The cubes as a cube-map array: a 6-layer input (one probe) has a plain cube view, so the node makes its own.
@@ -348,31 +330,10 @@ private:
         for (uint32_t i = 0; i < kBindingCount; ++i)
             b[i] = {i, i == kUniforms ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                     1, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
-        VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-        li.bindingCount = kBindingCount;
-        li.pBindings = b.data();
-        VK_CHECK(vkCreateDescriptorSetLayout(mDevice, &li, nullptr, &mSetLayout));
-        VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                         {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kBindingCount - 1}};
-        VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-        pi.maxSets = 1;
-        pi.poolSizeCount = 2;
-        pi.pPoolSizes = sizes;
-        VK_CHECK(vkCreateDescriptorPool(mDevice, &pi, nullptr, &mPool));
-        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-        ai.descriptorPool = mPool;
-        ai.descriptorSetCount = 1;
-        ai.pSetLayouts = &mSetLayout;
-        VK_CHECK(vkAllocateDescriptorSets(mDevice, &ai, &mSet));
-        VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-        si.magFilter = si.minFilter = VK_FILTER_LINEAR;
-        si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
-        si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-        si.maxLod = VK_LOD_CLAMP_NONE;
-        VK_CHECK(vkCreateSampler(mDevice, &si, nullptr, &mLinear));
-        si.magFilter = si.minFilter = VK_FILTER_NEAREST;
-        si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
-        VK_CHECK(vkCreateSampler(mDevice, &si, nullptr, &mNearest));
+        const SamplerDesc samplers[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR},
+                                        {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST}}; // kLinear, kNearest
+        mSets = DescriptorSets(c, b, 1, samplers, "ibl.localized.set");
+        mSet = mSets.allocate();
         mUniforms =
             GpuBuffer(c, sizeof(LocalizedUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, "ibl.localized.uniforms");
 
@@ -380,7 +341,7 @@ private:
         // included), passing where the G-buffer's surface is not behind them (reverse Z: proxy depth <= surface
         // depth); depth clamped so that no far plane clips a volume; additive blending of every target.
         RasterPipelineDesc d;
-        d.setLayouts = {mSetLayout};
+        d.setLayouts = {mSets.layout()};
         d.vertex = ctx.shaders().compile("ibl/localized.vert");
         d.depthFormat = ctx.input("depth").desc().format;
         d.depthTest = true;
@@ -429,10 +390,8 @@ private:
     std::vector<LocalizedProbe> mProbes;
     Context* mContext = nullptr;
     VkDevice mDevice = VK_NULL_HANDLE;
-    VkDescriptorSetLayout mSetLayout = VK_NULL_HANDLE;
-    VkDescriptorPool mPool = VK_NULL_HANDLE;
+    DescriptorSets mSets;
     VkDescriptorSet mSet = VK_NULL_HANDLE;
-    VkSampler mLinear = VK_NULL_HANDLE, mNearest = VK_NULL_HANDLE;
     GpuBuffer mUniforms;
     VkImageView mCubeView = VK_NULL_HANDLE; // see cubeArrayView()
     VkImage mCubeViewImage = VK_NULL_HANDLE;

@@ -2,7 +2,7 @@
 #include "shaders/post/flare.h"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
-#include "nodes/camera/camera_state.hpp"
+#include "nodes/post/bright_pass.hpp"
 
 #include <cmath>
 
@@ -31,25 +31,12 @@ NodeSchema schema() {
     color.formatFrom = "color";
     color.size = SizeRule::ofInput("color");
     color.doc = "Colour plus flare";
-    OutputPort bright;
-    bright.name = "bright";
-    bright.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    bright.usage = Usage::StorageReadWrite;
-    bright.doc = "The bright pass (HDR), downsampled";
+    OutputPort bright = brightPassOutput();
     OutputPort flare = bright;
     flare.name = "flare";
     flare.doc = "The flare alone (HDR), at the bright pass's size";
     s.outputs = {color, bright, flare};
     s.params = {
-        {"exposure",
-         ParamType::Float,
-         0.0,
-         -24.0,
-         24.0,
-         {},
-         "Exposure in stops (as post.tonemap's) that makes the threshold display-referred; camera_state replaces it"},
-        {"threshold", ParamType::Float, 1.0, 0.0, 1e4, {}, "Exposed luminance above which light flares"},
-        {"downsample", ParamType::Int, 4, 1.0, 16.0, {}, "Bright-pass downsampling factor"},
         {"ghost_scales",
          ParamType::Vec4,
          nlohmann::json::array({-0.4, -0.75, -1.1, 0.5}),
@@ -75,19 +62,14 @@ NodeSchema schema() {
         {"halo_intensity", ParamType::Float, 0.05, 0.0, 10.0, {}, "Ring ghost energy relative to the source's"},
         {"halo_taps", ParamType::Int, 48, 1.0, 256.0, {}, "Taps on the ring"},
     };
+    prependBrightPassParams(s.params, "flares");
     return s;
 }
 
 class Flare final : public Node {
 public:
     void setup(SetupContext& ctx) override {
-        const ImageDesc& color = ctx.input("color");
-        mFactor = static_cast<uint32_t>(ctx.params().getInt("downsample"));
-        for (const char* port : {"bright", "flare"}) {
-            ImageDesc& d = ctx.output(port);
-            d.width = (color.width + mFactor - 1) / mFactor;
-            d.height = (color.height + mFactor - 1) / mFactor;
-        }
+        mFactor = sizeBrightPass(ctx, {"bright", "flare"});
         mBright = ctx.computePipeline("post/flare_bright.comp");
         mGhosts = ctx.computePipeline("post/flare_ghosts.comp");
         mComposite = ctx.computePipeline("post/flare.comp");
@@ -103,10 +85,7 @@ public:
         push.centre = glm::vec2(0.5f * out.width, 0.5f * out.height) / static_cast<float>(mFactor);
         push.halfDiagonal = 0.5f * std::hypot(static_cast<float>(out.width), static_cast<float>(out.height)) /
                             static_cast<float>(mFactor);
-        push.exposure = ctx.hasInput("camera_state") ? ctx.objectAs<CameraStateObject>("camera_state").state.exposure
-                                                     : std::exp2(p.getFloat("exposure"));
-        push.threshold = p.getFloat("threshold");
-        push.factor = static_cast<int>(mFactor);
+        fillBrightPass(ctx, mFactor, push);
         push.ghostIntensity = p.getFloat("ghost_intensity");
         push.haloRadius = p.getFloat("halo_radius");
         push.haloIntensity = p.getFloat("halo_intensity");

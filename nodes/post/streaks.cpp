@@ -3,6 +3,7 @@
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "nodes/camera/camera_state.hpp"
+#include "nodes/post/bright_pass.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -34,25 +35,12 @@ NodeSchema schema() {
     color.formatFrom = "color";
     color.size = SizeRule::ofInput("color");
     color.doc = "Colour plus streaks";
-    OutputPort bright;
-    bright.name = "bright";
-    bright.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    bright.usage = Usage::StorageReadWrite;
-    bright.doc = "The bright pass (HDR), downsampled";
+    OutputPort bright = brightPassOutput();
     OutputPort streaks = bright;
     streaks.name = "streaks";
     streaks.doc = "The streaks alone (HDR), at the bright pass's size";
     s.outputs = {color, bright, streaks};
     s.params = {
-        {"exposure",
-         ParamType::Float,
-         0.0,
-         -24.0,
-         24.0,
-         {},
-         "Exposure in stops (as post.tonemap's) that makes the threshold display-referred; camera_state replaces it"},
-        {"threshold", ParamType::Float, 1.0, 0.0, 1e4, {}, "Exposed luminance above which light streaks"},
-        {"downsample", ParamType::Int, 4, 1.0, 16.0, {}, "Bright-pass downsampling factor"},
         {"blades", ParamType::Int, 6, 0.0, 32.0, {}, "Aperture blades (0: a round aperture, no streaks)"},
         {"rotation", ParamType::Float, 0.0, -360.0, 360.0, {}, "Angle of the first spike in degrees"},
         {"f_number", ParamType::Float, 8.0, 0.5, 64.0, {}, "Aperture: spike length and energy grow with it"},
@@ -66,19 +54,14 @@ NodeSchema schema() {
         {"strength", ParamType::Float, 0.3, 0.0, 10.0, {}, "Streak energy / the source's bright energy at f/8"},
         {"max_samples", ParamType::Int, 48, 1.0, 256.0, {}, "Most taps per spike (one per bright-pass pixel up to it)"},
     };
+    prependBrightPassParams(s.params, "streaks");
     return s;
 }
 
 class Streaks final : public Node {
 public:
     void setup(SetupContext& ctx) override {
-        const ImageDesc& color = ctx.input("color");
-        mFactor = static_cast<uint32_t>(ctx.params().getInt("downsample"));
-        for (const char* port : {"bright", "streaks"}) {
-            ImageDesc& d = ctx.output(port);
-            d.width = (color.width + mFactor - 1) / mFactor;
-            d.height = (color.height + mFactor - 1) / mFactor;
-        }
+        mFactor = sizeBrightPass(ctx, {"bright", "streaks"});
         mBright = ctx.computePipeline("post/streaks_bright.comp");
         mSpikes = ctx.computePipeline("post/streaks_spikes.comp");
         mComposite = ctx.computePipeline("post/streaks.comp");
@@ -90,21 +73,17 @@ public:
         int blades = p.getInt("blades");
         float rotation = p.getFloat("rotation") * static_cast<float>(std::numbers::pi / 180.0);
         float fNumber = p.getFloat("f_number");
-        float exposure = std::exp2(p.getFloat("exposure"));
         float gate = 1.0f;
         if (ctx.hasInput("camera_state")) {
             const CameraState& s = ctx.objectAs<CameraStateObject>("camera_state").state;
             blades = s.bladeCount;
             rotation = s.bladeRotation;
             fNumber = s.fNumber;
-            exposure = s.exposure;
             // Wide open the blades are out of the light path: a round pupil, no spikes; straight edges by a stop down.
             gate = std::clamp(std::log2(fNumber / std::max(s.wideOpenFNumber, 1e-3f)), 0.0f, 1.0f);
         }
         gpu_types::StreaksPush push{};
-        push.exposure = exposure;
-        push.threshold = p.getFloat("threshold");
-        push.factor = static_cast<int>(mFactor);
+        fillBrightPass(ctx, mFactor, push);
         push.count = blades <= 0 ? 0u : static_cast<uint32_t>(blades % 2 == 0 ? blades : 2 * blades);
         push.rotation = rotation;
         push.spikeLength =
