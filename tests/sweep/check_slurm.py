@@ -141,9 +141,16 @@ def main():
             with open(sweep_file) as f:
                 other = json.load(f)
             other["axes"][0]["values"] = list(reversed(other["axes"][0]["values"]))
-            for key in ("graph", "reference"):  # relative to the sweep file, which moves to `work`
+            here = os.path.dirname(os.path.abspath(sweep_file))  # its paths are relative to it; the copy is elsewhere
+            for key in ("graph", "reference"):
                 if isinstance(other.get(key), str):
-                    other[key] = os.path.join(os.path.dirname(os.path.abspath(sweep_file)), other[key])
+                    other[key] = os.path.join(here, other[key])
+            for point in other.get("points", []):
+                if isinstance(point.get("variant"), str):
+                    point["variant"] = os.path.join(here, point["variant"])
+            for axis in other["axes"]:
+                if isinstance(axis.get("variants"), list):
+                    axis["variants"] = [os.path.join(here, v) for v in axis["variants"]]
             other_file = os.path.join(work, "other.sweep.json")
             with open(other_file, "w") as f:
                 json.dump(other, f)
