@@ -85,6 +85,8 @@ private:
     PreparedDocument prepareDocument(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
     PreparedGraph prepare(const PreparedDocument& document, const std::string& pointer);
     PreparedGraph prepare(const nlohmann::json& spec, const std::string& pointer, const Defaults& defaults);
+    // Publishes a job's stages (compiling, rendering frame k of n) as events.
+    ProgressFn jobProgress(const std::string& job, const std::string& kind, const std::string& file);
     // Publishes a node's long work (a bake) as `stage: "node"` events of the job.
     NodeProgressFn nodeProgress(const std::string& job, const std::string& kind, const std::string& file);
     RenderResult renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph,

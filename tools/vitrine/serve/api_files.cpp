@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 namespace vitrine::serve {
@@ -68,30 +69,35 @@ npm --prefix editor run build</code></pre>
 </body></html>
 )";
 
-} // namespace
-
-void Api::listGraphs(const httplib::Request&, httplib::Response& res) {
-    nlohmann::json graphs = nlohmann::json::array();
+// Calls `visit` for every regular file under the served directory that stays inside it (hidden folders,
+// node_modules and build trees skipped); true when it stopped after kMaxListedFiles entries.
+bool forEachServedFile(const Sandbox& sandbox, const std::function<void(const fs::directory_entry&)>& visit) {
     std::error_code ec;
     size_t seen = 0;
-    bool truncated = false;
-    fs::recursive_directory_iterator it(mSandbox.root(), fs::directory_options::skip_permission_denied, ec), end;
+    fs::recursive_directory_iterator it(sandbox.root(), fs::directory_options::skip_permission_denied, ec), end;
     for (; !ec && it != end; it.increment(ec)) {
-        if (++seen > kMaxListedFiles) {
-            truncated = true;
-            break;
-        }
+        if (++seen > kMaxListedFiles) return true;
         const fs::directory_entry& entry = *it;
         if (entry.is_directory(ec)) {
             if (skippedDirectory(entry.path())) it.disable_recursion_pending();
             continue;
         }
-        if (entry.path().extension() != ".json" || !entry.is_regular_file(ec)) continue;
-        if (entry.file_size(ec) > kMaxGraphBytes || !mSandbox.contains(entry.path())) continue;
+        if (entry.is_regular_file(ec) && sandbox.contains(entry.path())) visit(entry);
+    }
+    return false;
+}
+
+} // namespace
+
+void Api::listGraphs(const httplib::Request&, httplib::Response& res) {
+    nlohmann::json graphs = nlohmann::json::array();
+    const bool truncated = forEachServedFile(mSandbox, [&](const fs::directory_entry& entry) {
+        std::error_code ec;
+        if (entry.path().extension() != ".json" || entry.file_size(ec) > kMaxGraphBytes) return;
         JsonTextError error;
         std::optional<nlohmann::json> doc = parseJsonText(readFile(entry.path()), error);
         // Graphs have nodes, variants extend a graph; other JSON (the schema, glTF, metrics) is not listed.
-        if (!doc || !doc->is_object() || !(doc->contains("nodes") || doc->contains("extends"))) continue;
+        if (!doc || !doc->is_object() || !(doc->contains("nodes") || doc->contains("extends"))) return;
         const bool variant = doc->contains("extends");
         nlohmann::json item = {{"path", mSandbox.relative(fs::weakly_canonical(entry.path()))},
                                {"kind", variant ? "variant" : "graph"}};
@@ -99,7 +105,7 @@ void Api::listGraphs(const httplib::Request&, httplib::Response& res) {
         if (doc->contains("description") && (*doc)["description"].is_string())
             item["description"] = (*doc)["description"];
         graphs.push_back(std::move(item));
-    }
+    });
     std::sort(graphs.begin(), graphs.end(),
               [](const nlohmann::json& a, const nlohmann::json& b) { return a["path"] < b["path"]; });
     nlohmann::json body = {{"graphs", graphs}};
@@ -120,26 +126,12 @@ void Api::listFiles(const httplib::Request& req, httplib::Response& res) {
         }
     }
     std::vector<std::string> files;
-    std::error_code ec;
-    size_t seen = 0;
-    bool truncated = false;
-    fs::recursive_directory_iterator it(mSandbox.root(), fs::directory_options::skip_permission_denied, ec), end;
-    for (; !ec && it != end; it.increment(ec)) {
-        if (++seen > kMaxListedFiles) {
-            truncated = true;
-            break;
-        }
-        const fs::directory_entry& entry = *it;
-        if (entry.is_directory(ec)) {
-            if (skippedDirectory(entry.path())) it.disable_recursion_pending();
-            continue;
-        }
-        if (!entry.is_regular_file(ec) || !mSandbox.contains(entry.path())) continue;
+    const bool truncated = forEachServedFile(mSandbox, [&](const fs::directory_entry& entry) {
         std::string ext = entry.path().extension().string();
         std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-        if (!extensions.empty() && std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) continue;
+        if (!extensions.empty() && std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) return;
         files.push_back(mSandbox.relative(fs::weakly_canonical(entry.path())));
-    }
+    });
     std::sort(files.begin(), files.end());
     nlohmann::json body = {{"files", files}};
     if (truncated) body["truncated"] = true;

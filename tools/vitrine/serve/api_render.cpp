@@ -215,6 +215,13 @@ PreparedGraph Api::prepare(const PreparedDocument& doc, const std::string& point
     return prepared;
 }
 
+ProgressFn Api::jobProgress(const std::string& job, const std::string& kind, const std::string& file) {
+    return [this, job, kind, file](const std::string& stage, uint32_t done, uint32_t total) {
+        mEvents.publish(
+            "job", {{"job", job}, {"kind", kind}, {"graph", file}, {"stage", stage}, {"done", done}, {"total", total}});
+    };
+}
+
 NodeProgressFn Api::nodeProgress(const std::string& job, const std::string& kind, const std::string& file) {
     return [this, job, kind, file](const std::string& node, const std::string& label, size_t done, size_t total) {
         mEvents.publish("job", {{"job", job},
@@ -230,12 +237,8 @@ NodeProgressFn Api::nodeProgress(const std::string& job, const std::string& kind
 
 RenderResult Api::renderJob(const std::string& job, const std::string& kind, const PreparedGraph& graph,
                             const std::string& tag) {
-    const std::string file = graph.desc.file;
-    auto progress = [&, job, kind, file](const std::string& stage, uint32_t done, uint32_t total) {
-        mEvents.publish(
-            "job", {{"job", job}, {"kind", kind}, {"graph", file}, {"stage", stage}, {"done", done}, {"total", total}});
-    };
-    return mGpu.render(graph, progress, nodeProgress(job, kind, file), tag);
+    const std::string& file = graph.desc.file;
+    return mGpu.render(graph, jobProgress(job, kind, file), nodeProgress(job, kind, file), tag);
 }
 
 void Api::validate(const httplib::Request& req, httplib::Response& res) {
@@ -312,14 +315,7 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
         std::vector<std::string> ids(std::max<size_t>(prepared.previews.size(), 1));
         for (auto& id : ids) id = mImages.reserve();
         auto shared = std::make_shared<PreparedGraph>(std::move(prepared));
-        auto progress = [this, job, file](const std::string& stage, uint32_t done, uint32_t total) {
-            mEvents.publish("job", {{"job", job},
-                                    {"kind", "render"},
-                                    {"graph", file},
-                                    {"stage", stage},
-                                    {"done", done},
-                                    {"total", total}});
-        };
+        const ProgressFn progress = jobProgress(job, "render", file);
         auto fail = [this, ids, job](int status, const nlohmann::json& body, const std::string& stage) {
             for (const auto& id : ids) mImages.fail(id, status, body);
             mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", stage}, {"error", body.value("error", "")}});
