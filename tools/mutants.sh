@@ -3,7 +3,12 @@
 # reports every mutation that no test caught (a "survivor"). Exit status 1 when any survives, 2 on a broken entry
 # (a sed edit that changes nothing, a file that does not exist).
 #
-#   bash tools/mutants.sh [--list FILE] [--build DIR] [FILTER]
+#   bash tools/mutants.sh [--list FILE] [--build DIR] [--check-list] [FILTER]
+#
+# --check-list runs no test: it only checks that every entry still applies (each file exists, each sed edit changes
+# it, the line has the FILE ;; SED ;; CTEST-REGEX ;; DESCRIPTION shape and, when --build has a configured tree, the
+# regex selects some test). Seconds for the whole list; CI runs it as the ctest `mutants.list`, so an entry whose code
+# moved fails before the list can rot.
 #
 # FILTER (a grep -E pattern) keeps the entries whose line matches it, e.g. `deferred` or `flip`.
 #
@@ -19,14 +24,59 @@ root=$(pwd)
 list=tests/mutants.txt
 build=build
 filter=""
+check_only=0
 while [ $# -gt 0 ]; do
     case "$1" in
         --list) list=$2; shift 2 ;;
         --build) build=$2; shift 2 ;;
-        -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+        --check-list) check_only=1; shift ;;
+        -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
         *) filter=$1; shift ;;
     esac
 done
+trim() { local s=$1; s=${s#"${s%%[![:space:]]*}"}; s=${s%"${s##*[![:space:]]}"}; printf '%s' "$s"; }
+[ -f "$list" ] || { echo "mutants: no list $list" >&2; exit 2; }
+
+# --check-list: every entry must still change its files (and name tests that exist); nothing is built or run.
+if [ $check_only -eq 1 ]; then
+    tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+    all_tests=""
+    [ -f "$build/CTestTestfile.cmake" ] && all_tests=$(ctest --test-dir "$build" -N 2>/dev/null | sed -n 's/^ *Test *#[0-9]*: //p')
+    total=0; stale=0; lineno=0
+    while IFS= read -r line || [ -n "$line" ]; do
+        lineno=$((lineno + 1))
+        [[ -z "$(trim "$line")" || "$(trim "$line")" == \#* ]] && continue
+        [ -n "$filter" ] && ! grep -qE -- "$filter" <<<"$line" && continue
+        total=$((total + 1))
+        IFS=$'\x1f' read -r -a fields <<<"${line// ;; /$'\x1f'}"
+        n=${#fields[@]}
+        where="$list:$lineno"
+        if [ "$n" -lt 4 ] || [ $((n % 2)) -ne 0 ]; then
+            echo "STALE   $where: expected FILE ;; SED [;; FILE ;; SED ...] ;; CTEST-REGEX ;; DESCRIPTION"
+            stale=$((stale + 1)); continue
+        fi
+        what=$(trim "${fields[n - 1]}"); tests=$(trim "${fields[n - 2]}")
+        for ((i = 0; i < n - 2; i += 2)); do
+            f=$(trim "${fields[i]}"); e=$(trim "${fields[i + 1]}")
+            if [ ! -f "$f" ]; then echo "STALE   $where: $f: no such file ($what)"; stale=$((stale + 1)); continue 2; fi
+            cp "$f" "$tmp/copy"
+            if ! sed -i -e "$e" "$tmp/copy" 2>"$tmp/err"; then
+                echo "STALE   $where: $f: the edit '$e' is not a valid sed script: $(head -1 "$tmp/err") ($what)"
+                stale=$((stale + 1)); continue 2
+            fi
+            if cmp -s "$f" "$tmp/copy"; then
+                echo "STALE   $where: $f: the edit '$e' changes nothing ($what)"; stale=$((stale + 1)); continue 2
+            fi
+        done
+        if [ -n "$all_tests" ] && ! grep -qE -- "$tests" <<<"$all_tests"; then
+            echo "STALE   $where: /$tests/ selects no test ($what)"; stale=$((stale + 1)); continue
+        fi
+    done < "$list"
+    echo "mutants: $total entr$([ $total -eq 1 ] && echo y || echo ies) checked, $stale stale$([ -z "$all_tests" ] && echo " (test names not checked: no build in $build)")"
+    [ $stale -gt 0 ] && exit 1
+    exit 0
+fi
+
 [ -f "$build/CTestTestfile.cmake" ] || { echo "mutants: no build in $build; run bash tools/build.sh first" >&2; exit 2; }
 
 scratch=$root/.mutants
@@ -34,7 +84,6 @@ mkdir -p "$scratch"
 log=$scratch/log
 : > "$log"
 
-trim() { local s=$1; s=${s#"${s%%[![:space:]]*}"}; s=${s%"${s##*[![:space:]]}"}; printf '%s' "$s"; }
 
 # A scratch source tree for C++ mutations: the tracked files of the working tree, refreshed before each run.
 cxx_tree_ready=0
