@@ -141,6 +141,10 @@ public:
         for (uint32_t face = 0; face < sky.desc().layers; ++face)
             hashImage(readImage(ctx.gpu(), sky, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face), lighting);
         hashImage(readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL), lighting);
+        // The bake's own code and the device that runs it change the result too: the SPIR-V of its shaders (an edit
+        // of an included BRDF file re-bakes instead of loading a stale lightmap) and the device's name (another GPU, or
+        // lavapipe, bakes other bits).
+        hashBakeCode(ctx, lighting);
         const BakeKey key = bake::lightmapCacheKey(scene, mSettings, lighting.result());
         const BakeCache cache(defaultCacheDir());
 
@@ -169,6 +173,16 @@ public:
     void releaseGpu() override { mUploaded = false; } // a new executor's outputs start empty
 
 private:
+    void hashBakeCode(ExecuteContext& ctx, scene::Hasher& h) const {
+        const size_t textures = std::max<size_t>(1, mScene->scene().textures.size());
+        const ShaderDefines defines = {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}};
+        for (const char* path : {"bake/lightmap.comp", "bake/lightmap_texels.vert", "bake/lightmap_texels.frag"}) {
+            const CompiledShader shader = ctx.shaders().compile(path, defines);
+            h.bytes(shader.spirv.data(), shader.spirv.size() * sizeof(uint32_t));
+        }
+        h.string(ctx.gpu().deviceInfo().name);
+    }
+
     static double msSince(Clock::time_point t) {
         return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
     }

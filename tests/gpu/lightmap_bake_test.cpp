@@ -33,8 +33,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <optional>
+#include <sstream>
 
 namespace vitrine::test {
 namespace {
@@ -323,6 +325,29 @@ TEST_F(LightmapBake, MuseumBakeIsFiniteLitWhereTheSunIsAndCached) {
     for (const auto& e : fs::directory_iterator(cacheDir / "bake" / "lightmap")) stored += e.is_regular_file() ? 1 : 0;
     EXPECT_EQ(stored, 2u) << "a changed sky must not reuse the bake of the first";
     EXPECT_NE(fourth.at("lightmap").pixels, first.at("lightmap").pixels);
+
+    // An edit of the bake's own code (its sky term, in a copy of shaders/) is baked anew: the key holds the bake
+    // shaders' SPIR-V, so neither a user's edit nor a mutation run is served the stale file.
+    const fs::path edited = fs::path(VITRINE_TEST_OUT) / "museum_bake_shaders";
+    fs::remove_all(edited);
+    fs::copy(defaultShaderDir(), edited, fs::copy_options::recursive);
+    {
+        std::ifstream in(edited / "bake" / "lightmap.comp");
+        std::stringstream source;
+        source << in.rdbuf();
+        std::string text = source.str();
+        const std::string from = "* push.scales.y;";
+        const size_t at = text.find(from);
+        ASSERT_NE(at, std::string::npos) << "the bake shader's sky term moved; update this test";
+        text.replace(at, from.size(), "* push.scales.y * 0.5;");
+        std::ofstream(edited / "bake" / "lightmap.comp") << text;
+    }
+    ScopedEnv shaderDir("VITRINE_SHADER_DIR", edited.string());
+    auto fifth = runGraph(g);
+    stored = 0;
+    for (const auto& e : fs::directory_iterator(cacheDir / "bake" / "lightmap")) stored += e.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(stored, 3u) << "an edited bake shader must not load the bake of the unedited one";
+    EXPECT_NE(fifth.at("lightmap").pixels, first.at("lightmap").pixels);
 }
 
 // Mean luminance of each block of a bx x by grid over the image.
