@@ -301,9 +301,12 @@ def security_checks(nodes):
               f"?token= answers with an HttpOnly SameSite=Strict cookie ({cookie})")
         r, _ = server.request("GET", "/api/status", headers={"Cookie": cookie.split(";")[0]}, auth=False)
         check(r.status == 200, "the cookie alone is enough")
-        r, _ = server.request("GET", "/api/status", headers={"Cookie": "vitrine_token=" + "0" * len(server.token)},
+        r, _ = server.request("GET", "/api/status", headers={"Cookie": "vitrine_token_%d=" % port + "0" * len(server.token)},
                               auth=False)
         check(r.status == 401, "a wrong cookie: 401")
+        r, _ = server.request("GET", "/api/status", headers={"Cookie": "vitrine_token_%d=%s" % (port + 1, server.token)},
+                              auth=False)
+        check(r.status == 401, "another port's cookie: 401")
 
     # DNS rebinding: only the loopback names with this port are answered.
     for host in ["127.0.0.1.attacker.example:%d" % port, "127.0.0.1.attacker.example", "127.1.2.3:%d" % port,
@@ -820,7 +823,8 @@ def main():
     r, payload = server.request("GET", "/?token=" + server.token, auth=False)
     cookie = r.getheader("Set-Cookie", "")
     check(r.status == 200 and b"<title>editor</title>" in payload, "GET /?token=... serves the editor's index.html")
-    check(cookie.startswith("vitrine_token=") and "HttpOnly" in cookie, "the token is kept as a cookie")
+    check(cookie.startswith("vitrine_token_%d=" % server.port) and "HttpOnly" in cookie,
+          "the token is kept as a cookie named with the port (cookies do not tell ports apart)")
     r, payload = server.request("GET", "/assets/app.js", headers={"Cookie": cookie.split(";")[0]}, auth=False)
     check(r.status == 200 and r.getheader("Content-Type") == "text/javascript", "static files with the cookie")
     r, payload = server.request("GET", "/api/nodes", headers={"Authorization": "token " + server.token}, auth=False)
