@@ -128,6 +128,8 @@ Api::PreparedDocument Api::prepareDocument(const nlohmann::json& spec, const std
         }
     }
     document = mergeGraphDocument(std::move(document), file, sets);
+    // Path params out of DIR are refused before anything else looks at the graph (validation, node setups).
+    mSandbox.checkPathParams(document, file.parent_path(), label);
 
     // The preview: size, frame count and the one output rendered, written into the document before it is validated
     // (so a frame.write beyond a shortened run is not an error, and the warm-graph key is the document).
