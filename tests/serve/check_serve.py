@@ -364,6 +364,8 @@ def security_checks(nodes):
               f"POST with Content-Type {ctype}: 415 with a message ({resp.status})")
     r, body = server.json("PUT", "/api/graphs/graphs/ctype.json", zoneplate_bytes, headers={"Content-Type": "text/plain"})
     check(r.status == 415 and not os.path.exists(os.path.join(gdir, "ctype.json")), f"PUT as text/plain: 415 ({r.status})")
+    r, body = server.json("POST", "/api/validate", b"{" + b" " * 2_000_000 + b"}", headers={"Content-Type": "text/plain"})
+    check(r.status == 415, f"an oversize body with the wrong Content-Type: 415, not 413 ({r.status})")
     r, body = server.json("POST", "/api/validate", {"graph": "graphs/fxaa_zoneplate.json"},
                           headers={"Content-Type": "application/json; charset=utf-8"})
     check(r.status == 200, "application/json; charset=utf-8 is JSON")
