@@ -462,6 +462,14 @@ def security_checks(nodes):
                 check(refused and SECRET not in text and work not in text and outside not in text,
                       f"{route} {node_type}.{param} = {how} path out of DIR: refused, nothing echoed "
                       f"({r.status}: {text[:300]})")
+    # A working graph whose lens names a JSON file out of DIR: its setup used to read it and echo its "format".
+    for value in [os.path.relpath(secret_path, gdir), secret_path]:
+        for route in ["/api/validate", "/api/render"]:
+            r, payload = server.request("POST", route, {"graph": "graphs/camera_checker.json",
+                                                        "set": ["camera.params.lens=" + value], "width": 32, "height": 18})
+            text = payload.decode(errors="replace")
+            check("refused" in text and SECRET not in text and outside not in text,
+                  f"{route} camera_checker.json with lens {value[:40]}...: refused, the file not echoed ({text[:200]})")
     check(tree_digest(outside) == outside_digest, "nothing outside DIR was written (security checks)")
 
 
