@@ -462,6 +462,33 @@ def security_checks(nodes):
                 check(refused and SECRET not in text and work not in text and outside not in text,
                       f"{route} {node_type}.{param} = {how} path out of DIR: refused, nothing echoed "
                       f"({r.status}: {text[:300]})")
+    # Event streams hold a server thread each: 16 open at once (16 tabs, or a script) must not starve the API.
+    streams = []
+    for _ in range(16):
+        sk = socket.create_connection((server.host, server.port))
+        sk.settimeout(10)
+        sk.sendall(("GET /api/events HTTP/1.1\r\nHost: %s:%d\r\n%s\r\n" %
+                    (server.host, server.port, "".join("%s: %s\r\n" % kv for kv in server.auth().items()))).encode())
+        streams.append(sk)
+    answers = []
+    for sk in streams:
+        try:
+            answers.append(int(sk.recv(64).split()[1]))
+        except (OSError, IndexError, ValueError):
+            answers.append(0)
+        if answers[-1] != 200:
+            sk.close()
+    try:
+        r, _ = server.request("GET", "/api/status", timeout=10)
+        status = r.status
+    except OSError:
+        status = 0
+    check(status == 200, f"the API answers while 16 event streams are open ({status})")
+    check(answers.count(200) >= 4 and 503 in answers and all(a in (200, 503) for a in answers),
+          f"event streams past the limit get 503 ({answers})")
+    for sk in streams:
+        sk.close()
+
     # A working graph whose lens names a JSON file out of DIR: its setup used to read it and echo its "format".
     for value in [os.path.relpath(secret_path, gdir), secret_path]:
         for route in ["/api/validate", "/api/render"]:
