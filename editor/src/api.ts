@@ -188,15 +188,31 @@ export interface JobEvent {
 export function subscribeEvents(onJob: (e: JobEvent) => void): () => void {
   if (typeof EventSource === 'undefined') return () => undefined;
   const url = token ? `/api/events?token=${encodeURIComponent(token)}` : '/api/events';
-  const source = new EventSource(url);
-  source.addEventListener('job', (ev) => {
-    try {
-      onJob(JSON.parse((ev as MessageEvent<string>).data) as JobEvent);
-    } catch {
-      /* ignore malformed events */
-    }
-  });
-  return () => source.close();
+  let source: EventSource | null = null;
+  let timer: ReturnType<typeof setTimeout> | undefined;
+  let stopped = false;
+  const open = () => {
+    const s = new EventSource(url);
+    source = s;
+    s.addEventListener('job', (ev) => {
+      try {
+        onJob(JSON.parse((ev as MessageEvent<string>).data) as JobEvent);
+      } catch {
+        /* ignore malformed events */
+      }
+    });
+    // A stream the server refuses (503: too many streams open, from other tabs) is closed for good by the browser:
+    // try again a little later. Network errors reconnect by themselves (readyState CONNECTING).
+    s.addEventListener('error', () => {
+      if (!stopped && s.readyState === EventSource.CLOSED) timer = setTimeout(open, 5000);
+    });
+  };
+  open();
+  return () => {
+    stopped = true;
+    clearTimeout(timer);
+    source?.close();
+  };
 }
 
 /** Files under DIR for path pickers: `GET /api/files[?ext=.cube,.png]` when the server has it, else none. */

@@ -130,6 +130,9 @@ private:
     EventHub& mEvents;
     ImageStore mImages;
     std::atomic<uint64_t> mJobs{0};
+    // Open /api/events streams, at most kMaxEventStreams of the server's 16 threads (serve_command.cpp).
+    static constexpr int kMaxEventStreams = 8;
+    std::atomic<int> mStreams{0};
 };
 
 } // namespace vitrine::serve
