@@ -11,7 +11,10 @@ of the size asked for; validate reports the JSON pointer; compare returns the `v
 malformed JSON -> 400 with line and column; an oversize body -> 413; a graph that fails returns an error and the next
 request works; a client that disconnects mid-render and two clients at once; progress as server-sent events;
 with a --host other than the loopback default, requests without the token get 401. A second server instance
-checks the token and the editor's static files. Ends with "N passed, M failed".
+checks the token and the editor's static files, a third --no-token. Issue #27's checks run first
+(security_checks: the loopback token, Host and Origin, headers, 415, chunked bodies past --max-body, where PUT
+writes, ETag/If-Match, every path param of every node pointed out of DIR, event streams that must not starve the
+API); VITRINE_SERVE_CHECKS=security runs only those. Ends with "N passed, M failed".
 """
 import atexit
 import hashlib
