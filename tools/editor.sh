@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Opens the graph editor: builds vitrine and the editor's bundle (editor/dist/) when needed, then serves the
-# repository root with `vitrine serve .` and prints the URL to open (http://127.0.0.1:8420/ by default).
+# repository root with `vitrine serve .` and prints the URL to open (http://127.0.0.1:8420/?token=... by default:
+# the token is what lets the browser in; --no-token drops it).
 # Extra arguments go to `vitrine serve` (e.g. --port 0 for any free port). Ctrl-C stops it.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -122,7 +122,7 @@ function Editor() {
       const found = new Set<string>();
       for (const g of graphs) {
         try {
-          const doc = JSON.parse(await api.readGraph(g.path)) as Json;
+          const doc = JSON.parse(await api.readGraph(g.path, false)) as Json;
           if (!isObject(doc)) continue;
           for (const n of Object.values(nodesOf(doc))) {
             if (!isObject(n) || typeof n.type !== 'string' || !isObject(n.params)) continue;

@@ -59,19 +59,29 @@ export const listGraphs = async (): Promise<GraphListEntry[]> =>
 
 export const listNodes = (): Promise<NodeSchema[]> => getJson<NodeSchema[]>('/api/nodes');
 
-export async function readGraph(path: string): Promise<string> {
+/** The ETag of each graph file as this page last read or wrote it: a save sends it as If-Match, so that a file changed
+ * since (another tab, another editor) is not overwritten: the server answers 412 and the save fails with its message. */
+const etags = new Map<string, string>();
+
+/** A graph file's text; `track` (default) keeps its ETag for the next `writeGraph` of that path. */
+export async function readGraph(path: string, track = true): Promise<string> {
   const res = await fetch(`/api/graphs/${path.split('/').map(encodeURIComponent).join('/')}`, { headers: headers() });
   if (!res.ok) throw await failure(res);
+  const etag = res.headers.get('ETag');
+  if (track && etag) etags.set(path, etag);
   return res.text();
 }
 
 export async function writeGraph(path: string, text: string): Promise<void> {
+  const known = etags.get(path);
   const res = await fetch(`/api/graphs/${path.split('/').map(encodeURIComponent).join('/')}`, {
     method: 'PUT',
-    headers: headers({ 'Content-Type': 'application/json' }),
+    headers: headers(known ? { 'Content-Type': 'application/json', 'If-Match': known } : { 'Content-Type': 'application/json' }),
     body: text,
   });
   if (!res.ok) throw await failure(res);
+  const etag = res.headers.get('ETag');
+  if (etag) etags.set(path, etag);
 }
 
 /** A graph for a request: a file under DIR, or a document sent inline standing for the file `base`. */
@@ -178,15 +188,31 @@ export interface JobEvent {
 export function subscribeEvents(onJob: (e: JobEvent) => void): () => void {
   if (typeof EventSource === 'undefined') return () => undefined;
   const url = token ? `/api/events?token=${encodeURIComponent(token)}` : '/api/events';
-  const source = new EventSource(url);
-  source.addEventListener('job', (ev) => {
-    try {
-      onJob(JSON.parse((ev as MessageEvent<string>).data) as JobEvent);
-    } catch {
-      /* ignore malformed events */
-    }
-  });
-  return () => source.close();
+  let source: EventSource | null = null;
+  let timer: ReturnType<typeof setTimeout> | undefined;
+  let stopped = false;
+  const open = () => {
+    const s = new EventSource(url);
+    source = s;
+    s.addEventListener('job', (ev) => {
+      try {
+        onJob(JSON.parse((ev as MessageEvent<string>).data) as JobEvent);
+      } catch {
+        /* ignore malformed events */
+      }
+    });
+    // A stream the server refuses (503: too many streams open, from other tabs) is closed for good by the browser:
+    // try again a little later. Network errors reconnect by themselves (readyState CONNECTING).
+    s.addEventListener('error', () => {
+      if (!stopped && s.readyState === EventSource.CLOSED) timer = setTimeout(open, 5000);
+    });
+  };
+  open();
+  return () => {
+    stopped = true;
+    clearTimeout(timer);
+    source?.close();
+  };
 }
 
 /** Files under DIR for path pickers: `GET /api/files[?ext=.cube,.png]` when the server has it, else none. */

@@ -77,7 +77,7 @@ LensData loadLens(const std::filesystem::path& path) {
     const Reader r(path.string());
     if (!doc.is_object()) r.fail("", "expected a lens object (format vitrine-lens/1)");
     if (r.member(doc, "", "format") != "vitrine-lens/1")
-        r.fail("/format", "expected \"vitrine-lens/1\", got " + brief(doc["format"]));
+        r.fail("/format", "expected \"vitrine-lens/1\": not a lens file"); // its content is not echoed
     LensData lens;
     lens.file = path.string();
     const json& name = r.member(doc, "", "name");
@@ -154,7 +154,7 @@ std::filesystem::path findLens(const std::string& nameOrPath, const std::filesys
         if (e.path().extension() == ".json") names.insert(e.path().stem().string());
     std::string list;
     for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-    throw UserError("no lens '" + nameOrPath + "': expected a .json file or one of " + lenses.string() + ": " + list);
+    throw UserError("no lens '" + nameOrPath + "': expected a .json file or one of data/lenses/: " + list);
 }
 
 float interpolate(const std::vector<std::pair<float, float>>& table, float focalMm) {

@@ -46,7 +46,7 @@ NodeSchema schema() {
     state.doc = "The camera's state this frame (nodes/camera/camera_state.hpp) for the post nodes' camera_state";
     s.outputs = {state};
     s.params = {
-        {"lens", ParamType::String, "canon_ef_50mm_f1.8_stm", {}, {}, {},
+        {"lens", ParamType::Path, "canon_ef_50mm_f1.8_stm", {}, {}, {},
          "A lens of data/lenses/ by name (file stem), or a lens .json file relative to the graph"},
         {"focal_length", ParamType::Float, 0.0, 0.0, 2000.0, {}, "Focal length (mm) within the lens's range; 0: its shortest"},
         {"focus_distance", ParamType::Float, 5.0, 0.01, 100000.0, {}, "Focus distance (m); closer than the lens's closest focus clamps"},

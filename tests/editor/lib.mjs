@@ -70,8 +70,12 @@ for (const sig of ['SIGINT', 'SIGTERM', 'SIGHUP'])
         process.exit(130);
     });
 
-// Starts `vitrine serve DIR --port 0` and reads the URL it prints ("vitrine serve: listening on http://H:P/").
-// Its stdout and stderr go to logFile.
+// The access token of the server startServer started last (vitrine serve asks for one on the loopback too):
+// openGraph passes it in the URL, the page keeps it as a cookie.
+let serverToken = null;
+
+// Starts `vitrine serve DIR --port 0` and reads the URL it prints ("vitrine serve: listening on
+// http://H:P/?token=T"): `url` is http://H:P/, `token` T. Its stdout and stderr go to logFile.
 export async function startServer({ vitrine, dir, editorDist, logFile, extraArgs = [] }) {
     const log = fs.createWriteStream(logFile);
     const proc = spawn(vitrine, ['serve', dir, '--port', '0', '--editor', editorDist, ...extraArgs],
@@ -86,6 +90,7 @@ export async function startServer({ vitrine, dir, editorDist, logFile, extraArgs
             const m = text.match(/listening on (http:\/\/[^\s]+\/)(\?token=\w+)?/);
             if (m) {
                 clearTimeout(timer);
+                serverToken = m[2] ? m[2].slice('?token='.length) : null;
                 resolve(m[1]);
             }
         };
@@ -103,6 +108,7 @@ export async function startServer({ vitrine, dir, editorDist, logFile, extraArgs
     const exited = new Promise(resolve => proc.on('exit', (code, signal) => resolve({ code, signal })));
     return {
         url,
+        token: serverToken,
         pid: proc.pid,
         alive: () => proc.exitCode === null && proc.signalCode === null,
         // SIGTERM, then SIGKILL after 60 s; the exit status.
@@ -170,7 +176,8 @@ export async function waitIdle(page, timeout = 180000) {
 
 // Opens FILE (relative to the served directory) through the ?graph= URL and waits until it is drawn and idle.
 export async function openGraph(page, url, file, { idle = true, timeout = 180000 } = {}) {
-    await page.goto(`${url}?graph=${encodeURIComponent(file)}`);
+    const token = serverToken ? `&token=${serverToken}` : '';
+    await page.goto(`${url}?graph=${encodeURIComponent(file)}${token}`);
     await waitVisible(page, 'app', `opening ${file}`, 30000);
     await poll(async () => ((await page.locator(tid('current-file')).textContent()) || '').includes(file),
                async () => `opening ${file}: current-file shows "${await page.locator(tid('current-file')).textContent().catch(() => '?')}"`,

@@ -11,7 +11,10 @@ of the size asked for; validate reports the JSON pointer; compare returns the `v
 malformed JSON -> 400 with line and column; an oversize body -> 413; a graph that fails returns an error and the next
 request works; a client that disconnects mid-render and two clients at once; progress as server-sent events;
 with a --host other than the loopback default, requests without the token get 401. A second server instance
-checks the token and the editor's static files. Ends with "N passed, M failed".
+checks the token and the editor's static files, a third --no-token. Issue #27's checks run first
+(security_checks: the loopback token, Host and Origin, headers, 415, chunked bodies past --max-body, where PUT
+writes, ETag/If-Match, every path param of every node pointed out of DIR, event streams that must not starve the
+API); VITRINE_SERVE_CHECKS=security runs only those. Ends with "N passed, M failed".
 """
 import atexit
 import hashlib
@@ -94,9 +97,9 @@ def tree_digest(root):
 
 
 class Server:
-    def __init__(self, directory, *extra):
+    def __init__(self, directory, *extra, stderr=None):
         self.proc = subprocess.Popen([vitrine, "serve", directory, "--port", "0", "--validate", *extra],
-                                     stdout=subprocess.PIPE, text=True)
+                                     stdout=subprocess.PIPE, stderr=stderr, text=True)
         servers.append(self.proc)
         self.url = None
         deadline = time.time() + 120
@@ -116,18 +119,81 @@ class Server:
             raise SystemExit("check_serve: the server did not start")
         threading.Thread(target=self.proc.stdout.read, daemon=True).start()
 
-    def request(self, method, path, body=None, headers=None, timeout=600):
+    def auth(self):
+        """The header that carries the access token (none when the server printed none)."""
+        return {"Authorization": "token " + self.token} if self.token else {}
+
+    def request(self, method, path, body=None, headers=None, timeout=600, auth=True):
+        """A request with the token (unless auth=False) and, when it has a body, Content-Type: application/json
+        (unless headers name one)."""
         conn = http.client.HTTPConnection(self.host, self.port, timeout=timeout)
         data = body if isinstance(body, (bytes, str)) or body is None else json.dumps(body)
-        conn.request(method, path, body=data, headers=headers or {})
+        sent = dict(self.auth()) if auth else {}
+        if data is not None:
+            sent["Content-Type"] = "application/json"
+        sent.update(headers or {})
+        conn.request(method, path, body=data, headers=sent)
         r = conn.getresponse()
         payload = r.read()
         conn.close()
         return r, payload
 
-    def json(self, method, path, body=None, headers=None):
-        r, payload = self.request(method, path, body, headers)
+    def status_only(self, method, path, headers=None, auth=True, timeout=30):
+        """The status and JSON body of a request that may stream (the event stream): the body is read only when the
+        answer is not a stream."""
+        conn = http.client.HTTPConnection(self.host, self.port, timeout=timeout)
+        conn.request(method, path, headers=dict(self.auth() if auth else {}, **(headers or {})))
+        r = conn.getresponse()
+        body = {} if (r.getheader("Content-Type") or "").startswith("text/event-stream") else js(r.read())
+        conn.close()
+        return r, body
+
+    def json(self, method, path, body=None, headers=None, auth=True):
+        r, payload = self.request(method, path, body, headers, auth=auth)
         return r, js(payload)
+
+    def raw(self, head, body_chunks=(), read_timeout=120):
+        """Sends HEAD (request line and headers, without the final blank line; Host and the token are added) and
+        BODY_CHUNKS from a thread over a raw socket, and reads the response while it sends: (status, headers, body)
+        of the first response. Sending stops quietly when the server closes the connection."""
+        s = socket.create_connection((self.host, self.port))
+        s.settimeout(read_timeout)
+        extra = f"Host: {self.host}:{self.port}\r\n"
+        if self.token:
+            extra += f"Authorization: token {self.token}\r\n"
+
+        def send():
+            try:
+                s.sendall((head + extra + "\r\n").encode())
+                for chunk in body_chunks:
+                    s.sendall(chunk)
+            except OSError:
+                pass
+
+        sender = threading.Thread(target=send, daemon=True)
+        sender.start()
+        data = b""
+        try:
+            while b"\r\n\r\n" not in data:
+                more = s.recv(65536)
+                if not more:
+                    break
+                data += more
+            head_bytes, _, rest = data.partition(b"\r\n\r\n")
+            lines = head_bytes.decode(errors="replace").split("\r\n")
+            status = int(lines[0].split()[1]) if lines and len(lines[0].split()) > 1 else 0
+            headers = {k.strip().lower(): v.strip() for k, _, v in (l.partition(":") for l in lines[1:])}
+            length = int(headers.get("content-length", "0"))
+            while len(rest) < length:
+                more = s.recv(65536)
+                if not more:
+                    break
+                rest += more
+        except OSError:
+            status, headers, rest = 0, {}, b""
+        s.close()
+        sender.join(timeout=30)
+        return status, headers, rest[:int(headers.get("content-length", len(rest)) or 0)]
 
     def stop(self):
         self.proc.send_signal(signal.SIGTERM)
@@ -176,16 +242,275 @@ os.symlink(outside, os.path.join(served, "linkdir"))
 os.makedirs(os.path.join(served, "scene"))
 with open(os.path.join(served, "scene", "evil.gltf"), "w") as f:
     json.dump({"asset": {"version": "2.0"}, "buffers": [{"uri": "../../outside/x.bin", "byteLength": 64}]}, f)
+# Files an attack would like to read or write: a JSON file outside DIR with a marker that must never come back in
+# an answer, a repository's .git/, node_modules/ and the editor's own sources inside DIR.
+SECRET = "SECRET-7f3a9c-do-not-echo"
+with open(os.path.join(outside, "secret.json"), "w") as f:
+    json.dump({"format": SECRET, "name": SECRET, "token": SECRET}, f)
+os.makedirs(os.path.join(served, ".git"))
+with open(os.path.join(served, ".git", "config"), "w") as f:
+    f.write("[core]\n")
+os.makedirs(os.path.join(served, "node_modules", "pkg"))
+os.makedirs(os.path.join(served, "editor", "src"))
+with open(os.path.join(served, "editor", "package.json"), "w") as f:
+    f.write('{"name": "vitrine-editor"}\n')
 outside_digest = tree_digest(outside)
 
 with open(os.path.join(gdir, "fxaa_zoneplate.json"), "rb") as f:
     zoneplate_bytes = f.read()
 zoneplate = json.loads(zoneplate_bytes)
 
+FILE_EXTENSIONS = re.compile(r"\.(json|cube|exr|hdr|png|jpe?g|glb|gltf|ocio|txt)\b", re.I)
+FILE_NAMES = {"lens", "file", "path", "lut", "scene", "gltf", "probes", "filename"}
+
+
+def path_param_checks(nodes):
+    """Every param that names a file is a `path` kind (so that the served directory confines it)."""
+    wrong = []
+    for node in nodes:
+        for p in node.get("params", []):
+            if p.get("type") != "string":  # path already; numbers, enums and vectors name no file
+                continue
+            default = p.get("default")
+            looks = (p["name"] in FILE_NAMES or
+                     (isinstance(default, str) and FILE_EXTENSIONS.search(default)) or
+                     FILE_EXTENSIONS.search(p.get("doc", "")))
+            if looks:
+                wrong.append(f"{node['type']}.{p['name']} ({p.get('type')})")
+    check(not wrong, f"every param that names a file is a path kind (not: {wrong})")
+    return [(node["type"], p["name"]) for node in nodes for p in node.get("params", []) if p.get("type") == "path"]
+
+
+def security_checks(nodes):
+    """Issue #27: DNS rebinding, cross-origin requests, path params out of DIR, chunked bodies past --max-body, PUT
+    where it should not write, If-Match, security headers, Content-Type, the loopback token."""
+    port = server.port
+    secret_path = os.path.join(outside, "secret.json")
+
+    # The loopback token (as Jupyter's): printed, required on every route, kept as an HttpOnly SameSite cookie.
+    check(server.token is not None and len(server.token) >= 32, "a loopback server prints a URL with a token")
+    for method, path, body in [("GET", "/api/status", None), ("GET", "/api/graphs", None), ("GET", "/api/events", None),
+                               ("GET", "/api/graphs/graphs/fxaa_zoneplate.json", None),
+                               ("PUT", "/api/graphs/graphs/token.json", zoneplate_bytes),
+                               ("POST", "/api/validate", {"graph": "graphs/fxaa_zoneplate.json"})]:
+        r, body = server.status_only(method, path, auth=False) if path == "/api/events" else \
+            server.json(method, path, body, auth=False)
+        check(r.status == 401 and "token" in body.get("error", ""), f"{method} {path} without the token: 401 ({r.status})")
+    check(not os.path.exists(os.path.join(gdir, "token.json")), "a PUT without the token writes nothing")
+    if server.token:
+        r, _ = server.request("GET", "/api/status?token=" + server.token, auth=False)
+        cookie = r.getheader("Set-Cookie", "")
+        check(r.status == 200 and "HttpOnly" in cookie and "SameSite=Strict" in cookie,
+              f"?token= answers with an HttpOnly SameSite=Strict cookie ({cookie})")
+        r, _ = server.request("GET", "/api/status", headers={"Cookie": cookie.split(";")[0]}, auth=False)
+        check(r.status == 200, "the cookie alone is enough")
+        r, _ = server.request("GET", "/api/status", headers={"Cookie": "vitrine_token_%d=" % port + "0" * len(server.token)},
+                              auth=False)
+        check(r.status == 401, "a wrong cookie: 401")
+        r, _ = server.request("GET", "/api/status", headers={"Cookie": "vitrine_token_%d=%s" % (port + 1, server.token)},
+                              auth=False)
+        check(r.status == 401, "another port's cookie: 401")
+
+    # DNS rebinding: only the loopback names with this port are answered.
+    for host in ["127.0.0.1.attacker.example:%d" % port, "127.0.0.1.attacker.example", "127.1.2.3:%d" % port,
+                 "attacker.example:%d" % port, "127.0.0.1:%d" % (port + 1 if port < 65535 else 1), "localhost.:%d" % port]:
+        r, body = server.json("GET", "/api/graphs", headers={"Host": host})
+        check(r.status == 403 and "Host" in body.get("error", ""), f"Host {host}: 403 naming the Host ({r.status})")
+    for host in ["127.0.0.1:%d" % port, "localhost:%d" % port, "[::1]:%d" % port]:
+        r, _ = server.json("GET", "/api/status", headers={"Host": host})
+        check(r.status == 200, f"Host {host}: answered ({r.status})")
+    # Cross-origin requests: refused on what changes state and on the event stream.
+    for origin in ["http://127.0.0.1.attacker.example:%d" % port, "http://attacker.example", "null",
+                   "http://127.0.0.1:%d" % (port + 1)]:
+        for method, path, body in [("PUT", "/api/graphs/graphs/cors.json", zoneplate_bytes),
+                                   ("POST", "/api/validate", {"graph": "graphs/fxaa_zoneplate.json"}),
+                                   ("POST", "/api/render", {"graph": "graphs/fxaa_zoneplate.json"}),
+                                   ("DELETE", "/api/graphs/graphs/fxaa_zoneplate.json", None),
+                                   ("GET", "/api/events", None)]:
+            r, reply = server.status_only(method, path, headers={"Origin": origin}) if path == "/api/events" else \
+                server.json(method, path, body, headers={"Origin": origin})
+            check(r.status == 403 and "rigin" in reply.get("error", ""),
+                  f"{method} {path} from Origin {origin}: 403 naming the origin ({r.status})")
+    check(not os.path.exists(os.path.join(gdir, "cors.json")), "a cross-origin PUT writes nothing")
+    r, body = server.json("POST", "/api/validate", {"graph": "graphs/fxaa_zoneplate.json"},
+                          headers={"Origin": "http://127.0.0.1:%d" % port})
+    check(r.status == 200 and body.get("ok") is True, "a POST from the server's own page (Origin) works")
+
+    # Headers on every answer; no caching of the API.
+    for method, path in [("GET", "/api/status"), ("GET", "/api/nope"), ("GET", "/"), ("GET", "/api/graphs/graphs/x.json")]:
+        r, _ = server.request(method, path)
+        csp = r.getheader("Content-Security-Policy", "")
+        check("default-src 'self'" in csp and "frame-ancestors 'none'" in csp and "unsafe-eval" not in csp and
+              "script-src 'self'" in csp and "http" not in csp, f"{path}: Content-Security-Policy ({csp})")
+        check(r.getheader("X-Frame-Options") == "DENY" and r.getheader("X-Content-Type-Options") == "nosniff" and
+              r.getheader("Referrer-Policy") == "no-referrer", f"{path}: X-Frame-Options, nosniff, Referrer-Policy")
+        if path.startswith("/api/"):
+            check(r.getheader("Cache-Control") == "no-store", f"{path}: Cache-Control: no-store")
+    r, _ = server.request("GET", "/api/status", auth=False)
+    check(r.getheader("Content-Security-Policy") and r.getheader("Cache-Control") == "no-store",
+          "a 401 has the headers too")
+    # A JSON body with another Content-Type (what an HTML form can send without a preflight): 415.
+    for ctype in ["text/plain", "application/x-www-form-urlencoded", "multipart/form-data; boundary=x", None]:
+        headers = {"Content-Type": ctype} if ctype else {}
+        conn = http.client.HTTPConnection(server.host, server.port, timeout=60)
+        sent = dict(server.auth(), **headers)
+        conn.putrequest("POST", "/api/validate")
+        for k, v in sent.items():
+            conn.putheader(k, v)
+        payload = json.dumps({"graph": "graphs/fxaa_zoneplate.json"}).encode()
+        conn.putheader("Content-Length", str(len(payload)))
+        conn.endheaders(payload)
+        resp = conn.getresponse()
+        body = js(resp.read())
+        conn.close()
+        check(resp.status == 415 and "Content-Type" in body.get("error", ""),
+              f"POST with Content-Type {ctype}: 415 with a message ({resp.status})")
+    r, body = server.json("PUT", "/api/graphs/graphs/ctype.json", zoneplate_bytes, headers={"Content-Type": "text/plain"})
+    check(r.status == 415 and not os.path.exists(os.path.join(gdir, "ctype.json")), f"PUT as text/plain: 415 ({r.status})")
+    r, body = server.json("POST", "/api/validate", b"{" + b" " * 2_000_000 + b"}", headers={"Content-Type": "text/plain"})
+    check(r.status == 415, f"an oversize body with the wrong Content-Type: 415, not 413 ({r.status})")
+    r, body = server.json("POST", "/api/validate", {"graph": "graphs/fxaa_zoneplate.json"},
+                          headers={"Content-Type": "application/json; charset=utf-8"})
+    check(r.status == 200, "application/json; charset=utf-8 is JSON")
+
+    # Bodies past --max-body (1000000 here): 413 before anything is stored, chunked or not.
+    big = b'{"nodes": {}, "pad": "' + b" " * 3_000_000 + b'"}'
+    status, headers, body = server.raw("PUT /api/graphs/graphs/big_chunked.json HTTP/1.1\r\n"
+                                       "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n",
+                                       [b"%x\r\n%s\r\n" % (len(big[i:i + 65536]), big[i:i + 65536])
+                                        for i in range(0, len(big), 65536)] + [b"0\r\n\r\n"])
+    check(status == 413 and not os.path.exists(os.path.join(gdir, "big_chunked.json")),
+          f"a chunked PUT past --max-body: 413, nothing written ({status})")
+    status, headers, body = server.raw("POST /api/render HTTP/1.1\r\n"
+                                       "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n",
+                                       [b"%x\r\n%s\r\n" % (len(big[i:i + 65536]), big[i:i + 65536])
+                                        for i in range(0, len(big), 65536)] + [b"0\r\n\r\n"])
+    check(status == 413, f"a chunked POST past --max-body: 413 ({status})")
+    r, body = server.json("PUT", "/api/graphs/graphs/big_plain.json", big)
+    check(r.status == 413 and not os.path.exists(os.path.join(gdir, "big_plain.json")),
+          f"a PUT past --max-body with Content-Length: 413, nothing written ({r.status})")
+    status, headers, body = server.raw("PUT /api/graphs/graphs/small_chunked.json HTTP/1.1\r\n"
+                                       "Content-Type: application/json\r\nTransfer-Encoding: chunked\r\n",
+                                       [b"%x\r\n%s\r\n" % (len(zoneplate_bytes), zoneplate_bytes), b"0\r\n\r\n"])
+    with open(os.path.join(gdir, "small_chunked.json"), "rb") if os.path.exists(
+            os.path.join(gdir, "small_chunked.json")) else open(os.devnull, "rb") as f:
+        check(status == 201 and f.read() == zoneplate_bytes, f"a chunked PUT under --max-body is written ({status})")
+    r, _ = server.request("GET", "/api/status")
+    check(r.status == 200, "the server answers after oversize bodies")
+
+    # PUT writes graphs and variants only, never under dot-folders, node_modules or the editor's own sources.
+    for path, body in [(".git/config.json", zoneplate_bytes), (".git/config", zoneplate_bytes),
+                       (".hidden.json", zoneplate_bytes), ("graphs/.cache/x.json", zoneplate_bytes),
+                       ("node_modules/pkg/package.json", zoneplate_bytes), ("editor/package.json", b'{"name": "x"}'),
+                       ("editor/package.json", zoneplate_bytes), ("editor/src/graph.json", zoneplate_bytes),
+                       ("graphs/notagraph.json", b'{"name": "x", "scripts": {"postinstall": "rm -rf ~"}}'),
+                       ("graphs/wrongformat.json", b'{"format": "other/1", "nodes": {}}'),
+                       ("graphs/array.json", b"[1, 2]")]:
+        r, reply = server.json("PUT", "/api/graphs/" + path, body)
+        check(r.status in (400, 403, 422) and reply.get("error"), f"PUT {path}: refused ({r.status}: {reply.get('error')})")
+    check(not os.path.exists(os.path.join(served, ".git", "config.json")) and
+          not os.path.exists(os.path.join(served, ".hidden.json")) and
+          not os.path.exists(os.path.join(served, "node_modules", "pkg", "package.json")) and
+          not os.path.exists(os.path.join(served, "editor", "src", "graph.json")) and
+          not os.path.exists(os.path.join(gdir, "notagraph.json")), "refused PUTs wrote nothing")
+    with open(os.path.join(served, "editor", "package.json")) as f:
+        check(f.read() == '{"name": "vitrine-editor"}\n', "editor/package.json is unchanged")
+    r, _ = server.json("PUT", "/api/graphs/graphs/variants/put_variant.json", {"extends": "../fxaa_zoneplate.json"})
+    check(r.status == 201, f"PUT of a variant ({r.status})")
+
+    # ETag on GET, If-Match on PUT (412 when the file changed since), NAME.json.bak of what a PUT replaced.
+    target = "/api/graphs/graphs/etag.json"
+    with open(os.path.join(gdir, "etag.json"), "wb") as f:
+        f.write(zoneplate_bytes)
+    r, first = server.request("GET", target)
+    etag = r.getheader("ETag")
+    check(r.status == 200 and etag and etag.startswith('"'), f"GET of a graph has an ETag ({etag})")
+    edited = json.loads(first)
+    edited["description"] = "edited in tab 1"
+    edited_bytes = json.dumps(edited, indent=2).encode()
+    r, _ = server.request("PUT", target, edited_bytes, headers={"If-Match": etag or '"none"'})
+    new_etag = r.getheader("ETag")
+    check(r.status == 200 and new_etag and new_etag != etag, f"PUT with the current ETag: 200 and a new ETag ({r.status})")
+    with open(os.path.join(gdir, "etag.json.bak"), "rb") if os.path.exists(os.path.join(gdir, "etag.json.bak")) \
+            else open(os.devnull, "rb") as f:
+        check(f.read() == zoneplate_bytes, "the PUT kept what it replaced as etag.json.bak")
+    r, _ = server.request("GET", target)
+    check(r.getheader("ETag") == new_etag, "GET after PUT: the ETag the PUT answered")
+    stale = dict(edited, description="edited in tab 2")
+    r, body = server.json("PUT", target, stale, headers={"If-Match": etag or '"none"'})
+    with open(os.path.join(gdir, "etag.json"), "rb") as f:
+        check(r.status == 412 and f.read() == edited_bytes and body.get("error"),
+              f"PUT with a stale If-Match: 412, the file unchanged ({r.status})")
+    r, _ = server.request("PUT", "/api/graphs/graphs/etag_new.json", zoneplate_bytes, headers={"If-Match": '"abc"'})
+    check(r.status == 412 and not os.path.exists(os.path.join(gdir, "etag_new.json")),
+          f"If-Match on a file that does not exist: 412 ({r.status})")
+    r, _ = server.request("PUT", target, edited_bytes, headers={"If-Match": "*"})
+    check(r.status == 200, "If-Match: * on an existing file")
+
+    # Every path param of every node (from the schemas, so new nodes are covered) pointed out of DIR: refused, and
+    # neither the file's content nor where DIR lies on the machine comes back.
+    escapes = {"..": os.path.relpath(secret_path, gdir), "absolute": secret_path,
+               "URL-encoded ..": os.path.relpath(secret_path, gdir).replace("..", "%2e%2e"),
+               "URL-encoded /": os.path.relpath(secret_path, gdir).replace("/", "%2f")}
+    for node_type, param in path_param_checks(nodes):
+        for how, value in escapes.items():
+            doc = {"frame": {"width": 8, "height": 8}, "nodes": {"n": {"type": node_type, "params": {param: value}}},
+                   "outputs": {"final": "n.color"}}
+            for route in ["/api/render", "/api/validate"]:
+                r, payload = server.request("POST", route, {"document": doc, "base": "graphs/probe.json"})
+                text = payload.decode(errors="replace")
+                body = js(payload)
+                error = body.get("error", "") or " ".join(e.get("error", "") for e in body.get("errors", []))
+                refused = (r.status == 403 if route == "/api/render" else body.get("ok") is False) and "refused" in error
+                check(refused and SECRET not in text and work not in text and outside not in text,
+                      f"{route} {node_type}.{param} = {how} path out of DIR: refused, nothing echoed "
+                      f"({r.status}: {text[:300]})")
+    # Event streams hold a server thread each: 16 open at once (16 tabs, or a script) must not starve the API.
+    streams = []
+    for _ in range(16):
+        sk = socket.create_connection((server.host, server.port))
+        sk.settimeout(10)
+        sk.sendall(("GET /api/events HTTP/1.1\r\nHost: %s:%d\r\n%s\r\n" %
+                    (server.host, server.port, "".join("%s: %s\r\n" % kv for kv in server.auth().items()))).encode())
+        streams.append(sk)
+    answers = []
+    for sk in streams:
+        try:
+            answers.append(int(sk.recv(64).split()[1]))
+        except (OSError, IndexError, ValueError):
+            answers.append(0)
+        if answers[-1] != 200:
+            sk.close()
+    try:
+        r, _ = server.request("GET", "/api/status", timeout=10)
+        status = r.status
+    except OSError:
+        status = 0
+    check(status == 200, f"the API answers while 16 event streams are open ({status})")
+    check(answers.count(200) >= 4 and 503 in answers and all(a in (200, 503) for a in answers),
+          f"event streams past the limit get 503 ({answers})")
+    for sk in streams:
+        sk.close()
+
+    # A working graph whose lens names a JSON file out of DIR: its setup used to read it and echo its "format".
+    for value in [os.path.relpath(secret_path, gdir), secret_path]:
+        for route in ["/api/validate", "/api/render"]:
+            r, payload = server.request("POST", route, {"graph": "graphs/camera_checker.json",
+                                                        "set": ["camera.params.lens=" + value], "width": 32, "height": 18})
+            text = payload.decode(errors="replace")
+            check("refused" in text and SECRET not in text and outside not in text,
+                  f"{route} camera_checker.json with lens {value[:40]}...: refused, the file not echoed ({text[:200]})")
+    check(tree_digest(outside) == outside_digest, "nothing outside DIR was written (security checks)")
+
+
 def main():
     global server
-    server = Server(served, "--max-body", "1000000", "--editor", os.path.join(work, "no-editor"))
+    server = Server(served, "--max-body", "1000000", "--editor", os.path.join(served, "editor", "dist"))
     print("checking", server.url, flush=True)
+    nodes = json.loads(subprocess.run([vitrine, "nodes", "--json"], check=True, capture_output=True).stdout)
+    security_checks(nodes)
+    if os.environ.get("VITRINE_SERVE_CHECKS") == "security":
+        return
 
     # Status, nodes, graphs list.
     r, body = server.json("GET", "/api/status")
@@ -424,7 +749,7 @@ def main():
 
     def read_events():
         conn = http.client.HTTPConnection(server.host, server.port, timeout=600)
-        conn.request("GET", "/api/events")
+        conn.request("GET", "/api/events", headers=server.auth())
         resp = conn.getresponse()
         events.append(("status", resp.status, resp.getheader("Content-Type")))
         for line in resp:
@@ -458,10 +783,11 @@ def main():
         # Sends the render, and closes its connection as soon as the first frame is reported (from this thread, so
         # that the job is still running even on a fast GPU).
         conn = http.client.HTTPConnection(server.host, server.port, timeout=600)
-        conn.request("GET", "/api/events")
+        conn.request("GET", "/api/events", headers=server.auth())
         stream = conn.getresponse()
-        s.sendall(b"POST /api/render HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                  b"Content-Length: " + str(len(slow)).encode() + b"\r\n\r\n" + slow)
+        s.sendall(b"POST /api/render HTTP/1.1\r\nHost: 127.0.0.1:" + str(server.port).encode() +
+                  b"\r\nContent-Type: application/json\r\nAuthorization: token " + (server.token or "").encode() +
+                  b"\r\nContent-Length: " + str(len(slow)).encode() + b"\r\n\r\n" + slow)
         for line in stream:
             line = line.decode().rstrip("\n")
             if line.startswith("data: "):
@@ -477,7 +803,8 @@ def main():
     watcher.start()
     watcher.join(timeout=300)
     e = socket.create_connection((server.host, server.port))
-    e.sendall(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+    e.sendall(b"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1:" + str(server.port).encode() +
+              b"\r\nAuthorization: token " + (server.token or "").encode() + b"\r\n\r\n")
     time.sleep(0.2)
     e.close()
     slow_stages = [(ev.get("stage"), ev.get("done")) for ev in slow_events]
@@ -529,17 +856,18 @@ def main():
     server = Server(served, "--host", "127.0.0.2", "--editor", dist)
     check(server.token is not None and len(server.token) >= 32, "--host prints a URL with an access token")
     for path in ["/", "/assets/app.js", "/api/nodes", "/api/events", "/api/graphs/graphs/fxaa_zoneplate.json"]:
-        r, _ = server.request("GET", path, timeout=10)
+        r, _ = server.request("GET", path, timeout=10, auth=False)
         check(r.status == 401, f"GET {path} without the token: 401")
-    r, _ = server.request("GET", "/api/nodes?token=wrong")
+    r, _ = server.request("GET", "/api/nodes?token=wrong", auth=False)
     check(r.status == 401, "a wrong token: 401")
-    r, payload = server.request("GET", "/?token=" + server.token)
+    r, payload = server.request("GET", "/?token=" + server.token, auth=False)
     cookie = r.getheader("Set-Cookie", "")
     check(r.status == 200 and b"<title>editor</title>" in payload, "GET /?token=... serves the editor's index.html")
-    check(cookie.startswith("vitrine_token=") and "HttpOnly" in cookie, "the token is kept as a cookie")
-    r, payload = server.request("GET", "/assets/app.js", headers={"Cookie": cookie.split(";")[0]})
+    check(cookie.startswith("vitrine_token_%d=" % server.port) and "HttpOnly" in cookie,
+          "the token is kept as a cookie named with the port (cookies do not tell ports apart)")
+    r, payload = server.request("GET", "/assets/app.js", headers={"Cookie": cookie.split(";")[0]}, auth=False)
     check(r.status == 200 and r.getheader("Content-Type") == "text/javascript", "static files with the cookie")
-    r, payload = server.request("GET", "/api/nodes", headers={"Authorization": "token " + server.token})
+    r, payload = server.request("GET", "/api/nodes", headers={"Authorization": "token " + server.token}, auth=False)
     check(r.status == 200 and payload == nodes_cli, "Authorization: token ... works")
     r, payload = server.request("POST", "/api/render", json.dumps({"graph": "graphs/fxaa_zoneplate.json", "width": 160,
                                                                     "height": 90}),
@@ -548,6 +876,24 @@ def main():
     r, _ = server.request("GET", "/..%2f..%2foutside%2fsecret.png", headers={"Authorization": "token " + server.token})
     check(r.status in (403, 404), "static files cannot leave the editor's directory")
     check(server.stop() == 0, "the token server stops cleanly")
+
+    # --no-token: no token asked, with a warning on stderr; refused with a --host other than the loopback.
+    server = Server(served, "--no-token", "--editor", dist, stderr=subprocess.PIPE)
+    warning = []
+    threading.Thread(target=lambda: warning.append(server.proc.stderr.read()), daemon=True).start()
+    check(server.token is None, "--no-token prints a URL without a token")
+    r, payload = server.request("GET", "/api/nodes", auth=False)
+    check(r.status == 200 and payload == nodes_cli, "--no-token: the API answers without a token")
+    r, _ = server.request("GET", "/api/status", headers={"Host": "127.0.0.1.attacker.example:%d" % server.port})
+    check(r.status == 403, "--no-token: DNS rebinding still refused")
+    check(server.stop() == 0, "the --no-token server stops cleanly")
+    time.sleep(0.2)
+    check(warning and "--no-token" in warning[0] and "token" in warning[0].lower(),
+          f"--no-token warns on stderr ({(warning or [''])[0][-300:]!r})")
+    refused = subprocess.run([vitrine, "serve", served, "--port", "0", "--host", "127.0.0.2", "--no-token"],
+                             capture_output=True, text=True, timeout=120)
+    check(refused.returncode != 0 and "--no-token" in refused.stderr,
+          f"--no-token with a --host other than the loopback: refused ({refused.returncode})")
 
 
 try:

@@ -44,12 +44,14 @@ commands:
   jitter [PATTERN]... [--out DIR] [--frames N]
       Plot the camera jitter patterns (halton, ordered, rotated, improved, stratified) as SVG:
       the first 16 samples numbered in order, later frames (sub-grid shifts) as dots.
-  serve [DIR] [--port N] [--host ADDR] [--token T] [--editor DIR] [--max-body BYTES] [--warm N]
+  serve [DIR] [--port N] [--host ADDR] [--token T | --no-token] [--editor DIR] [--max-body BYTES] [--warm N]
       HTTP server for the graph editor: the editor at /, a JSON API under /api/ (nodes, graphs under DIR,
       validate, render previews, compare, progress events). One Vulkan device and the last N (--warm,
       default 4) compiled graphs stay warm between requests. Binds 127.0.0.1:8420 by default (--port 0: any
-      free port; the URL is printed); another --host needs the access token printed at start-up (or
-      --token). Reads and writes files under DIR only (default: the current directory).
+      free port; the URL is printed, with the access token every request needs: ?token=..., then a cookie;
+      --token T picks it, --no-token drops it on the loopback). Answers only to the loopback names (or
+      --host) and the server's own page (Host, Origin). Reads files under DIR only (default: the current
+      directory) and writes only graph and variant .json files there (NAME.json.bak keeps what a PUT replaced).
   sweep FILE [--out DIR] [--jobs N] [--retry-failed] [--devices 0,1] [--list]
       Quality-versus-cost study (README "Sweeps"): every point of the vitrine-sweep/1 FILE (axes of --set
       values, variant files, frame ranges) rendered as its own process, --jobs at once, compared with the

@@ -1,4 +1,4 @@
-// `vitrine serve [DIR] [--port N] [--host ADDR]`: the graph editor's server (tools/vitrine/serve/).
+// `vitrine serve [DIR] [--port N] [--host ADDR] [--token T | --no-token]`: the graph editor's server (tools/vitrine/serve/).
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "tools/vitrine/cli.hpp"
@@ -48,18 +48,35 @@ int serveCommand(const Args& args) {
     serve::ServeOptions options;
     options.dir = args.positional.empty() ? fs::path(".") : fs::path(args.positional[0]);
     options.editorDist = args.get("editor", (fs::path(VITRINE_SOURCE_DIR) / "editor" / "dist").string());
+    // A PUT never writes the editor's own files: its bundle, the sources around a bundle called dist/, and the
+    // repository's editor/ (when DIR is the repository).
+    options.readOnlyDirs = {options.editorDist, fs::path(VITRINE_SOURCE_DIR) / "editor"};
+    fs::path dist = options.editorDist.lexically_normal();
+    if (dist.filename().empty()) dist = dist.parent_path(); // "editor/dist/"
+    if (dist.filename() == "dist") options.readOnlyDirs.push_back(dist.parent_path());
     const std::string host = args.get("host", "127.0.0.1");
     const uint32_t port = args.getUint("port", 8420);
     if (port > 65535) throw UserError("--port: expected 0..65535 (0: any free port), got " + std::to_string(port));
     options.maxBodyBytes = args.getUint("max-body", 16u << 20);
     if (options.maxBodyBytes == 0) throw UserError("--max-body: expected at least 1 byte");
     options.loopbackOnly = isLoopback(host);
+    options.bindHost = host;
     options.token = args.get("token");
-    if (!options.loopbackOnly) {
+    const bool noToken = args.has("no-token");
+    if (noToken && !options.token.empty()) throw UserError("serve: give --token T or --no-token, not both");
+    if (noToken && !options.loopbackOnly)
+        throw UserError("serve: --no-token is refused with --host " + host +
+                        ": a server other machines can reach needs its access token");
+    if (!options.loopbackOnly)
         logWarning("serve: --host " + host + " opens the server to other machines: anyone who can reach it and has " +
                    "the token can read and write the graphs under the served directory and use the GPU");
-        if (options.token.empty()) options.token = newToken();
-    }
+    // As Jupyter: a token on the loopback too, since any local user or program (and any web page, through the
+    // browser) can reach 127.0.0.1.
+    if (noToken)
+        std::fprintf(stderr, "vitrine serve: warning: --no-token: no access token is asked; every program and user on "
+                             "this machine can read and write the graphs under the served directory\n");
+    else if (options.token.empty())
+        options.token = newToken();
     const uint32_t warm = args.getUint("warm", 4);
 
     serve::EventHub events;
@@ -74,6 +91,7 @@ int serveCommand(const Args& args) {
     const int bound = port == 0 ? server.bind_to_any_port(host)
                                 : (server.bind_to_port(host, static_cast<int>(port)) ? static_cast<int>(port) : -1);
     if (bound < 0) throw UserError("serve: cannot listen on " + host + ":" + std::to_string(port) + " (in use?)");
+    api.setPort(bound); // the Host and Origin headers must name it
     const std::string shownHost = host.find(':') != std::string::npos && host[0] != '[' ? "[" + host + "]" : host;
     const std::string url = "http://" + shownHost + ":" + std::to_string(bound) + "/";
     std::printf("vitrine serve: %s on %s\n", fs::canonical(options.dir).string().c_str(), gpu.deviceName().c_str());

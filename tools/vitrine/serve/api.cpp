@@ -6,6 +6,9 @@
 #include "core/graph/registry.hpp"
 #include "tools/vitrine/serve/http_util.hpp"
 
+#include <algorithm>
+#include <cctype>
+
 namespace vitrine::serve {
 
 namespace fs = std::filesystem;
@@ -88,10 +91,9 @@ Api::Handler Api::guarded(Handler handler) {
 
 namespace {
 
-// The host part of a Host header ("127.0.0.1:8080", "[::1]:8080", "localhost").
-std::string hostName(const std::string& header) {
-    if (!header.empty() && header[0] == '[') return header.substr(0, header.find(']') + 1);
-    return header.substr(0, header.find(':'));
+std::string lowered(std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+    return s;
 }
 
 bool constantTimeEqual(const std::string& a, const std::string& b) {
@@ -114,44 +116,177 @@ std::string cookieValue(const std::string& cookies, const std::string& name) {
     return {};
 }
 
+// Refusals of checkAccess: {"error", "status", "reason"}. A body the request has is left unread, so the connection
+// cannot carry another request.
+void refuse(const httplib::Request& req, httplib::Response& res, int status, const std::string& reason,
+            const std::string& message) {
+    replyError(res, status, message, {{"reason", reason}});
+    const std::string length = req.get_header_value("Content-Length");
+    if (req.has_header("Transfer-Encoding") || (!length.empty() && length != "0"))
+        res.set_header("Connection", "close");
+}
+
+const char* kTokenPage = R"(<!doctype html>
+<html><head><meta charset="utf-8"><title>vitrine serve: access token required</title></head><body>
+<h1>Access token required</h1>
+<p>This <code>vitrine serve</code> answers only to requests with its access token. Open the URL it printed when it
+started (<code>http://127.0.0.1:PORT/?token=...</code>); the browser then keeps the token as a cookie.</p>
+</body></html>
+)";
+
 } // namespace
+
+bool Api::isOwnHost(const std::string& header) const {
+    const std::string host = lowered(header);
+    std::vector<std::string> names = {"localhost", "127.0.0.1", "[::1]"};
+    if (!mOptions.bindHost.empty()) {
+        const std::string bind = lowered(mOptions.bindHost);
+        // A wildcard address is reached under names this server cannot know: the token is what guards it.
+        if (bind == "0.0.0.0" || bind == "::" || bind == "[::]") return true;
+        names.push_back(bind.find(':') != std::string::npos && bind[0] != '[' ? "[" + bind + "]" : bind);
+    }
+    const std::string port = std::to_string(mPort);
+    for (const std::string& name : names)
+        if (host == name + ":" + port || (mPort == 80 && host == name)) return true;
+    return false;
+}
+
+void Api::securityHeaders(const httplib::Request& req, httplib::Response& res) {
+    auto set = [&](const char* name, const char* value) {
+        if (!res.has_header(name)) res.set_header(name, value);
+    };
+    // The editor's bundle is external module scripts and styles from this server; images are its own URLs, blob:
+    // (fetched previews) or data: (an empty pixel). No inline or remote script, no framing.
+    set("Content-Security-Policy",
+        "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' blob: data:; "
+        "connect-src 'self'; font-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; "
+        "frame-ancestors 'none'");
+    set("X-Frame-Options", "DENY");
+    set("X-Content-Type-Options", "nosniff");
+    set("Referrer-Policy", "no-referrer");
+    if (req.path.rfind("/api/", 0) == 0 || req.path == "/api") set("Cache-Control", "no-store");
+}
 
 httplib::Server::HandlerResponse Api::checkAccess(const httplib::Request& req, httplib::Response& res) {
     using R = httplib::Server::HandlerResponse;
+    // A web page may make a name it controls resolve to 127.0.0.1 (DNS rebinding, e.g. 127.0.0.1.attacker.example);
+    // its requests then carry that name: only this server's own names and port are answered.
     const std::string host = req.get_header_value("Host");
-    // A web page may make a name it controls resolve to 127.0.0.1 (DNS rebinding); its requests then carry that name.
-    if (mOptions.loopbackOnly && req.has_header("Host")) {
-        const std::string name = hostName(host);
-        if (name != "localhost" && name != "[::1]" && name.rfind("127.", 0) != 0) {
-            replyError(res, 403, "Host '" + host + "' refused: this server answers only to the loopback names");
+    if (!isOwnHost(host)) {
+        refuse(req, res, 403, "host",
+               "Host '" + host + "' refused: this server answers only to localhost, 127.0.0.1 or [::1]" +
+                   (mOptions.bindHost.empty() || mOptions.loopbackOnly ? std::string() : " or " + mOptions.bindHost) +
+                   " with its port " + std::to_string(mPort) + " (against DNS rebinding)");
+        return R::Handled;
+    }
+    // Requests from another site's page (a browser says which in Origin; "null" from sandboxed frames and files)
+    // are refused: what changes state (PUT, POST, DELETE), the event stream, and any other that names one.
+    if (req.has_header("Origin")) {
+        const std::string origin = req.get_header_value("Origin");
+        const std::string scheme = "http://";
+        if (lowered(origin).rfind(scheme, 0) != 0 || !isOwnHost(origin.substr(scheme.size()))) {
+            refuse(req, res, 403, "origin",
+                   "cross-origin request refused: Origin '" + origin + "' is not this server's own page");
             return R::Handled;
         }
     }
-    // Requests from another site's page (a browser says which in Origin) are refused.
-    if (req.has_header("Origin") && req.get_header_value("Origin") != "http://" + host) {
-        replyError(res, 403, "Origin '" + req.get_header_value("Origin") + "' refused: not this server's own page");
-        return R::Handled;
-    }
     if (mOptions.token.empty()) return R::Unhandled;
+    // As Jupyter does: the token from the query (the printed URL), the header, or the cookie the query set. The
+    // cookie's name has the port: cookies do not tell ports apart, and two servers must not replace each other's.
+    const std::string cookieName = "vitrine_token_" + std::to_string(mPort);
     std::string given;
     if (req.has_param("token")) {
         given = req.get_param_value("token");
-        // As Jupyter does: the browser that opened the printed URL keeps the token as a cookie for the page's own
-        // requests (scripts, styles, the events stream).
         if (constantTimeEqual(given, mOptions.token))
-            res.set_header("Set-Cookie", "vitrine_token=" + given + "; Path=/; HttpOnly; SameSite=Strict");
+            res.set_header("Set-Cookie", cookieName + "=" + given + "; Path=/; HttpOnly; SameSite=Strict");
     } else if (req.has_header("Authorization")) {
         const std::string auth = req.get_header_value("Authorization");
         for (const char* scheme : {"token ", "Token ", "Bearer "})
             if (auth.rfind(scheme, 0) == 0) given = auth.substr(std::string(scheme).size());
     } else if (req.has_header("Cookie")) {
-        given = cookieValue(req.get_header_value("Cookie"), "vitrine_token");
+        given = cookieValue(req.get_header_value("Cookie"), cookieName);
     }
     if (!given.empty() && constantTimeEqual(given, mOptions.token)) return R::Unhandled;
-    replyError(res, 401,
-               "access token required: open the URL `vitrine serve` printed (…/?token=…), or send the header "
-               "'Authorization: token TOKEN'");
+    if (req.path.rfind("/api/", 0) != 0 && req.method == "GET") {
+        res.status = 401;
+        res.set_content(kTokenPage, "text/html; charset=utf-8");
+        return R::Handled;
+    }
+    refuse(req, res, 401, "token",
+           "access token required: open the URL `vitrine serve` printed (…/?token=…), or send the header "
+           "'Authorization: token TOKEN'");
     return R::Handled;
+}
+
+void Api::installWithBody(httplib::Server& server, const std::string& method, const std::string& pattern,
+                          Handler handler) {
+    Handler checked = guarded(std::move(handler));
+    // Before the body is read: a JSON body must say so. What an HTML form can send without the browser asking first
+    // (text/plain, form encodings) is refused, so that another site's page cannot post to the API.
+    auto contentTypeRefused = [](const httplib::Request& req, httplib::Response& res) {
+        std::string type = lowered(req.get_header_value("Content-Type"));
+        type = type.substr(0, type.find(';'));
+        while (!type.empty() && type.back() == ' ')
+            type.pop_back();
+        if (type == "application/json") return false;
+        replyError(res, 415,
+                   "Content-Type '" + req.get_header_value("Content-Type") +
+                       "' refused: send the JSON body with Content-Type: application/json",
+                   {{"reason", "content-type"}});
+        // The body is left unread: the connection cannot carry another request.
+        res.set_header("Connection", "close");
+        return true;
+    };
+    httplib::Server::HandlerWithContentReader withReader = [this, checked, contentTypeRefused](
+                                                              const httplib::Request& req, httplib::Response& res,
+                                                              const httplib::ContentReader& reader) {
+        if (contentTypeRefused(req, res)) return;
+        // --max-body counts the bytes received: cpp-httplib checks only Content-Length, not chunked bodies. Past
+        // the limit nothing more is kept; the rest is read and dropped (so that the connection stays usable) up to
+        // 64 MiB more, after which the connection is cut.
+        const size_t limit = mOptions.maxBodyBytes;
+        const size_t drainLimit = limit + (64u << 20);
+        std::string body;
+        size_t received = 0;
+        const bool complete = reader([&](const char* data, size_t size) {
+            received += size;
+            if (received > limit) {
+                body.clear();
+                body.shrink_to_fit();
+                return received <= drainLimit;
+            }
+            body.append(data, size);
+            return true;
+        });
+        if (received > limit || res.status == 413) {
+            replyError(res, 413,
+                       "request body too large: more than --max-body " + std::to_string(limit) + " bytes",
+                       {{"reason", "max-body"}});
+            if (!complete) res.set_header("Connection", "close");
+            return;
+        }
+        if (!complete) {
+            replyError(res, 400, "request body: cannot be read (malformed chunked encoding or connection lost)");
+            res.set_header("Connection", "close");
+            return;
+        }
+        // The request object is the server's own (not const); its body is filled here, as a route without a
+        // content reader would have it.
+        const_cast<httplib::Request&>(req).body = std::move(body);
+        checked(req, res);
+    };
+    // Requests without a body (no Content-Length, not chunked) do not go through the content reader.
+    Handler withoutBody = [checked, contentTypeRefused](const httplib::Request& req, httplib::Response& res) {
+        if (contentTypeRefused(req, res)) return;
+        checked(req, res);
+    };
+    if (method == "PUT") {
+        server.Put(pattern, withReader);
+        server.Put(pattern, withoutBody);
+    } else {
+        server.Post(pattern, withReader);
+        server.Post(pattern, withoutBody);
+    }
 }
 
 void Api::status(const httplib::Request&, httplib::Response& res) {
@@ -165,6 +300,7 @@ void Api::status(const httplib::Request&, httplib::Response& res) {
 
 void Api::install(httplib::Server& server) {
     server.set_payload_max_length(mOptions.maxBodyBytes);
+    server.set_post_routing_handler(&Api::securityHeaders);
     server.set_pre_routing_handler(
         [this](const httplib::Request& req, httplib::Response& res) { return checkAccess(req, res); });
     server.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
@@ -202,10 +338,13 @@ void Api::install(httplib::Server& server) {
     server.Get("/api/graphs", bind(&Api::listGraphs));
     server.Get("/api/files", bind(&Api::listFiles));
     server.Get("/api/graphs/(.+)", bind(&Api::getGraph));
-    server.Put("/api/graphs/(.+)", bind(&Api::putGraph));
-    server.Post("/api/validate", bind(&Api::validate));
-    server.Post("/api/render", bind(&Api::render));
-    server.Post("/api/compare", bind(&Api::compare));
+    auto route = [this](void (Api::*method)(const httplib::Request&, httplib::Response&)) -> Handler {
+        return [this, method](const httplib::Request& req, httplib::Response& res) { (this->*method)(req, res); };
+    };
+    installWithBody(server, "PUT", "/api/graphs/(.+)", route(&Api::putGraph));
+    installWithBody(server, "POST", "/api/validate", route(&Api::validate));
+    installWithBody(server, "POST", "/api/render", route(&Api::render));
+    installWithBody(server, "POST", "/api/compare", route(&Api::compare));
     server.Get("/api/images/([^/]+)", bind(&Api::image));
     server.Get("/api/events", bind(&Api::events));
     server.Get("/(.*)", bind(&Api::staticFile));

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 // The HTTP side of `vitrine serve`: the JSON API under /api/ and the editor's static files at /. Routes read and
 // write files through the Sandbox only, and hand every render to the GpuWorker.
@@ -20,9 +21,12 @@ namespace vitrine::serve {
 struct ServeOptions {
     std::filesystem::path dir;        // the served directory
     std::filesystem::path editorDist; // the editor's built bundle (editor/dist); a placeholder page when absent
-    std::string token;                // required on every request when not empty
-    bool loopbackOnly = true;         // the Host header must name the loopback (against DNS rebinding)
-    size_t maxBodyBytes = 16u << 20;  // larger request bodies get 413
+    std::string token;                // required on every request when not empty (--no-token: empty)
+    bool loopbackOnly = true;         // bound to a loopback address
+    std::string bindHost;             // --host: besides the loopback names, the one name the Host header may give
+    size_t maxBodyBytes = 16u << 20;  // larger request bodies get 413, whatever their transfer encoding
+    // Folders a PUT never writes into besides dot-folders, node_modules and build trees: the editor's own sources.
+    std::vector<std::filesystem::path> readOnlyDirs;
 };
 
 // PNGs of finished renders and compares, fetched with GET /api/images/ID; the oldest go first past `capacity`.
@@ -53,9 +57,21 @@ class Api {
 public:
     Api(const ServeOptions& options, GpuWorker& gpu, EventHub& events);
     void install(httplib::Server& server);
+    // The port the server listens on (known once bound): the Host and Origin headers must name it.
+    void setPort(int port) { mPort = port; }
 
 private:
     using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
+    // A route with a JSON body (PUT, POST): refuses another Content-Type with 415 before reading it, reads it with
+    // --max-body counted on the bytes received (chunked or not: 413 before anything is stored), then runs `handler`
+    // with req.body set. Errors as guarded().
+    void installWithBody(httplib::Server& server, const std::string& method, const std::string& pattern,
+                         Handler handler);
+    // True when `host` (a Host header, or an Origin without its scheme) names this server: localhost, 127.0.0.1,
+    // [::1] or --host, with the port it listens on.
+    bool isOwnHost(const std::string& host) const;
+    // Content-Security-Policy, X-Frame-Options, nosniff, Referrer-Policy on every answer; no-store on /api/.
+    static void securityHeaders(const httplib::Request& req, httplib::Response& res);
     // Maps what a route throws to a status and a JSON error body (HttpError, PathRefused 403, UserError 422 with the
     // file and JSON pointer of the culprit, anything else 500).
     Handler guarded(Handler handler);
@@ -66,6 +82,9 @@ private:
     void listFiles(const httplib::Request& req, httplib::Response& res);
     void getGraph(const httplib::Request& req, httplib::Response& res);
     void putGraph(const httplib::Request& req, httplib::Response& res);
+    // Refuses (403) a PUT to `path` (canonical, inside DIR) under a dot-folder, node_modules, a build tree or a
+    // readOnlyDirs folder; `shown` names it in the error.
+    void checkWritable(const std::filesystem::path& path, const std::string& shown) const;
     void staticFile(const httplib::Request& req, httplib::Response& res);
 
     // api_render.cpp
@@ -104,11 +123,16 @@ private:
     std::string newJobId();
 
     ServeOptions mOptions;
+    int mPort = 0;
+    std::mutex mPutMutex; // one PUT at a time: its If-Match check, .bak and write are one step
     Sandbox mSandbox;
     GpuWorker& mGpu;
     EventHub& mEvents;
     ImageStore mImages;
     std::atomic<uint64_t> mJobs{0};
+    // Open /api/events streams, at most kMaxEventStreams of the server's 16 threads (serve_command.cpp).
+    static constexpr int kMaxEventStreams = 8;
+    std::atomic<int> mStreams{0};
 };
 
 } // namespace vitrine::serve

@@ -7,6 +7,7 @@
 #include "tools/vitrine/serve/http_util.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -34,6 +35,39 @@ bool skippedDirectory(const fs::path& dir) {
     std::error_code ec;
     return (!name.empty() && name[0] == '.') || name == "node_modules" ||
            fs::exists(dir / "CMakeCache.txt", ec); // a build tree
+}
+
+// A strong ETag of a file's bytes (FNV-1a, 64 bits, and the size): what If-Match compares.
+std::string etagOf(const std::string& bytes) {
+    uint64_t hash = 14695981039346656037ull;
+    for (unsigned char c : bytes) {
+        hash ^= c;
+        hash *= 1099511628211ull;
+    }
+    char text[48];
+    std::snprintf(text, sizeof text, "\"%016llx-%zx\"", static_cast<unsigned long long>(hash), bytes.size());
+    return text;
+}
+
+// If-Match: "*" (any existing file) or a list of ETags, one of which must be the file's.
+bool ifMatchAccepts(const std::string& header, const std::string& current) {
+    if (current.empty()) return false; // no file: nothing can match
+    std::stringstream list(header);
+    for (std::string item; std::getline(list, item, ',');) {
+        item.erase(0, item.find_first_not_of(" \t"));
+        item.erase(item.find_last_not_of(" \t") + 1);
+        if (item.rfind("W/", 0) == 0) item.erase(0, 2); // a weak ETag names the same bytes here
+        if (item == "*" || item == current) return true;
+    }
+    return false;
+}
+
+bool isUnder(const fs::path& dir, const fs::path& path) {
+    auto d = dir.begin();
+    auto p = path.begin();
+    for (; d != dir.end(); ++d, ++p)
+        if (p == path.end() || *d != *p) return false;
+    return true;
 }
 
 const char* contentType(const std::string& extension) {
@@ -144,22 +178,85 @@ void Api::getGraph(const httplib::Request& req, httplib::Response& res) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw HttpError(404, relative + ": no such file under the served directory");
     if (path.extension() != ".json") throw HttpError(403, relative + ": refused: only graph files (.json) are served");
-    res.set_content(readFile(path), "application/json");
+    std::string bytes = readFile(path);
+    // The editor sends it back as If-Match when it saves: a file changed since (another tab, an editor) gets 412.
+    res.set_header("ETag", etagOf(bytes));
+    res.set_content(std::move(bytes), "application/json");
+}
+
+void Api::checkWritable(const fs::path& path, const std::string& shown) const {
+    // Only where GET /api/graphs looks: never a dot-folder or dot-file (.git/, .vscode/), node_modules, a build tree
+    // or the editor's own sources.
+    const fs::path inside = fs::path(mSandbox.relative(path));
+    fs::path dir = mSandbox.root();
+    for (auto part = inside.begin(); part != inside.end(); ++part) {
+        const std::string name = part->string();
+        if (!name.empty() && name[0] == '.')
+            throw HttpError(403, shown + ": refused: vitrine serve does not write dot-files or under dot-folders ('" +
+                                     name + "')", {{"reason", "location"}});
+        if (name == "node_modules")
+            throw HttpError(403, shown + ": refused: vitrine serve does not write under node_modules",
+                            {{"reason", "location"}});
+        if (std::next(part) == inside.end()) break;
+        dir /= *part;
+        std::error_code ec;
+        if (fs::exists(dir / "CMakeCache.txt", ec))
+            throw HttpError(403, shown + ": refused: vitrine serve does not write into a build tree",
+                            {{"reason", "location"}});
+    }
+    for (const fs::path& readOnly : mOptions.readOnlyDirs) {
+        std::error_code ec;
+        const fs::path canonical = fs::weakly_canonical(readOnly, ec);
+        if (!ec && isUnder(canonical, path))
+            throw HttpError(403, shown + ": refused: vitrine serve does not write the editor's own files",
+                            {{"reason", "location"}});
+    }
 }
 
 void Api::putGraph(const httplib::Request& req, httplib::Response& res) {
     const std::string relative = req.matches[1];
     const fs::path path = mSandbox.resolve(relative);
     if (path.extension() != ".json") throw HttpError(403, relative + ": refused: only graph files (.json) are written");
+    checkWritable(path, relative);
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw HttpError(409, relative + ": is a directory");
-    // The body must be a JSON object (a graph or a variant); it is written as sent, so that a file read and written
-    // back unchanged stays byte for byte the same.
-    parseRequestBody(req.body);
+    // The body must be a graph or a variant as the loader reads them: an object with "nodes" (an object) or
+    // "extends" (the base graph's path), and no other "format" than vitrine-graph/1. It is written as sent, so that
+    // a file read and written back unchanged stays byte for byte the same.
+    const nlohmann::json doc = parseRequestBody(req.body);
+    if (doc.contains("format") && doc["format"] != "vitrine-graph/1")
+        throw HttpError(422, relative + ": refused: /format: a graph's format is \"vitrine-graph/1\"",
+                        {{"pointer", "/format"}, {"reason", "not-a-graph"}});
+    const bool graph = doc.contains("nodes") && doc["nodes"].is_object();
+    const bool variant = doc.contains("extends") && doc["extends"].is_string();
+    if (!graph && !variant)
+        throw HttpError(422,
+                        relative + ": refused: not a vitrine graph (an object with \"nodes\") or variant (with " +
+                            "\"extends\"); vitrine serve writes nothing else",
+                        {{"pointer", ""}, {"reason", "not-a-graph"}});
+
+    // The If-Match check, the .bak and the write are one step: two PUTs do not interleave.
+    std::lock_guard lock(mPutMutex);
+    const bool existed = fs::is_regular_file(path, ec);
+    std::string previous;
+    if (existed) previous = readFile(path);
+    if (req.has_header("If-Match")) {
+        const std::string current = existed ? etagOf(previous) : std::string();
+        if (!ifMatchAccepts(req.get_header_value("If-Match"), current))
+            throw HttpError(412,
+                            relative + ": " +
+                                (existed ? "changed since it was read (If-Match " + req.get_header_value("If-Match") +
+                                               ", now " + current + "): reload it, or save under another name"
+                                         : "does not exist any more (If-Match " + req.get_header_value("If-Match") +
+                                               ")"),
+                            {{"etag", current}, {"reason", "if-match"}});
+    }
     fs::create_directories(path.parent_path(), ec);
-    if (ec) throw HttpError(500, relative + ": cannot create its directory: " + ec.message());
-    const bool existed = fs::exists(path, ec);
+    if (ec) throw HttpError(500, relative + ": cannot create its directory");
+    // What the write replaces stays as NAME.json.bak (one generation).
+    if (existed) writeFileAtomically(fs::path(path.string() + ".bak"), previous);
     writeFileAtomically(path, req.body);
+    res.set_header("ETag", etagOf(req.body));
     replyJson(res, existed ? 200 : 201, {{"path", mSandbox.relative(path)}, {"bytes", req.body.size()}});
 }
 

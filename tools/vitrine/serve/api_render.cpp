@@ -128,6 +128,8 @@ Api::PreparedDocument Api::prepareDocument(const nlohmann::json& spec, const std
         }
     }
     document = mergeGraphDocument(std::move(document), file, sets);
+    // Path params out of DIR are refused before anything else looks at the graph (validation, node setups).
+    mSandbox.checkPathParams(document, file.parent_path(), label);
 
     // The preview: size, frame count and the one output rendered, written into the document before it is validated
     // (so a frame.write beyond a shortened run is not an error, and the warm-graph key is the document).
@@ -472,10 +474,20 @@ void Api::events(const httplib::Request& req, httplib::Response& res) {
         if (!last.empty() && last.size() < 19 && last.find_first_not_of("0123456789") == std::string::npos)
             after = std::stoull(last);
     }
-    res.set_header("Cache-Control", "no-cache");
+    // Each open stream holds one of the server's threads: past kMaxEventStreams a new one gets 503 (the editor tries
+    // again 5 s later), so that open tabs or scripts never starve the API of threads.
+    if (mStreams.fetch_add(1) >= kMaxEventStreams) {
+        --mStreams;
+        res.set_header("Retry-After", "5");
+        throw HttpError(503, "too many event streams open (" + std::to_string(kMaxEventStreams) +
+                                 "): close another editor tab, or retry");
+    }
+    // Frees the slot when the response (and the provider holding this) goes away, however the stream ends.
+    auto slot = std::shared_ptr<void>(nullptr, [this](void*) { --mStreams; });
+    res.set_header("Cache-Control", "no-store");
     EventHub* hub = &mEvents;
     auto first = std::make_shared<bool>(true);
-    res.set_chunked_content_provider("text/event-stream", [hub, after, first](size_t, httplib::DataSink& sink) mutable {
+    res.set_chunked_content_provider("text/event-stream", [hub, after, first, slot](size_t, httplib::DataSink& sink) mutable {
         if (*first) {
             *first = false;
             const std::string hello = "retry: 2000\nevent: hello\ndata: {}\n\n";

@@ -90,8 +90,8 @@ void Sandbox::checkExtends(const nlohmann::json& document, const fs::path& direc
         const std::string base = doc["extends"].get<std::string>();
         fs::path p(base);
         if (p.is_absolute())
-            throw PathRefused(where + ": /extends: refused: absolute path '" + base + "' (vitrine serve reads files " +
-                              "under the served directory only)");
+            throw PathRefused(where + ": /extends: refused: an absolute path (vitrine serve reads files "
+                                      "under the served directory only)");
         fs::path c = canonicalOf(dir / p);
         if (!isInside(mRoot, c))
             throw PathRefused(where + ": /extends: refused: '" + base + "' lies outside the served directory");
@@ -103,6 +103,33 @@ void Sandbox::checkExtends(const nlohmann::json& document, const fs::path& direc
     }
 }
 
+void Sandbox::checkPathValue(const std::string& text, const fs::path& directory, const std::string& where) const {
+    // Renderers open the value as it is (no URL decoding); an escaped dot or slash there is a probe, never a file.
+    const std::string escaped = lower(text);
+    for (const char* code : {"%2e", "%2f", "%5c"})
+        if (escaped.find(code) != std::string::npos)
+            throw PathRefused(where + ": refused: a percent-encoded '.', '/' or '\\' in the path; give a plain path "
+                                      "relative to the graph file, under the served directory");
+    fs::path p(text);
+    if (p.is_absolute() || (!text.empty() && (text[0] == '/' || text[0] == '\\')))
+        throw PathRefused(where + ": refused: an absolute path; vitrine serve reads files under the served "
+                                  "directory only (give a path relative to the graph file)");
+    for (const fs::path& part : p)
+        if (part == "..") {
+            // `..` may stay inside (a graph in graphs/ naming ../images/x.png): refused only when it leads out.
+            if (!isInside(mRoot, canonicalOf(directory / p)))
+                throw PathRefused(where + ": refused: '" + text + "' leads outside the served directory; " +
+                                  "vitrine serve reads files under it only");
+            break;
+        }
+    fs::path c = canonicalOf(directory / p);
+    if (!isInside(mRoot, c))
+        throw PathRefused(where + ": refused: '" + text +
+                          "' lies outside the served directory (through a symbolic link); vitrine serve reads files "
+                          "under it only");
+    if (lower(c.extension().string()) == ".gltf") checkGltfUris(c, where);
+}
+
 void Sandbox::checkPathParams(const GraphDesc& desc) const {
     for (const NodeDecl& node : desc.nodes) {
         if (!node.schema) continue;
@@ -110,17 +137,26 @@ void Sandbox::checkPathParams(const GraphDesc& desc) const {
             if (spec.type != ParamType::Path || !node.params.contains(spec.name)) continue;
             const nlohmann::json& value = node.params[spec.name];
             if (!value.is_string() || value.get<std::string>().empty()) continue;
-            const std::string text = value.get<std::string>();
-            const std::string where = desc.where(node.pointer() + "/params/" + pointerToken(spec.name));
-            fs::path p(text);
-            if (p.is_absolute())
-                throw PathRefused(where + ": refused: absolute path '" + text +
-                                  "'; vitrine serve reads files under the served directory only");
-            fs::path c = canonicalOf(desc.directory / p);
-            if (!isInside(mRoot, c))
-                throw PathRefused(where + ": refused: '" + text +
-                                  "' lies outside the served directory; vitrine serve reads files under it only");
-            if (lower(c.extension().string()) == ".gltf") checkGltfUris(c, where);
+            checkPathValue(value.get<std::string>(), desc.directory,
+                           desc.where(node.pointer() + "/params/" + pointerToken(spec.name)));
+        }
+    }
+}
+
+void Sandbox::checkPathParams(const nlohmann::json& document, const fs::path& directory,
+                              const std::string& file) const {
+    if (!document.is_object() || !document.contains("nodes") || !document["nodes"].is_object()) return;
+    for (const auto& [id, node] : document["nodes"].items()) {
+        if (!node.is_object() || !node.contains("type") || !node["type"].is_string()) continue;
+        if (!node.contains("params") || !node["params"].is_object()) continue;
+        const NodeSchema* schema = NodeRegistry::global().find(node["type"].get<std::string>());
+        if (!schema) continue; // validation reports the unknown type
+        for (const ParamSpec& spec : schema->params) {
+            if (spec.type != ParamType::Path || !node["params"].contains(spec.name)) continue;
+            const nlohmann::json& value = node["params"][spec.name];
+            if (!value.is_string() || value.get<std::string>().empty()) continue;
+            checkPathValue(value.get<std::string>(), directory,
+                           file + ": /nodes/" + pointerToken(id) + "/params/" + pointerToken(spec.name));
         }
     }
 }

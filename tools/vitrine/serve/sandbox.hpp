@@ -45,7 +45,17 @@ public:
     // PathRefused names the graph file and the param's JSON pointer.
     void checkPathParams(const GraphDesc& desc) const;
 
+    // The same for a graph document before it is validated (after `extends` and "set" are merged): every `path`
+    // param it sets, on nodes of any known type, whatever else is wrong with the graph. `directory` is where its
+    // relative paths resolve from; `file` names it in errors.
+    void checkPathParams(const nlohmann::json& document, const std::filesystem::path& directory,
+                         const std::string& file) const;
+
 private:
+    // One path param's value (`where`: "FILE: /nodes/ID/params/NAME"): refused when absolute, when it has a
+    // percent-encoded '.', '/' or '\\', or when it resolves outside the root. Errors never echo an absolute path.
+    void checkPathValue(const std::string& text, const std::filesystem::path& directory,
+                        const std::string& where) const;
     void checkGltfUris(const std::filesystem::path& gltf, const std::string& where) const;
 
     std::filesystem::path mRoot;
