@@ -641,7 +641,8 @@ void prepareTinygltfInput(LoadContext& ctx) {
         }
     }
     if (!copy) return;
-    std::string text = copy->dump();
+    // Invalid UTF-8 in a string (a name, say) is replaced rather than thrown on: tinygltf gets valid JSON either way.
+    std::string text = copy->dump(-1, ' ', false, Json::error_handler_t::replace);
     if (!ctx.glb) {
         ctx.tinygltfInput.assign(text.begin(), text.end());
         return;
