@@ -19,7 +19,7 @@ commands:
       --scene FILE (run, bench, compare): the graph's scene node becomes scene.gltf of FILE, e.g.
       `vitrine run graphs/gltf.json --scene model.glb` (output in out/model/). The glTF loader's warnings
       (what vitrine ignores: unsupported extensions in extensionsUsed, skins, ...) go to stderr once each;
-      --strict (run, bench, compare, export-scene): they are errors (exit 1); without --scene it sets the
+      --strict (run, bench, compare, validate, export-scene): they are errors (exit 1); without --scene it sets the
       param strict of every scene.gltf node of the graph.
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
   nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
