@@ -13,8 +13,9 @@
 // nodes), KHR_materials_unlit, KHR_materials_transmission (the factor; its texture is ignored with a warning),
 // KHR_materials_ior, KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's
 // reflection probes in VITRINE_reflection_probes (VITRINE_reflection_probes.md). Any other
-// extension in extensionsRequired is refused by name. Skins, morph targets and point/line primitives
-// are ignored with a warning. Embedded (data: URI, GLB) and external buffers and images both work.
+// extension in extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning. Skins,
+// morph targets and point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus
+// their sparse substitutions), as glTF says, indices included. Data URIs may be base64 or percent-encoded (RFC 2397). Embedded (data: URI, GLB) and external buffers and images both work.
 //
 // How glTF maps onto the scene model:
 // - A metallic-roughness material is a one-layer stack: shininess = 1 − roughnessFactor × texel.g,
@@ -45,6 +46,12 @@ Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warn
 // folder for external files). For the fuzzer and for callers that hold the file in memory.
 Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesystem::path& file,
                          std::vector<std::string>& warnings);
+
+// Loads for a user, as the scene.gltf node and `vitrine export-scene` do: each distinct warning (an unsupported
+// extension in extensionsUsed, skins, morph targets, unused attributes, tinygltf's own warnings, ...) is printed once
+// on stderr through logWarning(), as "warning: FILE: ELEMENT: WHAT (at /json/pointer)". strict: warnings are errors;
+// a UserError lists them all and nothing is printed.
+Scene loadGltfReporting(const std::filesystem::path& file, bool strict);
 
 // Writes the scene as one self-contained .glb: geometry (one interleaved vertex buffer view), materials
 // with VITRINE_material_layers plus a plain metallic-roughness fallback made from layer 0, textures as

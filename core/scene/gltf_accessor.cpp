@@ -136,6 +136,36 @@ const tinygltf::Accessor& accessorAt(const LoadContext& ctx, int index, const st
     return ctx.model->accessors[index];
 }
 
+// Calls set(target, valueBytes) for each of a sparse accessor's substitutions, in file order, after checking its
+// count, index type and byte ranges (glTF: sparse indices and values are tightly packed).
+template <typename F>
+void forEachSparse(const LoadContext& ctx, const tinygltf::Accessor& a, uint64_t elementSize, const std::string& element,
+                   F set) {
+    std::string se = element + ".sparse";
+    uint64_t n = a.sparse.count > 0 ? uint64_t(a.sparse.count) : 0;
+    if (n == 0 || n > a.count) ctx.fail(se + ".count", "expected 1.." + std::to_string(a.count));
+    int itype = a.sparse.indices.componentType;
+    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+        ctx.fail(se + ".indices.componentType", "expected an unsigned integer type");
+    }
+    uint64_t istride = 0, vstride = 0;
+    const uint8_t* ip = viewBytes(ctx, a.sparse.indices.bufferView, a.sparse.indices.byteOffset, n,
+                                  componentSize(itype), istride, se + ".indices");
+    const uint8_t* vp =
+        viewBytes(ctx, a.sparse.values.bufferView, a.sparse.values.byteOffset, n, elementSize, vstride, se + ".values");
+    istride = componentSize(itype); // sparse data is tightly packed whatever the view says
+    vstride = elementSize;
+    for (uint64_t k = 0; k < n; ++k) {
+        uint32_t target = readUnsigned(ip + k * istride, itype);
+        if (target >= a.count) {
+            ctx.fail(se + ".indices", "index " + std::to_string(target) + " at position " + std::to_string(k) +
+                                          " >= count " + std::to_string(a.count));
+        }
+        set(target, vp + k * vstride);
+    }
+}
+
 } // namespace
 
 glm::vec4 AccessorValues::get(size_t i) const {
@@ -185,29 +215,10 @@ AccessorValues readAccessor(const LoadContext& ctx, int index, const std::string
         }
     }
     if (a.sparse.isSparse) {
-        std::string se = element + ".sparse";
-        uint64_t n = a.sparse.count > 0 ? uint64_t(a.sparse.count) : 0;
-        if (n == 0 || n > a.count) ctx.fail(se + ".count", "expected 1.." + std::to_string(a.count));
-        int itype = a.sparse.indices.componentType;
-        if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-            itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-            ctx.fail(se + ".indices.componentType", "expected an unsigned integer type");
-        }
-        uint64_t istride = 0, vstride = 0;
-        const uint8_t* ip = viewBytes(ctx, a.sparse.indices.bufferView, a.sparse.indices.byteOffset, n,
-                                      componentSize(itype), istride, se + ".indices");
-        const uint8_t* vp = viewBytes(ctx, a.sparse.values.bufferView, a.sparse.values.byteOffset, n,
-                                      uint64_t(csize) * comps, vstride, se + ".values");
-        istride = componentSize(itype); // sparse data is tightly packed whatever the view says
-        vstride = uint64_t(csize) * comps;
-        for (uint64_t k = 0; k < n; ++k) {
-            uint32_t target = readUnsigned(ip + k * istride, itype);
-            if (target >= a.count) ctx.fail(se + ".indices", "index " + std::to_string(target) + " >= count");
-            for (int c = 0; c < comps; ++c) {
-                out.data[target * comps + c] =
-                    readComponent(vp + k * vstride + c * csize, a.componentType, a.normalized);
-            }
-        }
+        forEachSparse(ctx, a, uint64_t(csize) * comps, element, [&](uint32_t target, const uint8_t* value) {
+            for (int c = 0; c < comps; ++c)
+                out.data[target * comps + c] = readComponent(value + c * csize, a.componentType, a.normalized);
+        });
     }
     for (size_t i = 0; i < out.data.size(); ++i) {
         if (!std::isfinite(out.data[i])) {
@@ -227,17 +238,22 @@ std::vector<uint32_t> readIndices(const LoadContext& ctx, int index, const std::
                  "componentType " + std::to_string(t) + "; expected UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT");
     }
     if (a.type != TINYGLTF_TYPE_SCALAR) ctx.fail(element, "expected type SCALAR");
-    if (a.sparse.isSparse) {
-        // Rare for indices; reuse the general path, which handles sparse data, and convert.
-        AccessorValues v = readAccessor(ctx, index, use, {1});
-        return std::vector<uint32_t>(v.data.begin(), v.data.end());
+    if (a.count == 0) ctx.fail(element, "count is 0; expected at least one index");
+    // Without a bufferView the indices are zeros (glTF 2.0, 3.6.2.3), then the sparse substitutions if any.
+    if (a.bufferView < 0 && a.count > kMaxZeroElements) {
+        ctx.fail(element, "count " + std::to_string(a.count) + " without a bufferView; expected at most " +
+                              std::to_string(kMaxZeroElements));
     }
-    if (a.bufferView < 0) ctx.fail(element, "has no bufferView; expected index data");
-    uint64_t stride = 0;
-    const uint8_t* base = viewBytes(ctx, a.bufferView, a.byteOffset, a.count, componentSize(t), stride, element);
-    std::vector<uint32_t> out(a.count);
-    for (size_t i = 0; i < a.count; ++i) {
-        out[i] = readUnsigned(base + i * stride, t);
+    std::vector<uint32_t> out(a.count, 0u);
+    if (a.bufferView >= 0) {
+        uint64_t stride = 0;
+        const uint8_t* base = viewBytes(ctx, a.bufferView, a.byteOffset, a.count, componentSize(t), stride, element);
+        for (size_t i = 0; i < a.count; ++i)
+            out[i] = readUnsigned(base + i * stride, t);
+    }
+    if (a.sparse.isSparse) {
+        forEachSparse(ctx, a, componentSize(t), element,
+                      [&](uint32_t target, const uint8_t* value) { out[target] = readUnsigned(value, t); });
     }
     return out;
 }

@@ -41,13 +41,26 @@ struct LoadContext {
     const tinygltf::Model* model = nullptr;
     Scene* scene = nullptr;
     std::vector<std::string>* warnings = nullptr;
+    // What tinygltf is given when the file had to be rewritten for it (preflight()), else empty: the file's bytes.
+    // Data URIs tinygltf cannot decode (not base64, or a media type it does not list) become base64, and the
+    // `indices` of primitives whose index accessor has no bufferView are dropped (tinygltf refuses them; the
+    // meshes step reads them from doc).
+    std::vector<uint8_t> tinygltfInput;
     // Scene texture made for glTF texture i with usage u, or -1 (see resolveTexture()).
     std::vector<std::array<int32_t, 3>> textureByUsage;
     int32_t defaultMaterial = -1;
 
+    // "FILE: ELEMENT: WHAT", plus " (at /json/pointer)" when ELEMENT starts with a path into the glTF JSON
+    // (`accessors[0].bufferView` → /accessors/0/bufferView). warn() keeps each distinct warning once.
     [[noreturn]] void fail(const std::string& element, const std::string& what) const;
     void warn(const std::string& element, const std::string& what) const;
 };
+
+// The JSON pointer of the glTF path `element` starts with (`meshes[0].primitives[1].indices (accessors[3])` →
+// /meshes/0/primitives/1/indices), or "" when it does not start with a top-level glTF property.
+std::string jsonPointer(const std::string& element);
+// A data: URI (RFC 2397) decoded: base64 or percent-encoded payload. False with error set when malformed.
+bool decodeDataUri(const std::string& uri, std::vector<uint8_t>& out, std::string& mediaType, std::string& error);
 
 // `element.key`, or `key` at the top level (element empty).
 std::string path(const std::string& element, const char* key);

@@ -5,6 +5,7 @@
 #include "core/scene/probe_json.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/log.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -482,15 +483,24 @@ Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesyste
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
     std::string err, warn;
-    bool ok = ctx.glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                                    static_cast<unsigned>(bytes.size()), ctx.baseDir.string())
-                      : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
-                                                   static_cast<unsigned>(bytes.size()), ctx.baseDir.string());
+    const std::vector<uint8_t>& input = ctx.tinygltfInput.empty() ? bytes : ctx.tinygltfInput;
+    bool ok = ctx.glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, input.data(),
+                                                    static_cast<unsigned>(input.size()), ctx.baseDir.string())
+                      : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(input.data()),
+                                                   static_cast<unsigned>(input.size()), ctx.baseDir.string());
     std::istringstream lines(warn);
     for (std::string line; std::getline(lines, line);) {
         if (!line.empty()) ctx.warn("tinygltf", line);
     }
-    if (!ok) ctx.fail("glTF", "tinygltf could not load it: " + err);
+    if (!ok) {
+        // preflight() checks what glTF requires, so this is rare; tinygltf's parsers may give no reason at all.
+        while (!err.empty() && (err.back() == '\n' || err.back() == ' '))
+            err.pop_back();
+        std::replace(err.begin(), err.end(), '\n', ';');
+        ctx.fail("glTF", err.empty() ? "tinygltf refused the file without saying why (a property of the wrong type "
+                                       "or one its parser requires?); check it with the Khronos glTF-Validator"
+                                     : "tinygltf could not load it: " + err);
+    }
 
     Scene scene;
     ctx.model = &model;
@@ -507,6 +517,22 @@ Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warn
     gltf::LoadContext ctx;
     ctx.file = file.string();
     return loadGltfFromMemory(gltf::readGltfFile(ctx, file), file, warnings);
+}
+
+Scene loadGltfReporting(const std::filesystem::path& file, bool strict) {
+    std::vector<std::string> warnings; // distinct already (LoadContext::warn)
+    Scene scene = loadGltf(file, warnings);
+    if (strict && !warnings.empty()) {
+        std::string list;
+        for (const std::string& w : warnings)
+            list += "\n  " + w;
+        throw UserError(file.string() + ": " + std::to_string(warnings.size()) +
+                        (warnings.size() == 1 ? " warning" : " warnings") +
+                        ", which strict loading (--strict, or the scene.gltf param strict) makes errors:" + list);
+    }
+    for (const std::string& w : warnings)
+        logWarning(w);
+    return scene;
 }
 
 Scene loadGltf(const std::filesystem::path& file) {

@@ -49,7 +49,8 @@ std::vector<uint32_t> toTriangleList(const LoadContext& ctx, std::vector<uint32_
     return out;
 }
 
-void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, const std::string& e) {
+// indexAccessor: the primitive's `indices` as the file has it (tinygltf's copy may lack it, see tinygltfInput).
+void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAccessor, const std::string& e) {
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
     if (mode <= TINYGLTF_MODE_LINE_STRIP) {
         ctx.warn(e, "points and lines are not drawn; primitive skipped");
@@ -91,8 +92,8 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, const std::st
     if (!p.targets.empty()) ctx.warn(e + ".targets", "morph targets are not supported; ignored");
 
     std::vector<uint32_t> indices(n);
-    if (p.indices >= 0) {
-        indices = readIndices(ctx, p.indices, e + ".indices");
+    if (indexAccessor >= 0) {
+        indices = readIndices(ctx, indexAccessor, e + ".indices");
     } else {
         std::iota(indices.begin(), indices.end(), 0u);
     }
@@ -169,9 +170,11 @@ void loadMeshes(LoadContext& ctx) {
         Mesh mesh;
         mesh.name = model.meshes[i].name;
         mesh.firstPrimitive = static_cast<uint32_t>(ctx.scene->primitives.size());
+        const Json& primsJson = ctx.doc["meshes"][i]["primitives"];
         for (size_t j = 0; j < model.meshes[i].primitives.size(); ++j) {
-            loadPrimitive(ctx, model.meshes[i].primitives[j],
-                          "meshes[" + std::to_string(i) + "].primitives[" + std::to_string(j) + "]");
+            std::string e = "meshes[" + std::to_string(i) + "].primitives[" + std::to_string(j) + "]";
+            int indexAccessor = static_cast<int>(integer(ctx, primsJson[j], "indices", -1, e));
+            loadPrimitive(ctx, model.meshes[i].primitives[j], indexAccessor, e);
         }
         mesh.primitiveCount = static_cast<uint32_t>(ctx.scene->primitives.size()) - mesh.firstPrimitive;
         ctx.scene->meshes.push_back(mesh);

@@ -14,15 +14,146 @@
 #include <fstream>
 #include <set>
 
+#include <tiny_gltf.h>
+
 namespace vitrine::scene::gltf {
 
+namespace {
+
+std::string located(const std::string& file, const std::string& element, const std::string& what) {
+    std::string pointer = jsonPointer(element);
+    return file + ": " + element + ": " + what + (pointer.empty() ? "" : " (at " + pointer + ")");
+}
+
+bool identifierChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; }
+
+} // namespace
+
 void LoadContext::fail(const std::string& element, const std::string& what) const {
-    throw UserError(file + ": " + element + ": " + what);
+    throw UserError(located(file, element, what));
 }
 
 void LoadContext::warn(const std::string& element, const std::string& what) const {
-    if (warnings) warnings->push_back(file + ": " + element + ": " + what);
+    if (!warnings) return;
+    std::string message = located(file, element, what);
+    if (std::find(warnings->begin(), warnings->end(), message) == warnings->end()) warnings->push_back(message);
 }
+
+std::string jsonPointer(const std::string& element) {
+    static const std::set<std::string> kTopLevel = {
+        "accessors", "animations", "asset",  "buffers", "bufferViews", "cameras", "extensions",
+        "extensionsRequired", "extensionsUsed", "extras", "images", "materials", "meshes", "nodes",
+        "samplers", "scene", "scenes", "skins", "textures"};
+    size_t i = 0;
+    while (i < element.size() && identifierChar(element[i]))
+        ++i;
+    std::string first = element.substr(0, i);
+    if (!kTopLevel.count(first)) return "";
+    std::string pointer = "/" + first;
+    while (i < element.size()) {
+        if (element[i] == '[') {
+            size_t close = element.find(']', i);
+            if (close == std::string::npos || close == i + 1) break;
+            std::string digits = element.substr(i + 1, close - i - 1);
+            if (!std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) break;
+            pointer += "/" + digits;
+            i = close + 1;
+        } else if (element[i] == '.' && i + 1 < element.size() && identifierChar(element[i + 1])) {
+            size_t start = ++i;
+            while (i < element.size() && identifierChar(element[i]))
+                ++i;
+            pointer += "/" + element.substr(start, i - start); // glTF keys have no '~' or '/' to escape
+        } else {
+            break;
+        }
+    }
+    return pointer;
+}
+
+bool decodeDataUri(const std::string& uri, std::vector<uint8_t>& out, std::string& mediaType, std::string& error) {
+    out.clear();
+    if (uri.rfind("data:", 0) != 0) {
+        error = "expected a URI starting with 'data:'";
+        return false;
+    }
+    size_t comma = uri.find(',');
+    if (comma == std::string::npos) {
+        error = "data: URI without ','; expected data:[<media type>][;base64],<data>";
+        return false;
+    }
+    std::string header = uri.substr(5, comma - 5);
+    std::string lower = header;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    bool base64 = lower.size() >= 7 && lower.compare(lower.size() - 7, 7, ";base64") == 0;
+    mediaType = lower.substr(0, lower.find(';'));
+    if (mediaType.empty()) mediaType = "text/plain"; // RFC 2397's default
+    // The payload is percent-encoded (RFC 2397 and 3986); a base64 payload rarely is, but may be.
+    std::string payload;
+    for (size_t i = comma + 1; i < uri.size(); ++i) {
+        if (uri[i] != '%') {
+            payload += uri[i];
+            continue;
+        }
+        if (i + 2 >= uri.size() || !std::isxdigit(uint8_t(uri[i + 1])) || !std::isxdigit(uint8_t(uri[i + 2]))) {
+            error = "data: URI has '%' at character " + std::to_string(i) + " not followed by two hex digits";
+            return false;
+        }
+        payload += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+        i += 2;
+    }
+    if (!base64) {
+        out.assign(payload.begin(), payload.end());
+        return true;
+    }
+    uint32_t bits = 0;
+    int count = 0;
+    size_t padding = 0;
+    for (size_t i = 0; i < payload.size(); ++i) {
+        char c = payload[i];
+        int v = c >= 'A' && c <= 'Z' ? c - 'A'
+                : c >= 'a' && c <= 'z' ? c - 'a' + 26
+                : c >= '0' && c <= '9' ? c - '0' + 52
+                : c == '+' ? 62
+                : c == '/' ? 63
+                           : -1;
+        if (c == '=') {
+            ++padding;
+            continue;
+        }
+        if (v < 0 || padding > 0) {
+            error = "data: URI's base64 payload has '" + std::string(1, c) + "' at payload character " +
+                    std::to_string(i) + "; expected A-Z a-z 0-9 + / and '=' padding at the end";
+            return false;
+        }
+        bits = (bits << 6) | static_cast<uint32_t>(v);
+        count += 6;
+        if (count >= 8) {
+            count -= 8;
+            out.push_back(static_cast<uint8_t>(bits >> count));
+        }
+    }
+    return true;
+}
+
+namespace {
+
+std::string base64Encode(const std::vector<uint8_t>& data) {
+    static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((data.size() + 2) / 3 * 4);
+    for (size_t i = 0; i < data.size(); i += 3) {
+        uint32_t v = uint32_t(data[i]) << 16;
+        if (i + 1 < data.size()) v |= uint32_t(data[i + 1]) << 8;
+        if (i + 2 < data.size()) v |= data[i + 2];
+        out += kAlphabet[(v >> 18) & 63];
+        out += kAlphabet[(v >> 12) & 63];
+        out += i + 1 < data.size() ? kAlphabet[(v >> 6) & 63] : '=';
+        out += i + 2 < data.size() ? kAlphabet[v & 63] : '=';
+    }
+    return out;
+}
+
+} // namespace
 
 std::string path(const std::string& element, const char* key) {
     return element.empty() ? std::string(key) : element + "." + key;
@@ -207,10 +338,30 @@ bool looksLikeGlb(const std::filesystem::path& file, const std::vector<uint8_t>&
     return false;
 }
 
+const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength, kLightsPunctual,
+                                          kMeshQuantization, kLayersExtension, kUnlit,
+                                          kTransmission, kIor, kProbesExtension};
+
+// An extension the file uses but does not require may be ignored (glTF 2.0, 3.12): a warning per extension.
+void checkUsedExtensions(const LoadContext& ctx) {
+    const Json* used = member(ctx.doc, "extensionsUsed");
+    if (!used) return;
+    if (!used->is_array()) ctx.fail("extensionsUsed", "expected an array of extension names");
+    const Json* required = member(ctx.doc, "extensionsRequired");
+    for (size_t i = 0; i < used->size(); ++i) {
+        const Json& name = (*used)[i];
+        std::string element = "extensionsUsed[" + std::to_string(i) + "]";
+        if (!name.is_string()) ctx.fail(element, "expected an extension name");
+        std::string n = name.get<std::string>();
+        if (kSupported.count(n)) continue;
+        if (required && required->is_array() && std::find(required->begin(), required->end(), name) != required->end())
+            continue; // refused by checkRequiredExtensions()
+        ctx.warn(element, "extension '" + n + "' is not supported by vitrine; what the file puts under that name in "
+                                              "\"extensions\" is ignored and the file is drawn as if it lacked it");
+    }
+}
+
 void checkRequiredExtensions(const LoadContext& ctx) {
-    static const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength, kLightsPunctual,
-                                                     kMeshQuantization, kLayersExtension, kUnlit,
-                                                     kTransmission, kIor, kProbesExtension};
     const Json* required = member(ctx.doc, "extensionsRequired");
     if (!required) return;
     if (!required->is_array()) ctx.fail("extensionsRequired", "expected an array of extension names");
@@ -254,7 +405,17 @@ void checkExternalFile(const LoadContext& ctx, const Json& obj, const std::strin
     if (!uri) return;
     if (!uri->is_string()) ctx.fail(element + ".uri", "expected a string");
     std::string s = uri->get<std::string>();
-    if (s.rfind("data:", 0) == 0) return; // tinygltf decodes it and checks its length
+    if (s.rfind("data:", 0) == 0) {
+        std::vector<uint8_t> data;
+        std::string mediaType, error;
+        if (!decodeDataUri(s, data, mediaType, error)) ctx.fail(element + ".uri", error);
+        if (minBytes > 0 && data.size() != minBytes) {
+            ctx.fail(element + ".uri", "data: URI holds " + std::to_string(data.size()) + " bytes; expected byteLength " +
+                                           std::to_string(minBytes));
+        }
+        if (minBytes == 0 && data.empty()) ctx.fail(element + ".uri", "data: URI holds no bytes; expected an image");
+        return;
+    }
     std::filesystem::path path = ctx.baseDir / urlDecode(s);
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) {
@@ -264,6 +425,15 @@ void checkExternalFile(const LoadContext& ctx, const Json& obj, const std::strin
     if (!ec && size < minBytes) {
         ctx.fail(element, "file '" + s + "' has " + std::to_string(size) + " bytes; expected byteLength " +
                               std::to_string(minBytes));
+    }
+}
+
+// Fails naming the first of keys that obj lacks: properties glTF 2.0's schema requires, which tinygltf would
+// otherwise refuse with a message that names no element (or none at all).
+void require(const LoadContext& ctx, const Json& obj, const std::string& element,
+             std::initializer_list<std::pair<const char*, const char*>> keys) {
+    for (const auto& [key, what] : keys) {
+        if (!member(obj, key)) ctx.fail(path(element, key), std::string("missing; expected ") + what + " (required by glTF 2.0)");
     }
 }
 
@@ -320,15 +490,48 @@ void checkReferences(const LoadContext& ctx) {
         });
     });
     forEach(ctx, d, "accessors", "", [&](const std::string& e, const Json& a) {
+        require(ctx, a, e,
+                {{"componentType", "the component type (5120..5126)"},
+                 {"count", "the number of elements"},
+                 {"type", "SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4"}});
         checkOptionalIndex(ctx, a, "bufferView", e, "bufferViews");
         if (const Json* sparse = object(ctx, a, "sparse", e)) {
-            if (const Json* idx = object(ctx, *sparse, "indices", e + ".sparse")) {
-                checkOptionalIndex(ctx, *idx, "bufferView", e + ".sparse.indices", "bufferViews");
+            std::string se = e + ".sparse";
+            require(ctx, *sparse, se,
+                    {{"count", "the number of substituted elements"},
+                     {"indices", "{bufferView, componentType}"},
+                     {"values", "{bufferView}"}});
+            if (const Json* idx = object(ctx, *sparse, "indices", se)) {
+                require(ctx, *idx, se + ".indices",
+                        {{"bufferView", "an index into bufferViews"}, {"componentType", "5121, 5123 or 5125"}});
+                checkOptionalIndex(ctx, *idx, "bufferView", se + ".indices", "bufferViews");
             }
-            if (const Json* val = object(ctx, *sparse, "values", e + ".sparse")) {
-                checkOptionalIndex(ctx, *val, "bufferView", e + ".sparse.values", "bufferViews");
+            if (const Json* val = object(ctx, *sparse, "values", se)) {
+                require(ctx, *val, se + ".values", {{"bufferView", "an index into bufferViews"}});
+                checkOptionalIndex(ctx, *val, "bufferView", se + ".values", "bufferViews");
             }
         }
+    });
+    forEach(ctx, d, "cameras", "", [&](const std::string& e, const Json& c) {
+        require(ctx, c, e, {{"type", "perspective or orthographic"}});
+        if (c["type"] == "perspective") require(ctx, c, e, {{"perspective", "{yfov, znear}"}});
+        if (c["type"] == "orthographic") require(ctx, c, e, {{"orthographic", "{xmag, ymag, zfar, znear}"}});
+        if (const Json* p = object(ctx, c, "perspective", e)) {
+            require(ctx, *p, e + ".perspective", {{"yfov", "the vertical field of view"}, {"znear", "the near plane"}});
+        }
+        if (const Json* o = object(ctx, c, "orthographic", e)) {
+            require(ctx, *o, e + ".orthographic",
+                    {{"xmag", "a number"}, {"ymag", "a number"}, {"zfar", "a number"}, {"znear", "a number"}});
+        }
+    });
+    forEach(ctx, d, "skins", "", [&](const std::string& e, const Json& s) {
+        require(ctx, s, e, {{"joints", "a non-empty array of node indices"}});
+        const Json& joints = s["joints"];
+        if (!joints.is_array() || joints.empty()) ctx.fail(e + ".joints", "expected a non-empty array of node indices");
+        for (size_t i = 0; i < joints.size(); ++i)
+            checkIndex(ctx, joints[i], e + ".joints[" + std::to_string(i) + "]", "nodes");
+        checkOptionalIndex(ctx, s, "skeleton", e, "nodes");
+        checkOptionalIndex(ctx, s, "inverseBindMatrices", e, "accessors");
     });
     bool binary = !ctx.glbBin.empty();
     std::vector<uint64_t> bufferLength;
@@ -376,7 +579,9 @@ void checkReferences(const LoadContext& ctx) {
     forEach(ctx, d, "animations", "", [&](const std::string& e, const Json& a) {
         const Json* samplers = member(a, "samplers");
         size_t samplerCount = samplers && samplers->is_array() ? samplers->size() : 0;
+        require(ctx, a, e, {{"channels", "an array of channels"}, {"samplers", "an array of samplers"}});
         forEach(ctx, a, "channels", e, [&](const std::string& ce, const Json& c) {
+            require(ctx, c, ce, {{"sampler", "an index into the animation's samplers"}, {"target", "{node, path}"}});
             int64_t s = integer(ctx, c, "sampler", -1, ce);
             if (s < 0 || static_cast<size_t>(s) >= samplerCount) {
                 ctx.fail(ce + ".sampler", "index " + std::to_string(s) + " out of range; the animation has " +
@@ -384,6 +589,7 @@ void checkReferences(const LoadContext& ctx) {
             }
             const Json* target = object(ctx, c, "target", ce);
             if (!target) ctx.fail(ce + ".target", "missing; expected {node, path}");
+            require(ctx, *target, ce + ".target", {{"path", "translation, rotation, scale or weights"}});
             checkOptionalIndex(ctx, *target, "node", ce + ".target", "nodes");
         });
         forEach(ctx, a, "samplers", e, [&](const std::string& se, const Json& s) {
@@ -392,6 +598,71 @@ void checkReferences(const LoadContext& ctx) {
             checkIndex(ctx, s["output"], se + ".output", "accessors");
         });
     });
+}
+
+void appendU32(std::vector<uint8_t>& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i)
+        out.push_back(static_cast<uint8_t>(v >> (8 * i)));
+}
+
+// What tinygltf cannot read although glTF allows it, rewritten in a copy of the JSON (see LoadContext::tinygltfInput).
+void prepareTinygltfInput(LoadContext& ctx) {
+    std::optional<Json> copy;
+    auto edit = [&]() -> Json& {
+        if (!copy) copy = ctx.doc;
+        return *copy;
+    };
+    for (const char* name : {"buffers", "images"}) {
+        const Json* list = member(ctx.doc, name);
+        for (size_t i = 0; list && i < list->size(); ++i) {
+            const Json* uri = member((*list)[i], "uri");
+            if (!uri || !uri->is_string()) continue;
+            const std::string& s = uri->get_ref<const std::string&>();
+            if (s.rfind("data:", 0) != 0 || tinygltf::IsDataURI(s)) continue;
+            std::vector<uint8_t> data;
+            std::string mediaType, error;
+            decodeDataUri(s, data, mediaType, error); // checked by checkExternalFile()
+            bool known = mediaType == "image/png" || mediaType == "image/jpeg" || mediaType == "image/bmp" ||
+                         mediaType == "image/gif";
+            std::string header = std::string(name) == "images" && known ? "data:" + mediaType + ";base64,"
+                                                                         : "data:application/octet-stream;base64,";
+            edit()[name][i]["uri"] = header + base64Encode(data);
+        }
+    }
+    // tinygltf refuses an index accessor without a bufferView (glTF: all zeros, plus sparse values).
+    const Json* meshes = member(ctx.doc, "meshes");
+    const Json* accessors = member(ctx.doc, "accessors");
+    for (size_t m = 0; meshes && accessors && m < meshes->size(); ++m) {
+        const Json* prims = member((*meshes)[m], "primitives");
+        for (size_t p = 0; prims && p < prims->size(); ++p) {
+            const Json* indices = member((*prims)[p], "indices");
+            if (indices && !member((*accessors)[indices->get<size_t>()], "bufferView"))
+                edit()["meshes"][m]["primitives"][p].erase("indices");
+        }
+    }
+    if (!copy) return;
+    // Invalid UTF-8 in a string (a name, say) is replaced rather than thrown on: tinygltf gets valid JSON either way.
+    std::string text = copy->dump(-1, ' ', false, Json::error_handler_t::replace);
+    if (!ctx.glb) {
+        ctx.tinygltfInput.assign(text.begin(), text.end());
+        return;
+    }
+    while (text.size() % 4 != 0)
+        text += ' ';
+    std::vector<uint8_t>& out = ctx.tinygltfInput;
+    uint64_t total = 12 + 8 + text.size() + (ctx.glbBin.empty() ? 0 : 8 + ctx.glbBin.size());
+    if (total > UINT32_MAX) ctx.fail("GLB", "too large to rewrite for its data: URIs (over 4 GiB)");
+    appendU32(out, kGlbMagic);
+    appendU32(out, 2);
+    appendU32(out, static_cast<uint32_t>(total));
+    appendU32(out, static_cast<uint32_t>(text.size()));
+    appendU32(out, kChunkJson);
+    out.insert(out.end(), text.begin(), text.end());
+    if (!ctx.glbBin.empty()) {
+        appendU32(out, static_cast<uint32_t>(ctx.glbBin.size()));
+        appendU32(out, kChunkBin);
+        out.insert(out.end(), ctx.glbBin.begin(), ctx.glbBin.end());
+    }
 }
 
 } // namespace
@@ -424,7 +695,9 @@ void preflight(LoadContext& ctx, const std::filesystem::path& file, const std::v
     std::string version = string(ctx, *asset, "version", "", "asset");
     if (version.rfind("2.", 0) != 0) ctx.fail("asset.version", "'" + version + "'; expected \"2.0\"");
     checkRequiredExtensions(ctx);
+    checkUsedExtensions(ctx);
     checkReferences(ctx);
+    prepareTinygltfInput(ctx);
 }
 
 } // namespace vitrine::scene::gltf

@@ -13,7 +13,10 @@ NodeSchema schema() {
     s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
             "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, KHR_lights_punctual.";
     s.pass = PassKind::Transfer;
-    s.params = {{"path", ParamType::Path, "", {}, {}, {}, "The .gltf or .glb file (relative to the graph file)"}};
+    s.params = {{"path", ParamType::Path, "", {}, {}, {}, "The .gltf or .glb file (relative to the graph file)"},
+                {"strict", ParamType::Bool, false, {}, {}, {},
+                 "Refuse the file when loading it gives warnings (what vitrine ignores: unsupported extensions in "
+                 "extensionsUsed, skins, morph targets, ...) instead of printing them; `--strict` on the command line"}};
     addSceneNodeSchema(s);
     return s;
 }
@@ -27,7 +30,7 @@ public:
         if (!std::filesystem::exists(file)) ctx.failParam("path", "file not found: " + file.string());
         std::shared_ptr<const scene::Scene> scene;
         try {
-            scene = std::make_shared<const scene::Scene>(scene::loadGltf(file));
+            scene = std::make_shared<const scene::Scene>(scene::loadGltfReporting(file, ctx.params().getBool("strict")));
         } catch (const UserError& e) {
             // The glTF error names its file and element; the graph's file and param say where the path came from.
             ctx.failParam("path", e.what());

@@ -25,7 +25,7 @@ int exportSceneCommand(const Args& args) {
         options.textureSize = args.getUint("texture-size", 1024);
         s = scene::buildMuseum(options);
     } else {
-        s = scene::loadGltf(source);
+        s = scene::loadGltfReporting(source, args.has("strict"));
     }
     if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
     scene::exportGlb(s, out);

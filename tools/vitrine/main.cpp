@@ -17,7 +17,10 @@ commands:
       OCIO display transform) and all outputs of a frame as one multi-layer EXR. --frames N is
       frame.frames (and frame.write = [N-1]) before validation; later --set frame.* override it.
       --scene FILE (run, bench, compare): the graph's scene node becomes scene.gltf of FILE, e.g.
-      `vitrine run graphs/gltf.json --scene model.glb` (output in out/model/).
+      `vitrine run graphs/gltf.json --scene model.glb` (output in out/model/). The glTF loader's warnings
+      (what vitrine ignores: unsupported extensions in extensionsUsed, skins, ...) go to stderr once each;
+      --strict (run, bench, compare, validate, export-scene): they are errors (exit 1); without --scene it sets the
+      param strict of every scene.gltf node of the graph.
   validate GRAPH [--set K=V]...     Load and compile GRAPH without rendering.
   nodes [--json [FILE]]             List node types with their ports and params; --json: the schemas as
                                     JSON on stdout (or in FILE).
@@ -39,7 +42,7 @@ commands:
       `accept` (re)writes the golden EXRs, `check` compares with FLIP tolerances and writes
       a heat map and report.html per failure into DIR (default golden-report). Exit 3: failed.
       --skip-missing: exit 77 (skipped) when this device class has no goldens yet.
-  export-scene museum|FILE OUT.glb [--seed N] [--texture-size N] [--force]
+  export-scene museum|FILE OUT.glb [--seed N] [--texture-size N] [--force] [--strict]
       Write the procedural museum (or re-write a glTF file) as glTF binary for other tools.
   jitter [PATTERN]... [--out DIR] [--frames N]
       Plot the camera jitter patterns (halton, ordered, rotated, improved, stratified) as SVG:

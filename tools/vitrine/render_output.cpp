@@ -42,7 +42,17 @@ std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool 
         }
         nlohmann::json node = {{"type", "scene.gltf"},
                                {"params", {{"path", std::filesystem::absolute(file).lexically_normal().string()}}}};
+        if (args.has("strict")) node["params"]["strict"] = true;
         sets.push_back(ids[0] + "=" + node.dump());
+    } else if (args.has("strict") && !graph.empty()) {
+        // --strict without --scene: every scene.gltf node of the graph loads strictly.
+        const nlohmann::json doc = loadGraphDocument(graph);
+        size_t count = 0;
+        if (doc.contains("nodes") && doc["nodes"].is_object())
+            for (const auto& [id, node] : doc["nodes"].items())
+                if (node.is_object() && node.contains("type") && node["type"] == "scene.gltf")
+                    sets.push_back(id + ".params.strict=true"), ++count;
+        if (count == 0) throw UserError(graph + ": --strict: the graph has no scene.gltf node (and no --scene FILE)");
     }
     if (frames > 0) {
         sets.push_back("frame.frames=" + std::to_string(frames));
