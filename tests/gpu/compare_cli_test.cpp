@@ -176,5 +176,52 @@ TEST(GoldenCli, PerturbedRenderFailsTheCheckAndWritesAReport) {
     EXPECT_GT(metrics["pairs"][0]["flip"]["mean"].get<double>(), 0.002);
 }
 
+// The block-luminance bound catches a small shift of brightness that loose per-pixel bounds let through; --keep writes
+// the render that --from reads back; a tolerance class meant for another device class skips (77).
+TEST(GoldenCli, BlockLuminanceKeepFromAndClass) {
+    const fs::path dir = freshDir("golden_blocks");
+    const json loose = {{"flipMean", 1.0}, {"percentile", 99}, {"flipPercentile", 1.0}, {"meanAbsDiff", 1.0},
+                        {"blockSize", 16}, {"blockLuminance", 0.01}};
+    json manifest = {{"format", "vitrine-golden/1"},
+                     {"tolerances", {{"lavapipe", loose}, {"gpu", loose}, {"elsewhere", loose}}},
+                     {"images", {{"zp", {{"graph", kSource + "/graphs/fxaa_zoneplate.json"},
+                                         {"set", {"frame.width=64", "frame.height=36"}}}}}}};
+    manifest["tolerances"]["elsewhere"]["appliesTo"] = "no-such-class";
+    std::ofstream(dir / "manifest.json") << manifest.dump(2);
+    const std::string m = " --manifest " + quote((dir / "manifest.json").string()) + " --quiet --force";
+    ASSERT_EQ(vitrine("golden accept" + m).status, 0);
+
+    const CliResult same = vitrine("golden check" + m + " --keep " + quote((dir / "kept").string()) + " --out " +
+                                   quote((dir / "r0").string()));
+    EXPECT_EQ(same.status, 0) << same.output;
+    EXPECT_NE(same.output.find("16px blocks' luminance 0.0000"), std::string::npos) << same.output;
+    EXPECT_TRUE(fs::is_regular_file(dir / "kept" / "zp.exr"));
+
+    // 0.05 EV brighter: +3.5 % everywhere. Every per-pixel bound is 1; only the blocks see it.
+    const CliResult brighter = vitrine("golden check" + m + " --set tonemap.params.exposure=0.05 --keep " +
+                                       quote((dir / "bright").string()) + " --out " + quote((dir / "r1").string()));
+    EXPECT_EQ(brighter.status, 3) << brighter.output;
+    EXPECT_NE(brighter.output.find("FAIL zp"), std::string::npos) << brighter.output;
+
+    // --from compares the kept render without rendering: the same verdict.
+    const CliResult from = vitrine("golden check" + m + " --from " + quote((dir / "bright").string()) + " --out " +
+                                   quote((dir / "r2").string()));
+    EXPECT_EQ(from.status, 3) << from.output;
+    const CliResult fromSame = vitrine("golden check" + m + " --from " + quote((dir / "kept").string()) + " --out " +
+                                       quote((dir / "r3").string()));
+    EXPECT_EQ(fromSame.status, 0) << fromSame.output;
+
+    // --goldens DIR: the kept brighter render as the golden makes the brighter render pass.
+    const CliResult goldens = vitrine("golden check" + m + " --set tonemap.params.exposure=0.05 --goldens " +
+                                      quote((dir / "bright").string()) + " --out " + quote((dir / "r4").string()));
+    EXPECT_EQ(goldens.status, 0) << goldens.output;
+
+    // A class whose tolerances apply to another device class is skipped, loudly.
+    const CliResult other = vitrine("golden check" + m + " --skip-missing --class elsewhere --out " +
+                                     quote((dir / "r5").string()));
+    EXPECT_EQ(other.status, 77) << other.output;
+    EXPECT_NE(other.output.find("SKIPPED, NOT CHECKED"), std::string::npos) << other.output;
+}
+
 } // namespace
 } // namespace vitrine::test

@@ -29,6 +29,13 @@ struct Tolerance {
     double percentile = 99.0;    // which per-pixel percentile is bounded ...
     double flipPercentile = 0.0; // ... and by how much
     double meanAbsDiff = 1.0;    // mean |rendered - golden| over RGB: catches small systematic shifts FLIP forgives
+    // Block luminance: the image is cut into blockSize x blockSize blocks (0: off) and no block's mean luminance may
+    // differ from the golden's by more than blockLuminance, relative (|a - g| / max(g, blockFloor)). Another CPU's
+    // code generation moves Monte Carlo paths of the bake and so single pixels (zero-mean noise FLIP sees), while a
+    // shading bug moves whole regions: this bound stays tight where the per-pixel ones must leave room for noise.
+    int blockSize = 0;
+    double blockLuminance = 1.0;
+    double blockFloor = 0.01;
 };
 
 struct GoldenCase {
@@ -46,6 +53,9 @@ struct Manifest {
     // The device class may have no goldens yet (nobody could accept them on such a device): `check --skip-missing`
     // then skips loudly instead of failing. Never set for lavapipe, whose goldens are in the tree.
     bool skipIfMissing = false;
+    // A tolerance class meant for one device class only (e.g. "lavapipe-codegen": two code generations of llvmpipe);
+    // empty: any.
+    std::string appliesTo;
 };
 
 double number(const json& object, const std::string& key, const std::string& where, double min, double max) {
@@ -60,13 +70,19 @@ Tolerance readTolerance(const json& t, const std::string& where, Tolerance base)
     if (!t.is_object()) throw UserError(where + ": expected an object {flipMean, percentile, flipPercentile}");
     for (const auto& [key, value] : t.items())
         if (key != "flipMean" && key != "percentile" && key != "flipPercentile" && key != "meanAbsDiff" &&
-            key != "skipIfMissing")
+            key != "blockSize" && key != "blockLuminance" && key != "blockFloor" && key != "skipIfMissing" &&
+            key != "measured" && key != "appliesTo")
             throw UserError(where + "/" + key +
-                            ": unknown key; expected flipMean, percentile, flipPercentile, meanAbsDiff or skipIfMissing");
+                            ": unknown key; expected flipMean, percentile, flipPercentile, meanAbsDiff, blockSize, "
+                            "blockLuminance, blockFloor, measured, appliesTo or skipIfMissing");
     if (t.contains("flipMean")) base.flipMean = number(t, "flipMean", where, 0.0, 1.0);
     if (t.contains("percentile")) base.percentile = number(t, "percentile", where, 0.0, 100.0);
     if (t.contains("flipPercentile")) base.flipPercentile = number(t, "flipPercentile", where, 0.0, 1.0);
     if (t.contains("meanAbsDiff")) base.meanAbsDiff = number(t, "meanAbsDiff", where, 0.0, 1e30);
+    if (t.contains("blockSize")) base.blockSize = static_cast<int>(number(t, "blockSize", where, 0.0, 4096.0));
+    if (t.contains("blockLuminance")) base.blockLuminance = number(t, "blockLuminance", where, 0.0, 1e30);
+    if (t.contains("blockFloor")) base.blockFloor = number(t, "blockFloor", where, 1e-9, 1e30);
+    // "measured": free text (or an object) recording the spread the bounds were derived from; not read.
     return base;
 }
 
@@ -93,6 +109,11 @@ Manifest readManifest(const fs::path& file, const std::string& deviceClass) {
             throw UserError(f + "/tolerances/" + deviceClass + "/skipIfMissing: expected true or false");
         m.skipIfMissing = t["skipIfMissing"].get<bool>();
     }
+    if (const json& t = doc["tolerances"][deviceClass]; t.contains("appliesTo")) {
+        if (!t["appliesTo"].is_string())
+            throw UserError(f + "/tolerances/" + deviceClass + "/appliesTo: expected a device class name");
+        m.appliesTo = t["appliesTo"].get<std::string>();
+    }
     for (const auto& [name, entry] : doc["images"].items()) {
         const std::string where = f + "/images/" + name;
         if (!entry.is_object() || !entry.contains("graph") || !entry["graph"].is_string())
@@ -118,6 +139,29 @@ double meanAbsDifference(const Image& a, const Image& b) {
     for (size_t i = 0; i < a.pixels.size(); ++i)
         if (i % 4 != 3) sum += std::fabs(static_cast<double>(a.pixels[i]) - b.pixels[i]);
     return sum / (3.0 * static_cast<double>(a.pixels.size() / 4));
+}
+
+// The largest relative difference of mean Rec. 709 luminance over blockSize x blockSize blocks (the last row and column
+// of blocks may be smaller): |a - g| / max(g, floor).
+double worstBlockLuminance(const Image& a, const Image& g, int blockSize, double floor) {
+    if (blockSize <= 0) return 0.0;
+    double worst = 0.0;
+    for (int by = 0; by < a.height; by += blockSize)
+        for (int bx = 0; bx < a.width; bx += blockSize) {
+            double la = 0.0, lg = 0.0;
+            int n = 0;
+            for (int y = by; y < std::min(by + blockSize, a.height); ++y)
+                for (int x = bx; x < std::min(bx + blockSize, a.width); ++x, ++n) {
+                    const float* p = a.at(x, y);
+                    const float* q = g.at(x, y);
+                    la += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                    lg += 0.2126 * q[0] + 0.7152 * q[1] + 0.0722 * q[2];
+                }
+            la /= n;
+            lg /= n;
+            worst = std::max(worst, std::fabs(la - lg) / std::max(lg, floor));
+        }
+    return worst;
 }
 
 // The plain (unweighted) p-th percentile of the per-pixel errors: the smallest error that at least p % of the pixels
@@ -164,7 +208,10 @@ int goldenCommand(const Args& args) {
     if (action != "check" && action != "accept") throw UserError(usage + ", got '" + action + "'");
 
     Context ctx(contextOptions(args));
-    const std::string deviceClassName = deviceClass(ctx);
+    // --class NAME reads the tolerances of another class of the manifest (e.g. "lavapipe-codegen", the bounds between
+    // two code generations of one CPU); the goldens stay the device class's unless --goldens names another folder.
+    const std::string actualClass = deviceClass(ctx);
+    const std::string deviceClassName = args.get("class", actualClass);
     const fs::path manifestFile = args.get("manifest", VITRINE_SOURCE_DIR "/tests/golden/manifest.json");
     Manifest manifest = readManifest(manifestFile, deviceClassName);
     std::vector<const GoldenCase*> selected;
@@ -179,9 +226,25 @@ int goldenCommand(const Args& args) {
         for (const GoldenCase& c : manifest.cases)
             selected.push_back(&c);
 
-    logInfo("device: " + ctx.deviceInfo().name + " (class " + deviceClassName + ")");
+    logInfo("device: " + ctx.deviceInfo().name + " (class " + actualClass + ", tolerances " + deviceClassName + ")");
     ShaderCompiler shaders;
-    const fs::path goldenDir = manifest.directory / deviceClassName;
+    const fs::path goldenDir = args.has("goldens") ? fs::path(args.get("goldens", "")) : manifest.directory / actualClass;
+    // --keep DIR: every image rendered by `check` is also written to DIR/<name>.exr, for a later `check --goldens DIR`
+    // (the code-generation test compares another code generation's renders with these).
+    const fs::path keepDir = args.get("keep", "");
+    if (!keepDir.empty()) {
+        std::error_code ec;
+        fs::create_directories(keepDir, ec);
+        if (ec) throw UserError(keepDir.string() + ": --keep: cannot create the folder: " + ec.message());
+    }
+    if (action == "check" && args.has("skip-missing") && !manifest.appliesTo.empty() &&
+        manifest.appliesTo != actualClass) {
+        const std::string message = "SKIPPED, NOT CHECKED: the tolerances " + deviceClassName + " apply to device class " +
+                                    manifest.appliesTo + ", this device is " + actualClass;
+        std::printf("%s\n", message.c_str());
+        logWarning(message);
+        return 77;
+    }
     if (action == "check" && args.has("skip-missing") && manifest.skipIfMissing && !fs::is_directory(goldenDir)) {
         // For test harnesses: a device class that never had goldens is skipped, not failed, and says so loudly.
         const std::string message = "SKIPPED, NOT CHECKED: no goldens for device class " + deviceClassName + " in " +
@@ -196,11 +259,25 @@ int goldenCommand(const Args& args) {
         std::vector<std::string> sets = c->sets;
         for (const std::string& s : args.all("set"))
             sets.push_back(s);
-        GraphDesc desc = loadGraph(c->graph, sets);
-        const std::string output = pickOutput(desc, c->output);
-        const uint32_t frames = desc.frame.frames;
-        Image actual = renderOutput(ctx, shaders, std::move(desc), output, frames, {frames - 1}, false).at(frames - 1);
         const fs::path goldenFile = goldenDir / (c->name + ".exr");
+        Image actual;
+        if (args.has("from")) {
+            // `check --from DIR`: DIR/<name>.exr (e.g. the goldens another machine or code generation accepted with
+            // --manifest) stands for the render, so the spread between two sets of renders is measured without
+            // rendering again.
+            const fs::path file = fs::path(args.get("from", "")) / (c->name + ".exr");
+            std::error_code ec;
+            if (!fs::exists(file, ec))
+                throw UserError(file.string() + ": --from: no image for '" + c->name + "'");
+            actual = loadExrLayer(file, "");
+        } else {
+            GraphDesc desc = loadGraph(c->graph, sets);
+            const std::string output = pickOutput(desc, c->output);
+            const uint32_t frames = desc.frame.frames;
+            actual = renderOutput(ctx, shaders, std::move(desc), output, frames, {frames - 1}, false).at(frames - 1);
+        }
+
+        if (!keepDir.empty() && !args.has("from")) writeExr(keepDir / (c->name + ".exr"), actual, ExrPixelType::Float);
 
         if (action == "accept") {
             std::error_code ec;
@@ -226,11 +303,16 @@ int goldenCommand(const Args& args) {
         const double mean = pair.metrics.flip.mean;
         const double pct = percentileOf(pair.flipErrorMap, c->tolerance.percentile);
         const double absDiff = meanAbsDifference(actual, golden);
-        const bool pass = mean <= c->tolerance.flipMean && pct <= c->tolerance.flipPercentile &&
-                          absDiff <= c->tolerance.meanAbsDiff;
-        std::printf("%s %s: FLIP mean %.6f (max %.6f), p%g %.6f (max %.6f), mean |diff| %.3g (max %.3g)\n",
-                    pass ? "ok  " : "FAIL", c->name.c_str(), mean, c->tolerance.flipMean, c->tolerance.percentile, pct,
-                    c->tolerance.flipPercentile, absDiff, c->tolerance.meanAbsDiff);
+        const Tolerance& t = c->tolerance;
+        const double block = worstBlockLuminance(actual, golden, t.blockSize, t.blockFloor);
+        const bool pass = mean <= t.flipMean && pct <= t.flipPercentile && absDiff <= t.meanAbsDiff &&
+                          block <= t.blockLuminance;
+        std::printf("%s %s: FLIP mean %.6f (max %.6f), p%g %.6f (max %.6f), mean |diff| %.3g (max %.3g)",
+                    pass ? "ok  " : "FAIL", c->name.c_str(), mean, t.flipMean, t.percentile, pct, t.flipPercentile,
+                    absDiff, t.meanAbsDiff);
+        if (t.blockSize > 0)
+            std::printf(", %dpx blocks' luminance %.4f (max %.4f)", t.blockSize, block, t.blockLuminance);
+        std::printf("\n");
         if (pass) continue;
         ++failures;
         if (!reports)

@@ -37,10 +37,14 @@ commands:
       FLIP error maps, metrics.json (PSNR, SSIM, FLIP; flicker and error per frame with
       --frames) and a self-contained report.html to DIR (default out/compare/A_vs_B).
       Files vitrine did not write there are not replaced without --force.
-  golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]...
+  golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]... [--from DIR]
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
-      `accept` (re)writes the golden EXRs, `check` compares with FLIP tolerances and writes
-      a heat map and report.html per failure into DIR (default golden-report). Exit 3: failed.
+      `accept` (re)writes the golden EXRs, `check` compares with FLIP, per-pixel and block
+      luminance tolerances and writes a heat map and report.html per failure into DIR
+      (default golden-report). Exit 3: failed. --from DIR: compare DIR/NAME.exr (renders kept
+      from another machine or code generation) instead of rendering; --keep DIR: also write each
+      render to DIR/NAME.exr; --goldens DIR: the goldens from DIR; --class NAME: that class's
+      tolerances (e.g. lavapipe-codegen).
       --skip-missing: exit 77 (skipped) when this device class has no goldens yet.
   export-scene museum|FILE OUT.glb [--seed N] [--texture-size N] [--force] [--strict]
       Write the procedural museum (or re-write a glTF file) as glTF binary for other tools.
@@ -88,7 +92,7 @@ int main(int argc, char** argv) {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
                                      "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm",
-                                     "jobs", "point", "collect", "devices",
+                                     "jobs", "point", "collect", "devices", "from", "keep", "goldens", "class",
                                      "partition", "time", "gpus-per-task", "sbatch-arg"},
                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
