@@ -3,5 +3,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@"
+# ccache (installed by install-deps) makes a second build of the same sources cheap, also from another clone:
+# paths are hashed relative to the checkout and the working directory is left out of the hash.
+launcher=()
+if command -v ccache >/dev/null; then
+    export CCACHE_BASEDIR="$(pwd)" CCACHE_NOHASHDIR=1
+    launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" "$@"
 cmake --build build -j "$(nproc)"

@@ -7,7 +7,7 @@
 set -euo pipefail
 
 packages=(
-    build-essential cmake ninja-build pkg-config git
+    build-essential cmake ninja-build pkg-config git ccache
     libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
     glslang-dev glslang-tools spirv-tools
     libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
