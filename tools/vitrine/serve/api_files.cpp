@@ -5,6 +5,7 @@
 #include "core/base/error.hpp"
 #include "core/base/json_text.hpp"
 #include "tools/vitrine/serve/http_util.hpp"
+#include "tools/vitrine/serve/sandbox.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -60,14 +61,6 @@ bool ifMatchAccepts(const std::string& header, const std::string& current) {
         if (item == "*" || item == current) return true;
     }
     return false;
-}
-
-bool isUnder(const fs::path& dir, const fs::path& path) {
-    auto d = dir.begin();
-    auto p = path.begin();
-    for (; d != dir.end(); ++d, ++p)
-        if (p == path.end() || *d != *p) return false;
-    return true;
 }
 
 const char* contentType(const std::string& extension) {
@@ -207,7 +200,7 @@ void Api::checkWritable(const fs::path& path, const std::string& shown) const {
     for (const fs::path& readOnly : mOptions.readOnlyDirs) {
         std::error_code ec;
         const fs::path canonical = fs::weakly_canonical(readOnly, ec);
-        if (!ec && isUnder(canonical, path))
+        if (!ec && isInside(canonical, path))
             throw HttpError(403, shown + ": refused: vitrine serve does not write the editor's own files",
                             {{"reason", "location"}});
     }

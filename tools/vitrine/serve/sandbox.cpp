@@ -20,14 +20,6 @@ fs::path canonicalOf(const fs::path& path) {
     return c;
 }
 
-bool isInside(const fs::path& root, const fs::path& canonical) {
-    auto r = root.begin();
-    auto c = canonical.begin();
-    for (; r != root.end(); ++r, ++c)
-        if (c == canonical.end() || *r != *c) return false;
-    return true;
-}
-
 // glTF URIs are URI references: %XX escapes decode to bytes before they name a file (as tinygltf does).
 std::string percentDecoded(const std::string& uri) {
     std::string out;
@@ -49,6 +41,14 @@ std::string lower(std::string s) {
 }
 
 } // namespace
+
+bool isInside(const fs::path& root, const fs::path& path) {
+    auto r = root.begin();
+    auto c = path.begin();
+    for (; r != root.end(); ++r, ++c)
+        if (c == path.end() || *r != *c) return false;
+    return true;
+}
 
 Sandbox::Sandbox(const fs::path& root) {
     std::error_code ec;

@@ -61,4 +61,7 @@ private:
     std::filesystem::path mRoot;
 };
 
+// Whether `path` is `root` or below it, component by component (both already canonical: nothing is resolved here).
+bool isInside(const std::filesystem::path& root, const std::filesystem::path& path);
+
 } // namespace vitrine::serve
