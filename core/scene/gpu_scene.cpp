@@ -64,7 +64,37 @@ GpuBvh& SceneObject::bvh(Context& ctx) {
 
 const StorageBufferSet& GpuScene::geometrySet() {
     if (!mGeometrySet) {
-        const VkBuffer buffers[2] = {mVertices.buffer(), mIndices.buffer()};
+        // The texel pool: every image once (textures may share one), in the layout of texelFetch's RGBA8 (r in
+        // the low byte), and per texture a uvec4 (first texel, width, height, bits: see scene.h TEXEL_*).
+        std::vector<uint32_t> imageStart(mScene.images.size(), ~0u);
+        std::vector<uint32_t> texels;
+        std::vector<std::array<uint32_t, 4>> table;
+        for (const scene::Texture& tex : mScene.textures) {
+            const scene::TextureImage& img = mScene.images[tex.image];
+            if (imageStart[tex.image] == ~0u) {
+                imageStart[tex.image] = static_cast<uint32_t>(texels.size());
+                texels.resize(texels.size() + static_cast<size_t>(img.width) * img.height);
+                std::memcpy(texels.data() + imageStart[tex.image], img.pixels.data(),
+                            static_cast<size_t>(img.width) * img.height * 4);
+            }
+            auto wrap = [](scene::Wrap w) {
+                return w == scene::Wrap::ClampToEdge ? VITRINE_TEXEL_CLAMP
+                       : w == scene::Wrap::MirroredRepeat ? VITRINE_TEXEL_MIRROR
+                                                          : VITRINE_TEXEL_REPEAT;
+            };
+            uint32_t bits = (tex.colorSpace() == scene::ColorSpace::Srgb ? VITRINE_TEXEL_SRGB : 0u) |
+                            (tex.sampler.magFilter == scene::Filter::Nearest ? VITRINE_TEXEL_NEAREST : 0u) |
+                            wrap(tex.sampler.wrapU) << VITRINE_TEXEL_WRAP_U_SHIFT |
+                            wrap(tex.sampler.wrapV) << VITRINE_TEXEL_WRAP_V_SHIFT;
+            table.push_back({imageStart[tex.image], img.width, img.height, bits});
+        }
+        if (table.empty()) table.push_back({0, 1, 1, 0});
+        if (texels.empty()) texels.push_back(0xffffffffu);
+        mTexelTable = uploadBuffer(mCtx, table.data(), table.size() * sizeof(table[0]), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                   mScene.name + ".texel_table");
+        mTexels = uploadBuffer(mCtx, texels.data(), texels.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                               mScene.name + ".texels");
+        const VkBuffer buffers[4] = {mVertices.buffer(), mIndices.buffer(), mTexelTable.buffer(), mTexels.buffer()};
         mGeometrySet = StorageBufferSet(mCtx, buffers, VK_SHADER_STAGE_COMPUTE_BIT, mScene.name + ".geometry");
     }
     return mGeometrySet;

@@ -100,7 +100,11 @@ public:
     const GpuBuffer& vertexBuffer() const { return mVertices; }
     const GpuBuffer& indexBuffer() const { return mIndices; }
     // Both as one descriptor set (binding 0 vertices, 1 indices; compute stage), made on first use: the
-    // VITRINE_GEOMETRY_SET of shaders/pathtrace/surface.glsl.
+    // VITRINE_GEOMETRY_SET of shaders/pathtrace/surface.glsl. Bindings 2 and 3 are the texel pool: level 0 of
+    // every texture as packed RGBA8 (binding 3) and a table of where each texture starts, its size, colour
+    // space and wrap modes (binding 2, uvec4 per texture; shaders/scene/scene.glsl VITRINE_SCENE_TEXEL_POOL).
+    // A ray tracer's invocations hit different textures; one buffer they all index replaces a walk over the
+    // sampler array, which costs one texture sample per scene texture on devices without non-uniform indexing.
     const StorageBufferSet& geometrySet();
     // Binds the vertex and index buffers. Then drawIndexed(cmd, draw) per draw.
     void bindGeometry(VkCommandBuffer cmd) const;
@@ -115,6 +119,7 @@ private:
     Context& mCtx;
     const scene::Scene& mScene;
     GpuBuffer mVertices, mIndices, mMaterials, mLayers, mInstances, mCamera;
+    GpuBuffer mTexelTable, mTexels; // the texel pool (geometrySet() bindings 2 and 3), made with the set
     StorageBufferSet mGeometrySet;
     std::vector<GpuImage> mTextures;       // one per scene texture
     std::vector<VkSampler> mSamplers;      // one per scene texture

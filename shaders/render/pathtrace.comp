@@ -9,6 +9,7 @@
 #define VITRINE_BVH_SET 1
 #define VITRINE_SCENE_SET 2
 #define VITRINE_GEOMETRY_SET 3
+#define VITRINE_SCENE_TEXEL_POOL // one buffer for all textures: no walk over the sampler array per sample
 #include "pathtrace/sampling.glsl"
 #include "pathtrace/surface.glsl"
 #include "render/pathtrace.h"

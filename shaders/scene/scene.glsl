@@ -45,11 +45,65 @@ UvGradients uvGradients(vec2 uv0, vec2 uv1) {
 #endif
 
 // The scene texture `index`. In a draw the index is the same for every invocation (dynamically uniform).
+#ifdef VITRINE_SCENE_TEXEL_POOL
+// The texel pool (GpuScene::geometrySet() bindings 2 and 3): level 0 of every texture in one buffer, which
+// invocations may index with different textures. Sampled as the samplers do at LOD 0 (zero gradients, so
+// the magnification filter): bilinear or nearest, the sampler's wrap modes, sRGB decoded before filtering.
+layout(set = VITRINE_GEOMETRY_SET, binding = 2, std430) readonly buffer SceneTexelTable { uvec4 sceneTexelTable[]; };
+layout(set = VITRINE_GEOMETRY_SET, binding = 3, std430) readonly buffer SceneTexels { uint sceneTexels[]; };
+
+// i modulo m in [0, m) (GLSL's % is undefined for negative operands).
+int texelModulo(int i, int m) {
+    int t = i - m * int(floor(float(i) / float(m)));
+    return t < 0 ? t + m : (t >= m ? t - m : t);
+}
+
+int texelWrap(int i, int size, uint mode) {
+    if (mode == VITRINE_TEXEL_CLAMP) return clamp(i, 0, size - 1);
+    if (mode == VITRINE_TEXEL_MIRROR) {
+        int t = texelModulo(i, 2 * size);
+        return t >= size ? 2 * size - 1 - t : t;
+    }
+    return texelModulo(i, size);
+}
+
+vec4 texelPoolFetch(uvec4 tex, int x, int y) {
+    vec4 c = unpackUnorm4x8(sceneTexels[tex.x + uint(y) * tex.y + uint(x)]);
+    if ((tex.w & VITRINE_TEXEL_SRGB) != 0u) {
+        vec3 lo = c.rgb / 12.92, hi = pow((c.rgb + 0.055) / 1.055, vec3(2.4));
+        c.rgb = mix(hi, lo, lessThanEqual(c.rgb, vec3(0.04045)));
+    }
+    return c;
+}
+
+vec4 texelPoolSample(int index, vec2 uv) {
+    uvec4 tex = sceneTexelTable[index];
+    ivec2 size = ivec2(tex.yz);
+    uint wrapU = (tex.w >> VITRINE_TEXEL_WRAP_U_SHIFT) & 3u, wrapV = (tex.w >> VITRINE_TEXEL_WRAP_V_SHIFT) & 3u;
+    vec2 st = uv * vec2(size);
+    if ((tex.w & VITRINE_TEXEL_NEAREST) != 0u) {
+        ivec2 i = ivec2(floor(st));
+        return texelPoolFetch(tex, texelWrap(i.x, size.x, wrapU), texelWrap(i.y, size.y, wrapV));
+    }
+    st -= 0.5;
+    vec2 f = fract(st);
+    ivec2 i0 = ivec2(floor(st));
+    int x0 = texelWrap(i0.x, size.x, wrapU), x1 = texelWrap(i0.x + 1, size.x, wrapU);
+    int y0 = texelWrap(i0.y, size.y, wrapV), y1 = texelWrap(i0.y + 1, size.y, wrapV);
+    vec4 top = mix(texelPoolFetch(tex, x0, y0), texelPoolFetch(tex, x1, y0), f.x);
+    vec4 bottom = mix(texelPoolFetch(tex, x0, y1), texelPoolFetch(tex, x1, y1), f.x);
+    return mix(top, bottom, f.y);
+}
+#endif
+
 // A ray tracer's invocations hit different materials, and without descriptor indexing (lavapipe has no
 // shaderSampledImageArrayNonUniformIndexing) an array of samplers may only be indexed with a dynamically
-// uniform value: VITRINE_SCENE_DIVERGENT_TEXTURES walks the array with a loop index, which is uniform.
+// uniform value: VITRINE_SCENE_DIVERGENT_TEXTURES walks the array with a loop index, which is uniform
+// (one sample per scene texture); VITRINE_SCENE_TEXEL_POOL samples the texel pool instead, at LOD 0 only.
 vec4 sceneTexture(int index, vec2 uv, vec2 ddx, vec2 ddy) {
-#ifdef VITRINE_SCENE_DIVERGENT_TEXTURES
+#if defined(VITRINE_SCENE_TEXEL_POOL)
+    return texelPoolSample(index, uv);
+#elif defined(VITRINE_SCENE_DIVERGENT_TEXTURES)
     vec4 texel = vec4(0.0);
     for (int t = 0; t < VITRINE_SCENE_TEXTURES; ++t)
         if (t == index) texel = textureGrad(sceneTextures[t], uv, ddx, ddy);

@@ -30,6 +30,15 @@ struct GpuTexRef {
 #define VITRINE_REF_CAVITY 4
 #define VITRINE_REF_MASK 5
 
+// The texel pool's per-texture bits (GpuScene::geometrySet() binding 2, w), for ray tracers' texture sampling.
+#define VITRINE_TEXEL_SRGB 1u    // colour: decode sRGB per texel before filtering, as an _SRGB image view does
+#define VITRINE_TEXEL_NEAREST 2u // magnification filter nearest (else linear)
+#define VITRINE_TEXEL_REPEAT 0u  // wrap modes, 2 bits each
+#define VITRINE_TEXEL_CLAMP 1u
+#define VITRINE_TEXEL_MIRROR 2u
+#define VITRINE_TEXEL_WRAP_U_SHIFT 2u
+#define VITRINE_TEXEL_WRAP_V_SHIFT 4u
+
 struct GpuLayer {
     vec4 albedo;   // factor (linear rgb, a = coverage)
     vec4 scalars0; // normal scale, shininess factor, shininess atZero, metallic factor
