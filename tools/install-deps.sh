@@ -10,7 +10,7 @@ packages=(
     build-essential cmake ninja-build pkg-config git ccache
     libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
     glslang-dev glslang-tools spirv-tools
-    libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
+    libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev libembree-dev
     libopenexr-dev libimath-dev libopencolorio-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     python3-jsonschema

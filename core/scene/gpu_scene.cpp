@@ -64,32 +64,9 @@ GpuBvh& SceneObject::bvh(Context& ctx) {
 
 const StorageBufferSet& GpuScene::geometrySet() {
     if (!mGeometrySet) {
-        // The texel pool: every image once (textures may share one), in the layout of texelFetch's RGBA8 (r in
-        // the low byte), and per texture a uvec4 (first texel, width, height, bits: see scene.h TEXEL_*).
-        std::vector<uint32_t> imageStart(mScene.images.size(), ~0u);
-        std::vector<uint32_t> texels;
-        std::vector<std::array<uint32_t, 4>> table;
-        for (const scene::Texture& tex : mScene.textures) {
-            const scene::TextureImage& img = mScene.images[tex.image];
-            if (imageStart[tex.image] == ~0u) {
-                imageStart[tex.image] = static_cast<uint32_t>(texels.size());
-                texels.resize(texels.size() + static_cast<size_t>(img.width) * img.height);
-                std::memcpy(texels.data() + imageStart[tex.image], img.pixels.data(),
-                            static_cast<size_t>(img.width) * img.height * 4);
-            }
-            auto wrap = [](scene::Wrap w) {
-                return w == scene::Wrap::ClampToEdge ? VITRINE_TEXEL_CLAMP
-                       : w == scene::Wrap::MirroredRepeat ? VITRINE_TEXEL_MIRROR
-                                                          : VITRINE_TEXEL_REPEAT;
-            };
-            uint32_t bits = (tex.colorSpace() == scene::ColorSpace::Srgb ? VITRINE_TEXEL_SRGB : 0u) |
-                            (tex.sampler.magFilter == scene::Filter::Nearest ? VITRINE_TEXEL_NEAREST : 0u) |
-                            wrap(tex.sampler.wrapU) << VITRINE_TEXEL_WRAP_U_SHIFT |
-                            wrap(tex.sampler.wrapV) << VITRINE_TEXEL_WRAP_V_SHIFT;
-            table.push_back({imageStart[tex.image], img.width, img.height, bits});
-        }
-        if (table.empty()) table.push_back({0, 1, 1, 0});
-        if (texels.empty()) texels.push_back(0xffffffffu);
+        const TexelPool pool = packTexelPool(mScene);
+        const auto& table = pool.table;
+        const auto& texels = pool.texels;
         mTexelTable = uploadBuffer(mCtx, table.data(), table.size() * sizeof(table[0]), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                    mScene.name + ".texel_table");
         mTexels = uploadBuffer(mCtx, texels.data(), texels.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
@@ -133,6 +110,67 @@ uint32_t mipCount(uint32_t w, uint32_t h) {
 
 } // namespace
 
+void packMaterials(const scene::Scene& scene, std::vector<GpuMaterial>& materials, std::vector<GpuLayer>& layers) {
+    materials.clear();
+    layers.clear();
+    for (const scene::Material& m : scene.materials) {
+        GpuMaterial g{};
+        g.info = {static_cast<uint32_t>(layers.size()), static_cast<uint32_t>(m.layers.size()),
+                  static_cast<uint32_t>(m.alphaMode), m.doubleSided ? 1u : 0u};
+        g.emissive = glm::vec4(m.emissiveFactor * m.emissiveStrength, m.alphaCutoff);
+        g.emissiveRef = texRef(m.emissiveTexture);
+        float r = m.ior == 0.0f ? 1.0f : (m.ior - 1.0f) / (m.ior + 1.0f); // KHR_materials_ior: 0 means F0 = 1
+        g.optics = {m.transmission, r * r, m.unlit ? 1.0f : 0.0f, 0.0f};
+        materials.push_back(g);
+        for (size_t li = 0; li < m.layers.size(); ++li) {
+            const scene::MaterialLayer& l = m.layers[li];
+            GpuLayer gl{};
+            gl.albedo = l.albedo.factor;
+            gl.scalars0 = {l.normal.scale, l.shininess.factor, l.shininess.atZero, l.metallic.factor};
+            gl.scalars1 = {l.metallic.atZero, l.cavity.factor, l.cavity.atZero, li == 0 ? 1.0f : l.mask.factor};
+            gl.bits = {li == 0 ? scene::kLayerAll : l.overrides, 0u, 0u, 0u};
+            gl.refs[VITRINE_REF_ALBEDO] = texRef(l.albedo.texture);
+            gl.refs[VITRINE_REF_NORMAL] = texRef(l.normal.texture);
+            gl.refs[VITRINE_REF_SHININESS] = texRef(l.shininess.texture, l.shininess.channel);
+            gl.refs[VITRINE_REF_METALLIC] = texRef(l.metallic.texture, l.metallic.channel);
+            gl.refs[VITRINE_REF_CAVITY] = texRef(l.cavity.texture, l.cavity.channel);
+            gl.refs[VITRINE_REF_MASK] = li == 0 ? texRef({}) : texRef(l.mask.texture, l.mask.channel);
+            layers.push_back(gl);
+        }
+    }
+}
+
+TexelPool packTexelPool(const scene::Scene& scene) {
+    TexelPool pool;
+    auto& texels = pool.texels;
+    auto& table = pool.table;
+    // The texel pool: every image once (textures may share one), in the layout of texelFetch's RGBA8 (r in
+    // the low byte), and per texture a uvec4 (first texel, width, height, bits: see scene.h TEXEL_*).
+    std::vector<uint32_t> imageStart(scene.images.size(), ~0u);
+    for (const scene::Texture& tex : scene.textures) {
+        const scene::TextureImage& img = scene.images[tex.image];
+        if (imageStart[tex.image] == ~0u) {
+            imageStart[tex.image] = static_cast<uint32_t>(texels.size());
+            texels.resize(texels.size() + static_cast<size_t>(img.width) * img.height);
+            std::memcpy(texels.data() + imageStart[tex.image], img.pixels.data(),
+                        static_cast<size_t>(img.width) * img.height * 4);
+        }
+        auto wrap = [](scene::Wrap w) {
+            return w == scene::Wrap::ClampToEdge ? VITRINE_TEXEL_CLAMP
+                   : w == scene::Wrap::MirroredRepeat ? VITRINE_TEXEL_MIRROR
+                                                      : VITRINE_TEXEL_REPEAT;
+        };
+        uint32_t bits = (tex.colorSpace() == scene::ColorSpace::Srgb ? VITRINE_TEXEL_SRGB : 0u) |
+                        (tex.sampler.magFilter == scene::Filter::Nearest ? VITRINE_TEXEL_NEAREST : 0u) |
+                        wrap(tex.sampler.wrapU) << VITRINE_TEXEL_WRAP_U_SHIFT |
+                        wrap(tex.sampler.wrapV) << VITRINE_TEXEL_WRAP_V_SHIFT;
+        table.push_back({imageStart[tex.image], img.width, img.height, bits});
+    }
+    if (table.empty()) table.push_back({0, 1, 1, 0});
+    if (texels.empty()) texels.push_back(0xffffffffu);
+    return pool;
+}
+
 GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& scene, float anisotropy)
     : mCtx(ctx), mScene(scene), mAnisotropy(anisotropy) {
     auto start = Clock::now();
@@ -147,31 +185,7 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
 
         std::vector<GpuMaterial> materials;
         std::vector<GpuLayer> layers;
-        for (const scene::Material& m : scene.materials) {
-            GpuMaterial g{};
-            g.info = {static_cast<uint32_t>(layers.size()), static_cast<uint32_t>(m.layers.size()),
-                      static_cast<uint32_t>(m.alphaMode), m.doubleSided ? 1u : 0u};
-            g.emissive = glm::vec4(m.emissiveFactor * m.emissiveStrength, m.alphaCutoff);
-            g.emissiveRef = texRef(m.emissiveTexture);
-            float r = m.ior == 0.0f ? 1.0f : (m.ior - 1.0f) / (m.ior + 1.0f); // KHR_materials_ior: 0 means F0 = 1
-            g.optics = {m.transmission, r * r, m.unlit ? 1.0f : 0.0f, 0.0f};
-            materials.push_back(g);
-            for (size_t li = 0; li < m.layers.size(); ++li) {
-                const scene::MaterialLayer& l = m.layers[li];
-                GpuLayer gl{};
-                gl.albedo = l.albedo.factor;
-                gl.scalars0 = {l.normal.scale, l.shininess.factor, l.shininess.atZero, l.metallic.factor};
-                gl.scalars1 = {l.metallic.atZero, l.cavity.factor, l.cavity.atZero, li == 0 ? 1.0f : l.mask.factor};
-                gl.bits = {li == 0 ? scene::kLayerAll : l.overrides, 0u, 0u, 0u};
-                gl.refs[VITRINE_REF_ALBEDO] = texRef(l.albedo.texture);
-                gl.refs[VITRINE_REF_NORMAL] = texRef(l.normal.texture);
-                gl.refs[VITRINE_REF_SHININESS] = texRef(l.shininess.texture, l.shininess.channel);
-                gl.refs[VITRINE_REF_METALLIC] = texRef(l.metallic.texture, l.metallic.channel);
-                gl.refs[VITRINE_REF_CAVITY] = texRef(l.cavity.texture, l.cavity.channel);
-                gl.refs[VITRINE_REF_MASK] = li == 0 ? texRef({}) : texRef(l.mask.texture, l.mask.channel);
-                layers.push_back(gl);
-            }
-        }
+        packMaterials(scene, materials, layers);
         mMaterials = uploadBuffer(ctx, materials.data(), materials.size() * sizeof(GpuMaterial),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".materials");
         mLayers = uploadBuffer(ctx, layers.data(), layers.size() * sizeof(GpuLayer), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,

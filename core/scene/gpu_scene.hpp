@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -69,6 +70,20 @@ struct GpuSceneStats {
 // Vertex/index buffers, layered materials, textures with mips (normal maps: Toksvig mips built on the
 // GPU without renormalising), per-frame instance and camera buffers, and the descriptor set over all of
 // them. Everything but the per-frame buffers is uploaded once, in the constructor (waits for the GPU).
+// The scene's layered materials as the GPU reads them (scene.h GpuMaterial / GpuLayer); also what the CPU path
+// tracer evaluates, so both read one description.
+void packMaterials(const scene::Scene& scene, std::vector<gpu_types::GpuMaterial>& materials,
+                   std::vector<gpu_types::GpuLayer>& layers);
+
+// Level 0 of every texture as packed RGBA8 texels (r in the low byte) and per texture a uvec4 (first texel, width,
+// height, VITRINE_TEXEL_* bits): what ray tracers sample (shaders/scene/scene.glsl VITRINE_SCENE_TEXEL_POOL and the
+// CPU path tracer). At least one entry in each.
+struct TexelPool {
+    std::vector<std::array<uint32_t, 4>> table;
+    std::vector<uint32_t> texels;
+};
+TexelPool packTexelPool(const scene::Scene& scene);
+
 class GpuScene {
 public:
     // anisotropy: max anisotropic filtering of the textures; < 0 chooses per device.

@@ -1,6 +1,8 @@
 // render.pathtrace: progressive path-traced reference of the scene camera (shaders/render/pathtrace.comp).
 #include "shaders/render/pathtrace.h"
+#include "nodes/render/pathtrace_cpu.hpp"
 #include "core/accel/gpu_bvh.hpp"
+#include "core/gpu/buffer_set.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/transfer.hpp"
@@ -13,6 +15,8 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+
+#include <time.h>
 
 namespace vitrine {
 namespace {
@@ -50,6 +54,9 @@ NodeSchema schema() {
         tex("history", "This node's color@prev (without it nothing accumulates across frames)", true),
         tex("history_stats", "This node's stats@prev", true),
     };
+    // The CPU tracer reads the sky back once a frame.
+    for (InputPort& in : s.inputs)
+        if (in.name == "sky" || in.name == "sky_sh" || in.name == "env_cdf") in.readBack = true;
     OutputPort color;
     color.name = "color";
     color.format = VK_FORMAT_R32G32B32A32_SFLOAT;
@@ -120,6 +127,15 @@ NodeSchema schema() {
          2147483647.0,
          {},
          "Random sequence (independent estimates for noise measurements)"},
+        {"backend",
+         ParamType::Enum,
+         "auto",
+         {},
+         {},
+         {"auto", "gpu", "cpu"},
+         "Where paths are traced: gpu (shaders/render/pathtrace.comp), cpu (nodes/render/pathtrace_cpu.cpp: the same "
+         "estimator, materials and BRDF through Embree on every core, about 10x the paths per second of lavapipe), "
+         "auto: cpu when the Vulkan device is a CPU (lavapipe), else gpu"},
     };
     return s;
 }
@@ -135,9 +151,19 @@ public:
         size_t textures = std::max<size_t>(1, mScene->scene().textures.size());
         mPipeline =
             ctx.computePipeline("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 3);
+        mStorePipeline = ctx.computePipeline("render/pathtrace_store.comp", {}, 1);
     }
 
     void execute(ExecuteContext& ctx) override {
+        const std::string backend = ctx.params().getString("backend");
+        const bool cpu = backend == "cpu" ||
+                         (backend == "auto" && ctx.gpu().deviceInfo().type == VK_PHYSICAL_DEVICE_TYPE_CPU);
+        if (cpu) executeCpu(ctx);
+        else executeGpu(ctx);
+    }
+
+private:
+    void executeGpu(ExecuteContext& ctx) {
         GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
         GpuBvh& bvh = mScene->bvh(ctx.gpu());
         const StorageBufferSet& geometry = gpu.geometrySet();
@@ -159,6 +185,7 @@ public:
         const uint32_t spp = static_cast<uint32_t>(p.getInt("spp"));
         const ImageDesc& out = ctx.output("color").desc();
         const auto start = std::chrono::steady_clock::now();
+        const double cpuStart = processCpuSeconds();
         const bool report = p.getBool("report");
         const uint32_t chunks = (spp + PATHTRACE_SAMPLES_PER_DISPATCH - 1) / PATHTRACE_SAMPLES_PER_DISPATCH;
         const uint32_t every = std::max(1u, chunks / 10);
@@ -182,25 +209,113 @@ public:
                 bar->advance(every);
             }
         }
-        if (report) reportFrame(ctx, start);
+        if (report) reportFrame(ctx, start, cpuStart, static_cast<double>(out.width) * out.height * spp);
     }
 
-private:
-    // Waits for the frame, then prints the samples per pixel since the restart, the frame's time and the median
-    // (and 90th percentile) of the per-pixel standard error relative to the pixel's mean luminance.
-    void reportFrame(ExecuteContext& ctx, std::chrono::steady_clock::time_point start) {
-        ctx.splitSubmission();
+    // The sky nodes' outputs, read back for the CPU tracer (they were computed earlier in this frame).
+    CpuSky readSky(ExecuteContext& ctx) {
+        CpuSky sky;
+        const GpuImage& cube = ctx.input("sky");
+        sky.size = static_cast<int>(cube.desc().width);
+        for (uint32_t face = 0; face < 6; ++face)
+            sky.faces.push_back(readImage(ctx.gpu(), cube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
+        const Image sh = readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        sky.sunIlluminance = glm::vec3(sh.at(9, 0)[0], sh.at(9, 0)[1], sh.at(9, 0)[2]);
+        sky.sunDirection = glm::vec3(sh.at(10, 0)[0], sh.at(10, 0)[1], sh.at(10, 0)[2]);
+        if (ctx.hasInput("env_cdf"))
+            sky.envCdf = readImage(ctx.gpu(), ctx.input("env_cdf"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        return sky;
+    }
+
+    void executeCpu(ExecuteContext& ctx) {
+        const Params& p = ctx.params();
+        const CameraFrame& cam = mCamera->current;
+        const bool posed = mCpu && mScene->pose.instanceWorld == mCpuPose;
+        bool moved = cam.viewProjNoJitter != mLastViewProj || !posed;
+        bool reset = !ctx.hasInput("history") || !ctx.inputValid("history") || moved;
+        mLastViewProj = cam.viewProjNoJitter;
+        const auto start = std::chrono::steady_clock::now();
+
+        ctx.splitSubmission(); // the sky nodes' work of this frame is done before it is read back
+        const CpuSky sky = readSky(ctx);
+        if (!posed) {
+            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld);
+            mCpuPose = mScene->pose.instanceWorld;
+        }
+        const ImageDesc& out = ctx.output("color").desc();
+        if (reset || mAccumulation.width != static_cast<int>(out.width) ||
+            mAccumulation.height != static_cast<int>(out.height))
+            mAccumulation.reset(static_cast<int>(out.width), static_cast<int>(out.height));
+
+        CpuTraceSettings s;
+        s.invViewProj = glm::inverse(cam.viewProjNoJitter);
+        s.cameraPos = cam.state.position;
+        s.width = static_cast<int>(out.width);
+        s.height = static_cast<int>(out.height);
+        s.spp = static_cast<uint32_t>(p.getInt("spp"));
+        s.maxBounces = static_cast<uint32_t>(p.getInt("max_bounces"));
+        s.seed = (ctx.frameIndex() * 0x9E3779B9u) ^ (static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu);
+        s.sunScale = p.getFloat("sun_scale");
+        s.skyScale = p.getFloat("sky_scale");
+        s.emissiveScale = p.getFloat("emissive_scale");
+        s.antialias = p.getBool("antialias");
+        s.envSampling = ctx.hasInput("env_cdf");
+
+        const bool report = p.getBool("report");
+        std::unique_ptr<Progress> bar;
+        size_t shown = 0;
+        std::function<void(double)> progress;
+        if (report) {
+            bar = std::make_unique<Progress>("path tracing " + std::to_string(out.width) + "x" +
+                                                 std::to_string(out.height) + " at " + std::to_string(s.spp) +
+                                                 " spp on the CPU",
+                                             100);
+            progress = [&](double done) {
+                size_t now = static_cast<size_t>(done * 100.0);
+                if (now > shown) bar->advance(now - shown);
+                shown = std::max(shown, now);
+            };
+        }
+        const CpuTraceCounters counters = mCpu->trace(s, sky, mAccumulation, progress);
+        bar.reset();
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const Image stats = readImage(ctx.gpu(), ctx.output("stats"), VK_IMAGE_LAYOUT_GENERAL);
-        std::vector<float> relative;
-        relative.reserve(static_cast<size_t>(stats.width) * stats.height);
-        float samples = 0.0f;
-        for (int y = 0; y < stats.height; ++y)
-            for (int x = 0; x < stats.width; ++x) {
-                const float* s = stats.at(x, y);
-                samples = std::max(samples, s[0]);
-                if (s[1] > 0.0f) relative.push_back(s[3] / s[1]);
+        mLastPathsPerSecond = static_cast<double>(counters.paths) / std::max(counters.seconds, 1e-9);
+        mLastRaysPerSecond = static_cast<double>(counters.rays) / std::max(counters.seconds, 1e-9);
+        mLastPathsPerCpuSecond = static_cast<double>(counters.paths) / std::max(counters.cpuSeconds, 1e-9);
+
+        // Into the outputs through a host-visible buffer and a copy shader (the outputs stay storage images).
+        const size_t bytes = mAccumulation.color.size() * 2 * sizeof(glm::vec4);
+        if (!mStoreBuffer || mStoreBuffer.size() < bytes) {
+            mStoreSet = StorageBufferSet();
+            mStoreBuffer = GpuBuffer(ctx.gpu(), bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "pathtrace.cpu_result");
+            const VkBuffer buffers[1] = {mStoreBuffer.buffer()};
+            mStoreSet = StorageBufferSet(ctx.gpu(), buffers, VK_SHADER_STAGE_COMPUTE_BIT, "pathtrace.cpu_result");
+        }
+        auto* dst = static_cast<glm::vec4*>(mStoreBuffer.mapped());
+        for (size_t i = 0; i < mAccumulation.color.size(); ++i) {
+            dst[2 * i] = mAccumulation.color[i];
+            dst[2 * i + 1] = mAccumulation.stats[i];
+        }
+        const glm::uvec4 push(out.width, out.height, 0u, 0u);
+        std::array<VkDescriptorSetLayout, 1> layouts = {mStoreSet.layout()};
+        std::array<VkDescriptorSet, 1> sets = {mStoreSet.set()};
+        ctx.dispatchWithSets(mStorePipeline, &push, sizeof(push), out.width, out.height, layouts, sets);
+
+        if (report) {
+            std::vector<float> relative;
+            float samples = 0.0f;
+            for (const glm::vec4& st : mAccumulation.stats) {
+                samples = std::max(samples, st.x);
+                if (st.y > 0.0f) relative.push_back(st.w / st.y);
             }
+            char rate[200];
+            std::snprintf(rate, sizeof rate, "; CPU tracer: %.0f paths/s, %.2f Mrays/s (%.0f paths per CPU-second)",
+                          mLastPathsPerSecond, mLastRaysPerSecond * 1e-6, mLastPathsPerCpuSecond);
+            logInfo(summaryLine(samples, seconds, relative) + rate);
+        }
+    }
+
+    static std::string summaryLine(float samples, double seconds, std::vector<float>& relative) {
         std::string noise = "no lit pixel";
         if (!relative.empty()) {
             auto at = [&](double q) {
@@ -215,16 +330,48 @@ private:
         }
         char line[160];
         std::snprintf(line, sizeof line, "render.pathtrace: %.0f spp accumulated, frame %.1f s; ", samples, seconds);
-        logInfo(line + noise);
+        return line + noise;
     }
 
-public:
+    // Waits for the frame, then prints the samples per pixel since the restart, the frame's time and the median
+    // (and 90th percentile) of the per-pixel standard error relative to the pixel's mean luminance.
+    void reportFrame(ExecuteContext& ctx, std::chrono::steady_clock::time_point start, double cpuStart, double paths) {
+        ctx.splitSubmission();
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double cpuSeconds = processCpuSeconds() - cpuStart;
+        const Image stats = readImage(ctx.gpu(), ctx.output("stats"), VK_IMAGE_LAYOUT_GENERAL);
+        std::vector<float> relative;
+        relative.reserve(static_cast<size_t>(stats.width) * stats.height);
+        float samples = 0.0f;
+        for (int y = 0; y < stats.height; ++y)
+            for (int x = 0; x < stats.width; ++x) {
+                const float* s = stats.at(x, y);
+                samples = std::max(samples, s[0]);
+                if (s[1] > 0.0f) relative.push_back(s[3] / s[1]);
+            }
+        char rate[160];
+        std::snprintf(rate, sizeof rate, "; %.0f paths/s (%.0f paths per CPU-second of this process)",
+                      paths / std::max(seconds, 1e-9), paths / std::max(cpuSeconds, 1e-9));
+        logInfo(summaryLine(samples, seconds, relative) + rate);
+    }
 
-private:
+    static double processCpuSeconds() {
+        timespec t{};
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+    }
+
     std::shared_ptr<SceneObject> mScene;
     std::shared_ptr<CameraObject> mCamera;
-    PipelineId mPipeline = 0;
+    PipelineId mPipeline = 0, mStorePipeline = 0;
     glm::mat4 mLastViewProj{0.0f};
+    // The CPU tracer: its Embree scene (of the pose it was built at), its accumulation and the result buffer.
+    std::unique_ptr<CpuPathTracer> mCpu;
+    std::vector<glm::mat4> mCpuPose;
+    CpuAccumulation mAccumulation;
+    GpuBuffer mStoreBuffer;
+    StorageBufferSet mStoreSet;
+    double mLastPathsPerSecond = 0.0, mLastRaysPerSecond = 0.0, mLastPathsPerCpuSecond = 0.0;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Pathtrace>(); });

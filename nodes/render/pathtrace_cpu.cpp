@@ -1,0 +1,714 @@
+// render.pathtrace's CPU tracer (see pathtrace_cpu.hpp). The functions below mirror, in order and by name,
+// shaders/pathtrace/sampling.glsl, shaders/scene/scene.glsl (evaluateLayers, texel pool), shaders/pathtrace/
+// surface.glsl and shaders/render/pathtrace.comp; the BRDF is core/shading's, the CPU mirror of common/brdf.glsl.
+#include "nodes/render/pathtrace_cpu.hpp"
+
+#include "core/base/error.hpp"
+#include "core/scene/gpu_scene.hpp"
+#include "core/shading/brdf.hpp"
+#include "shaders/scene/scene.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include <time.h>
+
+namespace vitrine {
+
+using gpu_types::GpuLayer;
+using gpu_types::GpuMaterial;
+using gpu_types::GpuTexRef;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+using namespace shading;
+
+void CpuAccumulation::reset(int w, int h) {
+    width = w;
+    height = h;
+    color.assign(static_cast<size_t>(w) * h, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    stats.assign(static_cast<size_t>(w) * h, glm::vec4(0.0f));
+}
+
+bool cpuPathTracerAvailable() { return true; }
+
+namespace {
+
+constexpr float kInfinity = 3.4e38f;
+
+float luminance(vec3 c) { return glm::dot(c, vec3(0.2126f, 0.7152f, 0.0722f)); }
+
+// --- sampling.glsl ---
+uint32_t pcgHash(uint32_t v) {
+    uint32_t state = v * 747796405u + 2891336453u;
+    uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+uint32_t rngSeed(glm::uvec2 pixel, uint32_t frame, uint32_t sampleIndex) {
+    return pcgHash(pixel.x ^ pcgHash(pixel.y ^ pcgHash(frame ^ pcgHash(sampleIndex))));
+}
+float rngNext(uint32_t& state) {
+    state = state * 747796405u + 2891336453u;
+    uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return static_cast<float>(((word >> 22u) ^ word) >> 8u) * (1.0f / 16777216.0f);
+}
+vec2 rngNext2(uint32_t& state) {
+    float a = rngNext(state);
+    return vec2(a, rngNext(state));
+}
+
+glm::mat3 basisAround(vec3 n) {
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z);
+    float b = n.x * n.y * a;
+    vec3 t(1.0f + s * n.x * n.x * a, s * b, -s * n.x);
+    vec3 bt(b, s + n.y * n.y * a, -n.y);
+    return glm::mat3(t, bt, n);
+}
+
+vec3 sampleCosine(vec2 u) {
+    float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+    return vec3(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x)));
+}
+
+vec3 sampleUniformSphere(vec2 u) {
+    float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.0f * kPi * u.y;
+    return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+
+vec3 sampleGgxVndf(vec3 v, float alpha, vec2 u) {
+    vec3 vh = glm::normalize(vec3(alpha * v.x, alpha * v.y, v.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0f ? vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : vec3(1.0f, 0.0f, 0.0f);
+    vec3 t2 = glm::cross(vh, t1);
+    float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
+    float p1 = r * std::cos(phi), p2 = r * std::sin(phi);
+    float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
+    vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+    return glm::normalize(vec3(alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)));
+}
+
+float ggxVndfPdf(float NoV, float NoH, float alpha) {
+    float a2 = alpha * alpha;
+    return ggxD(NoH, alpha) / (2.0f * (NoV + std::sqrt(a2 + (1.0f - a2) * NoV * NoV)));
+}
+
+struct BrdfLobes {
+    vec3 baseColor;
+    float metallic;
+    float roughness;
+    float specularProbability;
+};
+
+BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, float NoV) {
+    BrdfLobes b;
+    b.baseColor = baseColor;
+    b.metallic = metallic;
+    b.roughness = roughness;
+    float s = luminance(schlickFresnel(specularF0(baseColor, metallic), NoV));
+    float d = luminance(diffuseAlbedo(baseColor, metallic));
+    b.specularProbability = std::max(s / std::max(s + d, 1e-6f), 0.1f);
+    return b;
+}
+
+float brdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
+    float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return 0.0f;
+    vec3 h = glm::normalize(v + l);
+    float spec = ggxVndfPdf(NoV, std::clamp(glm::dot(n, h), 0.0f, 1.0f), ggxAlpha(b.roughness));
+    return b.specularProbability * spec + (1.0f - b.specularProbability) * NoL / kPi;
+}
+
+bool sampleBrdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 u, vec3& l) {
+    glm::mat3 frame = basisAround(n);
+    if (u.x < b.specularProbability) {
+        vec3 vl = glm::transpose(frame) * v;
+        vec3 h = frame * sampleGgxVndf(vl, ggxAlpha(b.roughness), vec2(u.y, u.z));
+        l = glm::reflect(-v, h);
+    } else {
+        l = frame * sampleCosine(vec2(u.y, u.z));
+    }
+    return glm::dot(n, l) > 0.0f;
+}
+
+float powerHeuristic(float a, float b) {
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+// --- common/cubemap.glsl ---
+vec3 cubeDirection(uint32_t face, vec2 uv) {
+    switch (face) {
+    case 0u: return vec3(1.0f, -uv.y, -uv.x);
+    case 1u: return vec3(-1.0f, -uv.y, uv.x);
+    case 2u: return vec3(uv.x, 1.0f, uv.y);
+    case 3u: return vec3(uv.x, -1.0f, -uv.y);
+    case 4u: return vec3(uv.x, -uv.y, 1.0f);
+    default: return vec3(-uv.x, -uv.y, -1.0f);
+    }
+}
+
+uint32_t cubeFace(vec3 d, vec2& uv) {
+    vec3 a = glm::abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        uv = d.x > 0.0f ? vec2(-d.z, -d.y) / a.x : vec2(d.z, -d.y) / a.x;
+        return d.x > 0.0f ? 0u : 1u;
+    }
+    if (a.y >= a.z) {
+        uv = d.y > 0.0f ? vec2(d.x, d.z) / a.y : vec2(d.x, -d.z) / a.y;
+        return d.y > 0.0f ? 2u : 3u;
+    }
+    uv = d.z > 0.0f ? vec2(d.x, -d.y) / a.z : vec2(-d.x, -d.y) / a.z;
+    return d.z > 0.0f ? 4u : 5u;
+}
+
+// --- the environment: sky cube map (bilinear at LOD 0 within a face, edges clamped) and sky.env_cdf ---
+constexpr float kEnvUniform = 0.1f;
+
+struct Env {
+    const CpuSky* sky = nullptr;
+    float scale = 1.0f;
+
+    vec3 radiance(vec3 d) const {
+        vec2 uv;
+        uint32_t face = cubeFace(d, uv);
+        const Image& img = sky->faces[face];
+        float x = (uv.x * 0.5f + 0.5f) * static_cast<float>(img.width) - 0.5f;
+        float y = (uv.y * 0.5f + 0.5f) * static_cast<float>(img.height) - 0.5f;
+        int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+        float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+        auto at = [&](int tx, int ty) {
+            const float* p = img.at(std::clamp(tx, 0, img.width - 1), std::clamp(ty, 0, img.height - 1));
+            return vec3(p[0], p[1], p[2]);
+        };
+        vec3 top = glm::mix(at(x0, y0), at(x0 + 1, y0), fx), bottom = glm::mix(at(x0, y0 + 1), at(x0 + 1, y0 + 1), fx);
+        return glm::mix(top, bottom, fy) * scale;
+    }
+
+    float cdf(int x, int row) const { return x < 0 || row < 0 ? 0.0f : sky->envCdf.at(x, row)[0]; }
+    float total() const { return sky->envCdf.empty() ? 0.0f : sky->envCdf.at(0, 6 * sky->size)[0]; }
+
+    float texelPdf(int x, int row, vec2 uv) const {
+        int size = sky->size;
+        float pRow = cdf(size, row) - cdf(size, row - 1);
+        float pX = cdf(x, row) - cdf(x - 1, row);
+        float texelArea = 4.0f / static_cast<float>(size * size);
+        float r2 = 1.0f + glm::dot(uv, uv);
+        return pRow * pX / texelArea * r2 * std::sqrt(r2);
+    }
+
+    float pdf(vec3 d) const {
+        int size = sky->size;
+        vec2 uv;
+        uint32_t face = cubeFace(d, uv);
+        glm::ivec2 t = glm::clamp(glm::ivec2((uv * 0.5f + 0.5f) * static_cast<float>(size)), glm::ivec2(0),
+                                  glm::ivec2(size - 1));
+        float p = texelPdf(t.x, static_cast<int>(face) * size + t.y, uv);
+        return (1.0f - kEnvUniform) * p + kEnvUniform / (4.0f * kPi);
+    }
+
+    vec3 sample(vec3 u) const {
+        if (u.x < kEnvUniform) return sampleUniformSphere(vec2(u.y, u.z));
+        int size = sky->size;
+        float ur = (u.x - kEnvUniform) / (1.0f - kEnvUniform);
+        int lo = 0, hi = 6 * size - 1;
+        while (lo < hi) {
+            int mid = (lo + hi) / 2;
+            if (cdf(size, mid) > ur) hi = mid;
+            else lo = mid + 1;
+        }
+        int row = lo;
+        float ux = u.y;
+        lo = 0;
+        hi = size - 1;
+        while (lo < hi) {
+            int mid = (lo + hi) / 2;
+            if (cdf(mid, row) > ux) hi = mid;
+            else lo = mid + 1;
+        }
+        float c0 = cdf(lo - 1, row), c1 = cdf(lo, row);
+        float fx = c1 > c0 ? std::clamp((ux - c0) / (c1 - c0), 0.0f, 0.999999f) : 0.5f;
+        vec2 uv = (vec2(static_cast<float>(lo) + fx, static_cast<float>(row % size) + u.z) * 2.0f) /
+                      static_cast<float>(size) -
+                  1.0f;
+        return glm::normalize(cubeDirection(static_cast<uint32_t>(row / size), uv));
+    }
+};
+
+// --- scene.glsl: texel pool and evaluateLayers ---
+struct Materials {
+    std::vector<GpuMaterial> materials;
+    std::vector<GpuLayer> layers;
+    TexelPool pool;
+
+    int modulo(int i, int m) const {
+        int t = i - m * static_cast<int>(std::floor(static_cast<float>(i) / static_cast<float>(m)));
+        return t < 0 ? t + m : (t >= m ? t - m : t);
+    }
+    int wrap(int i, int size, uint32_t mode) const {
+        if (mode == VITRINE_TEXEL_CLAMP) return std::clamp(i, 0, size - 1);
+        if (mode == VITRINE_TEXEL_MIRROR) {
+            int t = modulo(i, 2 * size);
+            return t >= size ? 2 * size - 1 - t : t;
+        }
+        return modulo(i, size);
+    }
+    // 8-bit channel to float: linear (v / 255) and sRGB-decoded (the GLSL's formula, tabulated).
+    struct Decode {
+        std::array<float, 256> linear{}, srgb{};
+        Decode() {
+            for (int i = 0; i < 256; ++i) {
+                float c = static_cast<float>(i) / 255.0f;
+                linear[i] = c;
+                srgb[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+            }
+        }
+    };
+    vec4 fetch(const std::array<uint32_t, 4>& tex, int x, int y) const {
+        static const Decode decode;
+        uint32_t packed = pool.texels[tex[0] + static_cast<uint32_t>(y) * tex[1] + static_cast<uint32_t>(x)];
+        const std::array<float, 256>& rgb = (tex[3] & VITRINE_TEXEL_SRGB) != 0u ? decode.srgb : decode.linear;
+        return vec4(rgb[packed & 0xffu], rgb[(packed >> 8) & 0xffu], rgb[(packed >> 16) & 0xffu],
+                    decode.linear[packed >> 24]);
+    }
+    vec4 sample(int index, vec2 uv) const {
+        const auto& tex = pool.table[static_cast<size_t>(index)];
+        glm::ivec2 size(static_cast<int>(tex[1]), static_cast<int>(tex[2]));
+        uint32_t wrapU = (tex[3] >> VITRINE_TEXEL_WRAP_U_SHIFT) & 3u, wrapV = (tex[3] >> VITRINE_TEXEL_WRAP_V_SHIFT) & 3u;
+        vec2 st = uv * vec2(size);
+        if ((tex[3] & VITRINE_TEXEL_NEAREST) != 0u) {
+            glm::ivec2 i(glm::floor(st));
+            return fetch(tex, wrap(i.x, size.x, wrapU), wrap(i.y, size.y, wrapV));
+        }
+        st -= 0.5f;
+        vec2 f = glm::fract(st);
+        glm::ivec2 i0(glm::floor(st));
+        int x0 = wrap(i0.x, size.x, wrapU), x1 = wrap(i0.x + 1, size.x, wrapU);
+        int y0 = wrap(i0.y, size.y, wrapV), y1 = wrap(i0.y + 1, size.y, wrapV);
+        vec4 top = glm::mix(fetch(tex, x0, y0), fetch(tex, x1, y0), f.x);
+        vec4 bottom = glm::mix(fetch(tex, x0, y1), fetch(tex, x1, y1), f.x);
+        return glm::mix(top, bottom, f.y);
+    }
+    static vec2 refUv(const GpuTexRef& r, vec2 uv0, vec2 uv1) {
+        vec3 uv(r.info.y == 0 ? uv0 : uv1, 1.0f);
+        return vec2(glm::dot(vec3(r.row0), uv), glm::dot(vec3(r.row1), uv));
+    }
+    vec4 sampleRef(const GpuTexRef& r, vec2 uv0, vec2 uv1) const {
+        if (r.info.x < 0) return vec4(1.0f);
+        return sample(r.info.x, refUv(r, uv0, uv1));
+    }
+    static float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }
+
+    struct LayeredSurface {
+        vec4 albedo{1.0f};
+        vec3 normal{0.0f, 0.0f, 1.0f};
+        float shininess = 0.5f, metallic = 0.0f, cavity = 1.0f;
+    };
+    LayeredSurface evaluateLayers(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
+        LayeredSurface s;
+        uint32_t first = m.info.x, count = m.info.y;
+        for (uint32_t i = 0; i < count; ++i) {
+            const GpuLayer& l = layers[first + i];
+            float w = 1.0f;
+            if (i > 0) {
+                const GpuTexRef& mr = l.refs[VITRINE_REF_MASK];
+                float t = mr.info.x < 0 ? 1.0f : channelOf(sampleRef(mr, uv0, uv1), mr.info.z);
+                w = std::clamp(l.scalars1.w * t, 0.0f, 1.0f);
+            }
+            uint32_t bits = l.bits.x;
+            if ((bits & VITRINE_LAYER_ALBEDO) != 0u)
+                s.albedo = glm::mix(s.albedo, l.albedo * sampleRef(l.refs[VITRINE_REF_ALBEDO], uv0, uv1), w);
+            if ((bits & VITRINE_LAYER_NORMAL) != 0u) {
+                vec3 n(0.0f, 0.0f, 1.0f);
+                const GpuTexRef& nr = l.refs[VITRINE_REF_NORMAL];
+                if (nr.info.x >= 0) {
+                    n = vec3(sampleRef(nr, uv0, uv1)) * 2.0f - 1.0f;
+                    n.x *= l.scalars0.x;
+                    n.y *= l.scalars0.x;
+                }
+                s.normal = glm::mix(s.normal, n, w);
+            }
+            if ((bits & VITRINE_LAYER_SHININESS) != 0u) {
+                const GpuTexRef& r = l.refs[VITRINE_REF_SHININESS];
+                float t = r.info.x < 0 ? 1.0f : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+                s.shininess = glm::mix(s.shininess, glm::mix(l.scalars0.z, l.scalars0.y, t), w);
+            }
+            if ((bits & VITRINE_LAYER_METALLIC) != 0u) {
+                const GpuTexRef& r = l.refs[VITRINE_REF_METALLIC];
+                float t = r.info.x < 0 ? 1.0f : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+                s.metallic = glm::mix(s.metallic, glm::mix(l.scalars1.x, l.scalars0.w, t), w);
+            }
+            if ((bits & VITRINE_LAYER_CAVITY) != 0u) {
+                const GpuTexRef& r = l.refs[VITRINE_REF_CAVITY];
+                float t = r.info.x < 0 ? 1.0f : channelOf(sampleRef(r, uv0, uv1), r.info.z);
+                s.cavity = glm::mix(s.cavity, glm::mix(l.scalars1.z, l.scalars1.y, t), w);
+            }
+        }
+        return s;
+    }
+};
+
+// Where an Embree triangle came from (the BVH's GpuBvhTriangleRef).
+struct TriangleRef {
+    uint32_t instance, primitive, triangle, material;
+};
+
+struct PathSurface {
+    vec3 position, geometricNormal, normal, baseColor;
+    float metallic, roughness, cavity;
+    vec3 emissive;
+};
+
+vec3 offsetRay(vec3 p, vec3 ng, vec3 dir) {
+    float scale = 1e-4f * (1.0f + std::max(std::max(std::abs(p.x), std::abs(p.y)), std::abs(p.z)));
+    return p + ng * (glm::dot(ng, dir) >= 0.0f ? scale : -scale);
+}
+
+} // namespace
+
+struct CpuPathTracer::Impl {
+    const scene::Scene& scene;
+    std::vector<glm::mat4> world;
+    std::vector<glm::mat3> normalMatrix;
+    Materials materials;
+    std::vector<TriangleRef> refs;
+    std::vector<glm::vec3> worldPositions; // 3 per triangle (the shading's geometric normal uses world positions)
+    RTCDevice device = nullptr;
+    RTCScene rtc = nullptr;
+
+    Impl(const scene::Scene& s, const std::vector<glm::mat4>& instanceWorld) : scene(s), world(instanceWorld) {
+        packMaterials(s, materials.materials, materials.layers);
+        materials.pool = packTexelPool(s);
+        device = rtcNewDevice("threads=1"); // our own threads call into it; its builder uses one
+        if (!device) throw InternalError("render.pathtrace: Embree could not create a device");
+        rtc = rtcNewScene(device);
+        rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
+        rtcSetSceneBuildQuality(rtc, RTC_BUILD_QUALITY_HIGH);
+        for (size_t i = 0; i < s.instances.size(); ++i) {
+            const glm::mat4& w = i < world.size() ? world[i] : s.instances[i].world;
+            if (i >= world.size()) world.push_back(w);
+            normalMatrix.push_back(glm::transpose(glm::inverse(glm::mat3(w))));
+            const scene::Mesh& mesh = s.meshes[s.instances[i].mesh];
+            for (uint32_t p = mesh.firstPrimitive; p < mesh.firstPrimitive + mesh.primitiveCount; ++p) {
+                const scene::Primitive& prim = s.primitives[p];
+                // As the GPU BVH (core/accel/scene_bvh.cpp): transparent primitives are left out.
+                if (s.materials[prim.material].transparent()) continue;
+                for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
+                    for (uint32_t k = 0; k < 3; ++k) {
+                        const scene::Vertex& v = s.vertices[s.indices[prim.firstIndex + 3 * t + k] + prim.vertexOffset];
+                        worldPositions.push_back(glm::vec3(w * glm::vec4(v.position, 1.0f)));
+                    }
+                    refs.push_back({static_cast<uint32_t>(i), p, t, prim.material});
+                }
+            }
+        }
+        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        const size_t triangles = refs.size();
+        float* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), std::max<size_t>(1, 3 * triangles)));
+        uint32_t* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                     3 * sizeof(uint32_t), triangles));
+        for (size_t i = 0; i < worldPositions.size(); ++i) {
+            vb[3 * i] = worldPositions[i].x;
+            vb[3 * i + 1] = worldPositions[i].y;
+            vb[3 * i + 2] = worldPositions[i].z;
+        }
+        for (size_t i = 0; i < 3 * triangles; ++i) ib[i] = static_cast<uint32_t>(i);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometry(rtc, geom);
+        rtcReleaseGeometry(geom);
+        rtcCommitScene(rtc);
+    }
+
+    ~Impl() {
+        if (rtc) rtcReleaseScene(rtc);
+        if (device) rtcReleaseDevice(device);
+    }
+
+    struct Hit {
+        float t;
+        vec2 barycentrics;
+        uint32_t triangle;
+    };
+
+    bool closest(vec3 o, vec3 d, float tmin, Hit& hit, uint64_t& rays) const {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        RTCRayHit rh{};
+        rh.ray.org_x = o.x;
+        rh.ray.org_y = o.y;
+        rh.ray.org_z = o.z;
+        rh.ray.dir_x = d.x;
+        rh.ray.dir_y = d.y;
+        rh.ray.dir_z = d.z;
+        rh.ray.tnear = tmin;
+        rh.ray.tfar = kInfinity;
+        rh.ray.mask = ~0u;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(rtc, &context, &rh);
+        ++rays;
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+        hit.t = rh.ray.tfar;
+        hit.barycentrics = vec2(rh.hit.u, rh.hit.v);
+        hit.triangle = rh.hit.primID;
+        return true;
+    }
+
+    bool occluded(vec3 o, vec3 d, uint64_t& rays) const {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        RTCRay r{};
+        r.org_x = o.x;
+        r.org_y = o.y;
+        r.org_z = o.z;
+        r.dir_x = d.x;
+        r.dir_y = d.y;
+        r.dir_z = d.z;
+        r.tnear = 0.0f;
+        r.tfar = kInfinity;
+        r.mask = ~0u;
+        rtcOccluded1(rtc, &context, &r);
+        ++rays;
+        return r.tfar < 0.0f;
+    }
+
+    // pathCulled: the back of a single-sided material's triangle, which the rasteriser culls.
+    bool culled(const Hit& hit, vec3 direction) const {
+        const TriangleRef& ref = refs[hit.triangle];
+        if (materials.materials[ref.material].info.w != 0u) return false;
+        const vec3* p = &worldPositions[3 * static_cast<size_t>(hit.triangle)];
+        return glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), direction) > 0.0f;
+    }
+
+    bool traceVisible(vec3 origin, vec3 dir, Hit& hit, uint64_t& rays) const {
+        float tmin = 0.0f;
+        for (int skip = 0; skip < 4; ++skip) {
+            if (!closest(origin, dir, tmin, hit, rays)) return false;
+            if (!culled(hit, dir)) return true;
+            // Past the culled triangle (Embree's tnear is inclusive, the GLSL test is strict).
+            tmin = std::nextafter(hit.t, kInfinity);
+        }
+        return false;
+    }
+
+    PathSurface pathSurface(const Hit& hit, vec3 origin, vec3 direction) const {
+        const TriangleRef& ref = refs[hit.triangle];
+        const scene::Primitive& prim = scene.primitives[ref.primitive];
+        auto vtx = [&](uint32_t k) -> const scene::Vertex& {
+            return scene.vertices[scene.indices[prim.firstIndex + 3 * ref.triangle + k] + prim.vertexOffset];
+        };
+        const scene::Vertex &v0 = vtx(0), &v1 = vtx(1), &v2 = vtx(2);
+        vec3 bary(1.0f - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics.x, hit.barycentrics.y);
+        const glm::mat3 w(world[ref.instance]);
+        const glm::mat3& normalM = normalMatrix[ref.instance];
+
+        PathSurface s;
+        s.position = origin + hit.t * direction;
+        vec3 ng = glm::normalize(normalM * glm::cross(v1.position - v0.position, v2.position - v0.position));
+        bool backFace = glm::dot(ng, direction) > 0.0f;
+        if (backFace) ng = -ng;
+        s.geometricNormal = ng;
+
+        vec3 n = normalM * (bary.x * v0.normal + bary.y * v1.normal + bary.z * v2.normal);
+        vec4 tangent = bary.x * v0.tangent + bary.y * v1.tangent + bary.z * v2.tangent;
+        vec2 uv0 = bary.x * v0.uv0 + bary.y * v1.uv0 + bary.z * v2.uv0;
+        vec2 uv1 = bary.x * v0.uv1 + bary.y * v1.uv1 + bary.z * v2.uv1;
+        vec4 color = bary.x * v0.color + bary.y * v1.color + bary.z * v2.color;
+
+        const GpuMaterial& m = materials.materials[ref.material];
+        Materials::LayeredSurface l = materials.evaluateLayers(m, uv0, uv1);
+
+        n = glm::dot(n, n) > 1e-20f ? glm::normalize(n) : ng;
+        vec3 t = w * vec3(tangent);
+        t = t - n * glm::dot(n, t);
+        t = glm::dot(t, t) > 1e-12f ? glm::normalize(t) : vec3(1.0f, 0.0f, 0.0f);
+        vec3 b = glm::cross(n, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+        float len = glm::length(l.normal);
+        vec3 nts = len > 1e-6f ? l.normal / len : vec3(0.0f, 0.0f, 1.0f);
+        vec3 N = glm::normalize(t * nts.x + b * nts.y + n * nts.z);
+        if (backFace) N = -N;
+        float NoV = glm::dot(N, -direction);
+        if (NoV < 0.01f) N = glm::normalize(N - direction * (0.01f - NoV));
+        s.normal = N;
+
+        s.baseColor = vec3(l.albedo) * vec3(color);
+        s.metallic = std::clamp(l.metallic, 0.0f, 1.0f);
+        s.roughness = roughnessFromShininess(std::clamp(l.shininess, 0.0f, 1.0f));
+        s.cavity = std::clamp(l.cavity, 0.0f, 1.0f);
+        s.emissive = vec3(m.emissive);
+        if (m.emissiveRef.info.x >= 0) s.emissive *= vec3(materials.sampleRef(m.emissiveRef, uv0, uv1));
+        if (m.optics.z > 0.5f) {
+            s.emissive = s.baseColor;
+            s.baseColor = vec3(0.0f);
+            s.metallic = 0.0f;
+            s.cavity = 0.0f;
+        }
+        return s;
+    }
+
+    // pathtrace.comp's tracePath, line for line.
+    vec3 tracePath(vec3 origin, vec3 dir, uint32_t& rng, const CpuTraceSettings& st, const Env& env,
+                   uint64_t& rays) const {
+        bool envSampling = st.envSampling && st.skyScale > 0.0f && env.total() > 0.0f;
+        vec3 sunE = env.sky->sunIlluminance * st.sunScale;
+        vec3 sunDir = glm::normalize(env.sky->sunDirection);
+        bool sun = sunE.x > 0.0f || sunE.y > 0.0f || sunE.z > 0.0f;
+
+        vec3 radiance(0.0f), throughput(1.0f);
+        float brdfPdfPrev = 0.0f;
+        for (uint32_t bounce = 0;; ++bounce) {
+            Hit hit;
+            if (!traceVisible(origin, dir, hit, rays)) {
+                float w = bounce == 0u || !envSampling ? 1.0f : powerHeuristic(brdfPdfPrev, env.pdf(dir));
+                radiance += throughput * env.radiance(dir) * w;
+                break;
+            }
+            PathSurface s = pathSurface(hit, origin, dir);
+            radiance += throughput * s.emissive * st.emissiveScale;
+            if (bounce >= st.maxBounces) break;
+
+            vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
+            BrdfLobes lobes = brdfLobes(s.baseColor, s.metallic, s.roughness, std::clamp(glm::dot(n, v), 0.0f, 1.0f));
+            vec3 weight = throughput * s.cavity;
+
+            if (sun && glm::dot(ng, sunDir) > 0.0f) {
+                vec3 f = brdfCosine(n, v, sunDir, s.baseColor, s.metallic, s.roughness);
+                if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, sunDir), sunDir, rays))
+                    radiance += weight * f * sunE;
+            }
+            if (envSampling) {
+                float a = rngNext(rng);
+                vec2 bc = rngNext2(rng);
+                vec3 l = env.sample(vec3(a, bc));
+                float pdf = env.pdf(l);
+                if (glm::dot(ng, l) > 0.0f && pdf > 0.0f) {
+                    vec3 f = brdfCosine(n, v, l, s.baseColor, s.metallic, s.roughness);
+                    if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, l), l, rays))
+                        radiance += weight * f * env.radiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
+                }
+            }
+
+            vec3 l;
+            float a = rngNext(rng);
+            vec2 bc = rngNext2(rng);
+            if (!sampleBrdf(lobes, n, v, vec3(a, bc), l) || glm::dot(ng, l) <= 0.0f) break;
+            float pdf = brdfPdf(lobes, n, v, l);
+            if (pdf <= 0.0f) break;
+            throughput = weight * brdfCosine(n, v, l, s.baseColor, s.metallic, s.roughness) / pdf;
+            brdfPdfPrev = pdf;
+            if (bounce >= 2u) {
+                float q = std::min(std::max(std::max(throughput.r, throughput.g), throughput.b), 0.95f);
+                if (rngNext(rng) >= q) break;
+                throughput /= q;
+            }
+            origin = offsetRay(s.position, ng, l);
+            dir = l;
+        }
+        return radiance;
+    }
+
+    // pathtrace.comp's main for one row: this batch's samples, merged into the accumulation (Chan et al.).
+    void traceRow(int y, const CpuTraceSettings& st, const Env& env, CpuAccumulation& acc, uint64_t& rays) const {
+        for (int x = 0; x < st.width; ++x) {
+            vec3 sum(0.0f);
+            float mean = 0.0f, m2 = 0.0f;
+            for (uint32_t i = 0; i < st.spp; ++i) {
+                uint32_t rng = rngSeed(glm::uvec2(x, y), st.seed, i);
+                vec2 jitter = st.antialias ? rngNext2(rng) : vec2(0.5f);
+                vec2 ndc = (vec2(static_cast<float>(x), static_cast<float>(y)) + jitter) /
+                               vec2(static_cast<float>(st.width), static_cast<float>(st.height)) * 2.0f -
+                           1.0f;
+                vec4 nearH = st.invViewProj * vec4(ndc, 1.0f, 1.0f);
+                vec4 farH = st.invViewProj * vec4(ndc, 0.5f, 1.0f);
+                vec3 dir = glm::normalize(vec3(farH) / farH.w - vec3(nearH) / nearH.w);
+                vec3 L = tracePath(st.cameraPos, dir, rng, st, env, rays);
+                if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) L = vec3(0.0f);
+                sum += L;
+                float yl = luminance(L), delta = yl - mean;
+                mean += delta / static_cast<float>(i + 1u);
+                m2 += delta * (yl - mean);
+            }
+            const size_t p = static_cast<size_t>(y) * st.width + x;
+            float nB = static_cast<float>(st.spp);
+            vec3 colorB = sum / std::max(nB, 1.0f);
+            glm::vec4& statsA = acc.stats[p];
+            float nA = statsA.x;
+            float n = nA + nB;
+            vec3 color = (vec3(acc.color[p]) * nA + colorB * nB) / std::max(n, 1.0f);
+            float delta = mean - statsA.y;
+            float meanY = statsA.y + delta * nB / std::max(n, 1.0f);
+            float M2 = statsA.z + m2 + delta * delta * nA * nB / std::max(n, 1.0f);
+            float standardError = n > 1.0f ? std::sqrt(std::max(M2, 0.0f) / ((n - 1.0f) * n)) : 0.0f;
+            acc.color[p] = vec4(color, 1.0f);
+            statsA = vec4(n, meanY, M2, standardError);
+        }
+    }
+};
+
+CpuPathTracer::CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld)
+    : mImpl(std::make_unique<Impl>(scene, instanceWorld)) {}
+
+CpuPathTracer::~CpuPathTracer() = default;
+
+CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
+                                      const std::function<void(double)>& progress) {
+    if (acc.width != s.width || acc.height != s.height) acc.reset(s.width, s.height);
+    auto cpuNow = [] {
+        timespec t{};
+        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+    };
+    const double cpuStart = cpuNow();
+    const auto wallStart = std::chrono::steady_clock::now();
+    Env env;
+    env.sky = &sky;
+    env.scale = s.skyScale;
+    const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+    std::atomic<int> nextRow{0}, rowsDone{0};
+    std::atomic<uint64_t> rays{0};
+    auto work = [&] {
+        uint64_t local = 0;
+        for (int y; (y = nextRow.fetch_add(1)) < s.height;) {
+            mImpl->traceRow(y, s, env, acc, local);
+            rowsDone.fetch_add(1);
+        }
+        rays.fetch_add(local);
+    };
+    std::vector<std::thread> pool;
+    for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
+    if (!progress) {
+        work();
+    } else {
+        // The calling thread reports progress and traces rows between reports.
+        auto last = std::chrono::steady_clock::now();
+        uint64_t local = 0;
+        for (int y; (y = nextRow.fetch_add(1)) < s.height;) {
+            mImpl->traceRow(y, s, env, acc, local);
+            rowsDone.fetch_add(1);
+            auto now = std::chrono::steady_clock::now();
+            if (now - last > std::chrono::milliseconds(200)) {
+                progress(static_cast<double>(rowsDone.load()) / s.height);
+                last = now;
+            }
+        }
+        rays.fetch_add(local);
+    }
+    for (auto& t : pool) t.join();
+    if (progress) progress(1.0);
+    CpuTraceCounters c;
+    c.paths = static_cast<uint64_t>(s.width) * s.height * s.spp;
+    c.rays = rays.load();
+    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    c.cpuSeconds = cpuNow() - cpuStart;
+    return c;
+}
+
+} // namespace vitrine
