@@ -74,7 +74,11 @@ void Progress::draw(bool force) {
         int filled = static_cast<int>(width * mDone / mTotal);
         std::string bar(filled, '#');
         bar.resize(width, '.');
-        std::fprintf(stderr, "\r%s [%s] %zu/%zu  %.1fs", mLabel.c_str(), bar.c_str(), mDone, mTotal, elapsed);
+        // The time left, from the rate so far, once some work is done.
+        char left[48] = "";
+        if (mDone > 0 && mDone < mTotal && elapsed > 0.5)
+            std::snprintf(left, sizeof left, ", ~%.0fs left", elapsed * static_cast<double>(mTotal - mDone) / mDone);
+        std::fprintf(stderr, "\r%s [%s] %zu/%zu  %.1fs%s   ", mLabel.c_str(), bar.c_str(), mDone, mTotal, elapsed, left);
         std::fflush(stderr);
     } else {
         int quarter = static_cast<int>(4 * mDone / mTotal);

@@ -445,9 +445,10 @@ PATHTRACE_TEST(TexturedSurfacesMatchTheRasterisersSamplers) {
 // a small emissive panel under the ceiling, a uniform sky outside. Most light reaches the walls after several
 // bounces, so the whole estimator (BRDF sampling, sky sampling and MIS, emitters found by BRDF sampling, Russian
 // roulette, the back-face rule) is exercised.
-std::filesystem::path boxRoom() {
-    SceneBuilder b("pt_box_room");
-    const uint32_t white = b.material("white", glm::vec3(0.75f), 0.0f, 0.3f);
+std::filesystem::path boxRoom(float whiteAlbedo = 0.75f, glm::vec3 eye = {0.0f, 0.0f, 3.4f},
+                              const std::string& name = "pt_box_room") {
+    SceneBuilder b(name);
+    const uint32_t white = b.material("white", glm::vec3(whiteAlbedo), 0.0f, 0.3f);
     const uint32_t red = b.material("red", glm::vec3(0.7f, 0.1f, 0.08f), 0.0f, 0.4f);
     const uint32_t green = b.material("green", glm::vec3(0.12f, 0.6f, 0.1f), 0.0f, 0.4f);
     const uint32_t metal = b.material("metal", glm::vec3(0.9f, 0.8f, 0.6f), 1.0f, 0.7f);
@@ -470,7 +471,7 @@ std::filesystem::path boxRoom() {
     for (Tri& t : box)
         for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->position += glm::vec3(0.35f, -0.55f, -0.35f);
     b.node("block", static_cast<int32_t>(b.mesh("block", box, metal)));
-    b.camera({0.0f, 0.0f, 3.4f}, {0.0f, 0.0f, 0.0f}, 0.7f);
+    b.camera(eye, {0.0f, 0.0f, 0.0f}, 0.7f);
     return b.write();
 }
 
@@ -556,6 +557,46 @@ TEST_F(PathTraceCpu, ErrorFallsAsOneOverSqrtSamples) {
     }
     const double expectedAll = std::sqrt((1.0 / 8.0 + 1.0 / 1024.0) / (1.0 / 64.0 + 1.0 / 1024.0));
     EXPECT_NEAR(rms.front() / rms.back(), expectedAll, 0.15 * expectedAll);
+}
+
+// target_noise: a converged result is stored in the bake cache and loaded, not traced, by the next run with the same
+// inputs (the log says so and the image is bit-identical); changing the sky, a material, the camera or the seed traces
+// again. The cache is a scratch folder (VITRINE_CACHE_DIR).
+TEST_F(PathTraceCpu, ConvergedResultIsCachedAndTracedAgainWhenAnInputChanges) {
+    const auto cacheDir = std::filesystem::temp_directory_path() / "vitrine_test_reference_cache";
+    std::filesystem::remove_all(cacheDir);
+    const char* old = std::getenv("VITRINE_CACHE_DIR");
+    const std::string saved = old ? old : "";
+    setenv("VITRINE_CACHE_DIR", cacheDir.c_str(), 1);
+    const int W = 24, H = 24;
+    const auto base = boxRoom();
+    auto run = [&](const std::filesystem::path& glb, double sky, int seed, std::string& log) {
+        testing::internal::CaptureStderr();
+        auto out = runGraph(traceGraph(glb, uniformSky(glb, sky),
+                                       {{"spp", 8}, {"seed", seed}, {"target_noise", 0.25}, {"min_spp", 16}}, W, H));
+        log = testing::internal::GetCapturedStderr();
+        return out.at("color");
+    };
+    auto traced = [](const std::string& log) { return log.find("render.pathtrace: converged after") != std::string::npos; };
+    auto loaded = [](const std::string& log) { return log.find("loaded from the bake cache") != std::string::npos; };
+    std::string log;
+    const Image first = run(base, 1.0, 0, log);
+    EXPECT_TRUE(traced(log)) << log;
+    const Image second = run(base, 1.0, 0, log);
+    EXPECT_TRUE(loaded(log)) << log;
+    EXPECT_FALSE(traced(log)) << log;
+    EXPECT_EQ(first.pixels, second.pixels);
+    run(base, 1.2, 0, log);
+    EXPECT_TRUE(traced(log)) << "sky changed:\n" << log;
+    run(base, 1.0, 1, log);
+    EXPECT_TRUE(traced(log)) << "seed changed:\n" << log;
+    run(boxRoom(0.7f, {0.0f, 0.0f, 3.4f}, "pt_box_room_material"), 1.0, 0, log);
+    EXPECT_TRUE(traced(log)) << "material changed:\n" << log;
+    run(boxRoom(0.75f, {0.1f, 0.0f, 3.4f}, "pt_box_room_camera"), 1.0, 0, log);
+    EXPECT_TRUE(traced(log)) << "camera moved:\n" << log;
+    if (old) setenv("VITRINE_CACHE_DIR", saved.c_str(), 1);
+    else unsetenv("VITRINE_CACHE_DIR");
+    std::filesystem::remove_all(cacheDir);
 }
 
 // Accumulation through color@prev / stats@prev with a still camera: after 16 frames of 4 samples the
