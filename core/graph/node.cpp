@@ -3,6 +3,9 @@
 #include "core/base/error.hpp"
 #include "core/graph/registry.hpp"
 
+#include <mutex>
+#include <utility>
+
 namespace vitrine {
 
 void detail::wrongObjectType(const std::string& port, const char* expected) {
@@ -39,6 +42,21 @@ int Params::getEnumIndex(const std::string& name) const {
     for (size_t i = 0; spec && i < spec->choices.size(); ++i)
         if (spec->choices[i] == value) return static_cast<int>(i);
     throw InternalError("node " + mSchema.type + ": param '" + name + "' is not an enum value");
+}
+
+namespace {
+std::mutex gFiguresMutex;
+std::map<std::string, std::vector<double>> gFigures;
+} // namespace
+
+void recordNodeFigure(const std::string& name, double value) {
+    std::lock_guard lock(gFiguresMutex);
+    gFigures[name].push_back(value);
+}
+
+std::map<std::string, std::vector<double>> takeNodeFigures() {
+    std::lock_guard lock(gFiguresMutex);
+    return std::exchange(gFigures, {});
 }
 
 } // namespace vitrine

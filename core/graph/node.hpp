@@ -11,7 +11,9 @@
 #include <filesystem>
 #include <memory>
 #include <span>
+#include <map>
 #include <string>
+#include <vector>
 #include <typeinfo>
 
 namespace vitrine {
@@ -165,5 +167,10 @@ public:
     // Nodes that own Vulkan objects (raster pipelines) drop them here; see PortObject::releaseGpu().
     virtual void releaseGpu() {}
 };
+
+// Figures a node measures about its own work (render.pathtrace: paths/s, rays/s), one value per frame, collected
+// by `vitrine bench` (its JSON's "node_figures" and its printout). Process-wide; thread-safe.
+void recordNodeFigure(const std::string& name, double value);
+std::map<std::string, std::vector<double>> takeNodeFigures(); // and forgets them
 
 } // namespace vitrine

@@ -465,6 +465,13 @@ private:
         mLastPathsPerSecond = static_cast<double>(c.paths) / std::max(c.seconds, 1e-9);
         mLastRaysPerSecond = static_cast<double>(c.rays) / std::max(c.seconds, 1e-9);
         mLastPathsPerCpuSecond = static_cast<double>(c.paths) / std::max(c.cpuSeconds, 1e-9);
+        recordCpuFigures();
+    }
+
+    void recordCpuFigures() const {
+        recordNodeFigure("render.pathtrace cpu paths/s", mLastPathsPerSecond);
+        recordNodeFigure("render.pathtrace cpu rays/s", mLastRaysPerSecond);
+        recordNodeFigure("render.pathtrace cpu paths per CPU-second", mLastPathsPerCpuSecond);
     }
 
     // mAccumulation into the outputs, through a host-visible buffer and a copy shader (the outputs stay storage
@@ -558,6 +565,7 @@ private:
         mLastPathsPerSecond = static_cast<double>(counters.paths) / std::max(counters.seconds, 1e-9);
         mLastRaysPerSecond = static_cast<double>(counters.rays) / std::max(counters.seconds, 1e-9);
         mLastPathsPerCpuSecond = static_cast<double>(counters.paths) / std::max(counters.cpuSeconds, 1e-9);
+        recordCpuFigures();
 
         storeAccumulation(ctx, out);
 
@@ -609,6 +617,8 @@ private:
                 samples = std::max(samples, s[0]);
                 if (s[1] > 0.0f) relative.push_back(s[3] / s[1]);
             }
+        recordNodeFigure("render.pathtrace gpu paths/s", paths / std::max(seconds, 1e-9));
+        recordNodeFigure("render.pathtrace gpu paths per CPU-second", paths / std::max(cpuSeconds, 1e-9));
         char rate[160];
         std::snprintf(rate, sizeof rate, "; %.0f paths/s (%.0f paths per CPU-second of this process)",
                       paths / std::max(seconds, 1e-9), paths / std::max(cpuSeconds, 1e-9));

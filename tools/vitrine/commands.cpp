@@ -189,7 +189,15 @@ int benchCommand(const Args& args) {
     RunOptions options;
     options.frames = frames + warmup;
     options.progress = !args.has("quiet");
+    takeNodeFigures();
     executor.run(options);
+    // Figures nodes measured about their own work (render.pathtrace's paths/s and rays/s), median of the frames
+    // after the warm-up.
+    nlohmann::json figures = nlohmann::json::object();
+    for (auto& [name, values] : takeNodeFigures()) {
+        if (values.size() > warmup) values.erase(values.begin(), values.begin() + warmup);
+        figures[name] = median(values);
+    }
 
     const auto& timings = executor.timings();
     nlohmann::json j;
@@ -221,6 +229,7 @@ int benchCommand(const Args& args) {
     }
     j["gpu_ms_total_median"] = median(total);
     j["cpu_record_ms_median"] = median(record);
+    j["node_figures"] = figures;
     if (ctx.validationMessageCount() > 0) j["validation_messages"] = ctx.validationMessageCount();
     j["scenes"] = nlohmann::json::array();
     for (const auto& r : graph.resources) {
@@ -259,6 +268,7 @@ int benchCommand(const Args& args) {
         std::printf("  %-41s %10.3f\n", "total GPU", median(total));
         std::printf("  CPU record %.3f ms; compile: graph %.2f ms, pipelines %.1f ms; scene build %.1f ms\n",
                     median(record), graphMs, executor.pipelineMs(), sceneMs);
+        for (const auto& [name, value] : figures.items()) std::printf("  %s: %.0f\n", name.c_str(), value.get<double>());
         const MemoryStats& m = executor.memory();
         std::printf("  transient memory: %s aliased, %s without aliasing (%.0f%%); persistent %s\n",
                     mib(m.transientAliased).c_str(), mib(m.transientUnaliased).c_str(),
