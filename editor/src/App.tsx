@@ -253,6 +253,7 @@ function Editor() {
         await write(path, text, false);
         dropAutosave(loaded.file.path); // the edits are in the new file now
         const file = await openFile(path, api.readGraph);
+        store.adopt(file); // the thumbnails stay (none re-rendered when the graph is the same)
         setLoaded((l) => (l ? { file, doc: file.merged, auto: l.auto } : l));
         const url = new URL(window.location.href);
         url.searchParams.set('graph', path);
@@ -261,7 +262,7 @@ function Editor() {
         setStatus(`save failed: ${(e as Error).message}`);
       }
     },
-    [loaded, write],
+    [loaded, write, store],
   );
 
   const deleteNode = useCallback(

@@ -402,6 +402,34 @@ scenarios.push(
         },
     },
     {
+        name: 'saveas_cache',
+        what: 'save as (same folder) and save as variant (another folder) keep every thumbnail: none is rendered again',
+        async run(page, log) {
+            await openGraph(page, server.url, ZONEPLATE);
+            await selectNode(page, 'fxaa');
+            await setParam(page, 'fxaa', 'subpix', 0.25);
+            await waitIdle(page);
+            const versions = async () => page.$$eval('img[data-testid^="preview-"]',
+                                                     els => Object.fromEntries(els.map(e => [e.dataset.testid, e.dataset.version])));
+            const before = await versions();
+            if (Object.keys(before).length < 3) fail(`saveas_cache: only ${Object.keys(before).length} thumbnails`);
+            await saveAs(page, 'save-as', 'graphs/zoneplate_copy.json');
+            await page.waitForTimeout(1000);
+            await waitIdle(page);
+            const afterCopy = await versions();
+            await saveAs(page, 'save-as-variant', 'graphs/variants/subpix_025.json');
+            await page.waitForTimeout(1000);
+            await waitIdle(page);
+            const afterVariant = await versions();
+            log(`thumbnail versions: ${JSON.stringify(before)} -> ${JSON.stringify(afterCopy)} -> ${JSON.stringify(afterVariant)}`);
+            if (JSON.stringify(afterCopy) !== JSON.stringify(before)) fail('saveas_cache: save as re-rendered thumbnails');
+            if (JSON.stringify(afterVariant) !== JSON.stringify(before))
+                fail('saveas_cache: save as variant re-rendered thumbnails');
+            const current = (await page.locator(tid('current-file')).textContent()) || '';
+            if (!current.includes('graphs/variants/subpix_025.json')) fail(`saveas_cache: current file is "${current}"`);
+        },
+    },
+    {
         name: 'fit',
         what: 'the museum graph (51 nodes and outputs, laid out automatically) opens fitted: every node inside the canvas',
         async run(page, log) {
