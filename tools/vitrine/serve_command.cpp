@@ -1,4 +1,5 @@
-// `vitrine serve [DIR] [--port N] [--host ADDR] [--token T | --no-token] [--max-queue N]`: the graph editor's server (tools/vitrine/serve/).
+// `vitrine serve [DIR] [--port N] [--host ADDR] [--token T | --no-token] [--max-queue N]`: the graph editor's server
+// (tools/vitrine/serve/).
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "tools/vitrine/cli.hpp"
@@ -9,9 +10,9 @@
 
 #include <atomic>
 #include <cerrno>
-#include <cstring>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <thread>
 
@@ -92,7 +93,8 @@ int serveCommand(const Args& args) {
     serve::GpuWorker gpu(contextOptions(args), std::max(1u, warm), maxQueue);
     serve::Api api(options, gpu, events);
     httplib::Server server;
-    // Event streams and requests waiting on the GPU hold a thread each; both are bounded below the pool's size (api.hpp).
+    // Event streams and requests waiting on the GPU hold a thread each; both are bounded below the pool's size
+    // (api.hpp).
     server.new_task_queue = [] { return new httplib::ThreadPool(serve::Api::kServerThreads); };
     api.install(server);
     // cpp-httplib 0.11 listens with a backlog of 5: 32 clients connecting at once (a page's requests, a load test)

@@ -328,33 +328,34 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
         };
         // A full queue refuses the job (503): its images fail with the same answer, so none is left pending.
         try {
-        mGpu.post(
-            [this, shared, job, ids, start, progress, fail, publishImages, file, png] {
-                try {
-                    RenderResult r = mGpu.renderNow(*shared, progress, nodeProgress(job, "render", file));
-                    if (shared->previews.empty())
-                        mImages.fulfil(ids[0], png(r.image), r.image.width, r.image.height);
-                    else
-                        publishImages(*shared, r, ids);
-                    mEvents.publish("job", {{"job", job},
-                                            {"kind", "render"},
-                                            {"stage", "done"},
-                                            {"image", ids[0]},
-                                            {"ms", msSince(start)},
-                                            {"warm", r.warm}});
-                } catch (const UserError& e) {
-                    fail(422, userErrorBody(e.what()), "error");
-                } catch (const std::exception& e) {
-                    fail(500, {{"error", std::string("internal error: ") + e.what()}}, "error");
-                }
-            },
-            tag,
-            [fail, tag] {
-                fail(409,
-                     {{"error", "superseded: a newer request with tag \"" + tag + "\" came before this one started"},
-                      {"superseded", true}},
-                     "superseded");
-            });
+            mGpu.post(
+                [this, shared, job, ids, start, progress, fail, publishImages, file, png] {
+                    try {
+                        RenderResult r = mGpu.renderNow(*shared, progress, nodeProgress(job, "render", file));
+                        if (shared->previews.empty())
+                            mImages.fulfil(ids[0], png(r.image), r.image.width, r.image.height);
+                        else
+                            publishImages(*shared, r, ids);
+                        mEvents.publish("job", {{"job", job},
+                                                {"kind", "render"},
+                                                {"stage", "done"},
+                                                {"image", ids[0]},
+                                                {"ms", msSince(start)},
+                                                {"warm", r.warm}});
+                    } catch (const UserError& e) {
+                        fail(422, userErrorBody(e.what()), "error");
+                    } catch (const std::exception& e) {
+                        fail(500, {{"error", std::string("internal error: ") + e.what()}}, "error");
+                    }
+                },
+                tag,
+                [fail, tag] {
+                    fail(
+                        409,
+                        {{"error", "superseded: a newer request with tag \"" + tag + "\" came before this one started"},
+                         {"superseded", true}},
+                        "superseded");
+                });
         } catch (const HttpError& e) {
             nlohmann::json body = e.detail();
             body["error"] = e.what();
@@ -365,7 +366,8 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
         nlohmann::json answer = {{"job", job}, {"image", ids[0]}, {"url", "/api/images/" + ids[0]}};
         if (!shared->previews.empty()) {
             nlohmann::json urls = nlohmann::json::object();
-            for (size_t i = 0; i < shared->previews.size(); ++i) urls[shared->previews[i]] = "/api/images/" + ids[i];
+            for (size_t i = 0; i < shared->previews.size(); ++i)
+                urls[shared->previews[i]] = "/api/images/" + ids[i];
             answer = {{"job", job}, {"images", urls}};
         }
         replyJson(res, 202, answer);
@@ -398,7 +400,9 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
     } catch (const HttpError& e) {
         mEvents.publish("job", {{"job", job},
                                 {"kind", "render"},
-                                {"stage", e.status() == 409 ? "superseded" : e.status() == 503 ? "refused" : "error"},
+                                {"stage", e.status() == 409   ? "superseded"
+                                          : e.status() == 503 ? "refused"
+                                                              : "error"},
                                 {"error", e.what()}});
         throw;
     } catch (const std::exception& e) {

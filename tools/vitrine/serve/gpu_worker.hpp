@@ -67,8 +67,8 @@ using NodeProgressFn =
 struct RenderResult {
     Image image;                         // the output at the last frame (with previews: the last one written)
     std::map<std::string, Image> images; // every graph output at the last frame, by name
-    bool warm = false;             // the compiled graph was kept from an earlier request
-    size_t validationMessages = 0; // Vulkan validation messages during this job (with --validate)
+    bool warm = false;                   // the compiled graph was kept from an earlier request
+    size_t validationMessages = 0;       // Vulkan validation messages during this job (with --validate)
 };
 
 class GpuWorker {
