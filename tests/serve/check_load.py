@@ -1,19 +1,24 @@
 #!/usr/bin/env python3
 """`vitrine serve` under load (issue #27), with the standard library only.
 
-usage: check_load.py VITRINE SOURCE_DIR [--bound-ms MS]
+usage: check_load.py VITRINE SOURCE_DIR [--bound-ms MS] [--max-ms MS]
 
 Opens 32 event streams from 8 loopback addresses 127.0.0.2..9 (8 from the first, then the others in turn, so that
 both the per-client and the global cap are met) and starts 32 renders at once (16 waiting for their PNG, 16 "async"), slow enough on lavapipe to fill
 the GPU queue; while they run, it times GET /api/status and GET /api/nodes. Checks:
   - 4 streams from the address that tried 8, at most 4 from any, and 8 in all get 200; the others 503 with
     Retry-After;
-  - status and nodes answer within the bound (--bound-ms, default 100) the whole time;
+  - status and nodes answer within --bound-ms (default 100) at the 95th percentile and within --max-ms (default 500)
+    every time. Measured on lavapipe, 2 cores shared with other builds (load average 9): max 17-33 ms; with another
+    lavapipe process baking beside it (load average 14): p95 28 ms, max 268 ms -- the CPU, not the server, so the
+    maximum's bound is 5x the 95th percentile's. The server before the queue: max 8.1 s; with cpp-httplib's listen
+    backlog of 5: max 1.0 s (a dropped SYN's retransmission);
   - every render gets either its PNG (a sync one at once, an async one at its /api/images URL) or 503 with
     Retry-After and "reason": "queue-full" -- none hangs or is lost; some are refused (the queue is bounded) and
     the server's own counts never pass its limits (waiting requests, queued jobs);
   - the server's resident memory after the load is within 256 MiB of what it was after one warm render;
-  - closed streams free their slots (status shows 0 open within 15 s) and a render afterwards works.
+  - closed streams free their slots (status shows 0 open within 15 s) and a render afterwards works;
+  - --max-queue 0 is refused; with --max-queue 1, of 4 async renders sent at once some get 503, the others finish.
 Prints the latencies (min, median, p95, max) and the RSS. Ends with "N passed, M failed".
 """
 import atexit
@@ -33,6 +38,7 @@ import time
 
 vitrine, source = sys.argv[1:3]
 bound_ms = float(sys.argv[sys.argv.index("--bound-ms") + 1]) if "--bound-ms" in sys.argv else 100.0
+max_ms = float(sys.argv[sys.argv.index("--max-ms") + 1]) if "--max-ms" in sys.argv else 500.0
 passed = 0
 failed = []
 
@@ -243,8 +249,14 @@ def spread(values):
 print(f"under load ({load_s:.1f} s): status {spread(status_ms)}", flush=True)
 print(f"under load: nodes {spread(nodes_ms)}", flush=True)
 check(all_ok, "status and nodes answered 200 throughout")
-check(max(status_ms) < bound_ms, f"status within {bound_ms:.0f} ms under load (max {max(status_ms):.1f} ms)")
-check(max(nodes_ms) < bound_ms, f"nodes within {bound_ms:.0f} ms under load (max {max(nodes_ms):.1f} ms)")
+def p95(values):
+    return sorted(values)[int(0.95 * (len(values) - 1))]
+
+
+for name, values in [("status", status_ms), ("nodes", nodes_ms)]:
+    check(p95(values) < bound_ms and max(values) < max_ms,
+          f"{name} under load: 95 % within {bound_ms:.0f} ms and all within {max_ms:.0f} ms "
+          f"(p95 {p95(values):.1f} ms, max {max(values):.1f} ms)")
 busy = [s for s in samples if s.get("busy") or s.get("queued", 0) > 0]
 check(len(busy) >= 3 and max(s.get("event_streams", 0) for s in samples) == MAX_STREAMS,
       f"the server was under load while timed ({len(busy)} of {len(samples)} samples busy)")
@@ -294,5 +306,36 @@ r, payload = request("POST", "/api/render", render_spec)
 check(r.status == 200 and png_size(payload) == SIZE, f"a render after the load works ({r.status})")
 proc.terminate()
 check(proc.wait(timeout=120) == 0, "the server stops cleanly")
+
+# --max-queue: out of range refused; 1 lets one job wait behind the running one.
+bad = subprocess.run([vitrine, "serve", work, "--port", "0", "--max-queue", "0"], capture_output=True, text=True,
+                     timeout=120)
+check(bad.returncode != 0 and "--max-queue" in bad.stderr, f"--max-queue 0 refused ({bad.returncode}: {bad.stderr[-200:]})")
+proc = subprocess.Popen([vitrine, "serve", work, "--port", "0", "--validate", "--max-queue", "1"],
+                        stdout=subprocess.PIPE, text=True)
+for line in proc.stdout:
+    m = re.search(r"listening on http://([^/]+):(\d+)/\?token=(\w+)", line)
+    if m:
+        host, port, token = m.group(1), int(m.group(2)), m.group(3)
+        AUTH = {"Authorization": "token " + token}
+        break
+threading.Thread(target=proc.stdout.read, daemon=True).start()
+answers = [request("POST", "/api/render", dict(render_spec, **{"async": True})) for _ in range(4)]
+statuses = [r.status for r, _ in answers]
+accepted = [js(p).get("url") for r, p in answers if r.status == 202]
+finished = []
+for url in accepted:
+    for _ in range(2400):
+        r, payload = request("GET", url)
+        if r.status != 202:
+            break
+        time.sleep(0.05)
+    finished.append((r.status, png_size(payload)))
+print(f"--max-queue 1, 4 async renders at once: {statuses}; accepted ones: {finished}", flush=True)
+check(statuses.count(503) >= 1 and 202 in statuses and set(statuses) <= {202, 503},
+      f"--max-queue 1: some of 4 renders at once refused ({statuses})")
+check(all(f == (200, SIZE) for f in finished), f"--max-queue 1: every accepted render finished ({finished})")
+proc.terminate()
+check(proc.wait(timeout=120) == 0, "the --max-queue 1 server stops cleanly")
 print(f"{passed} passed, {len(failed)} failed")
 sys.exit(1 if failed else 0)
