@@ -10,6 +10,7 @@
 //
 // usage: node tests/editor/measure.mjs --vitrine build/vitrine [--source .] [--out build/editor-measure]
 //                                      [--repeat 5] [--edits 100] [--skip zoneplate,museum] [--museum-edits 0]
+//                                      [--warm N] (the server's --warm)
 import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
@@ -76,7 +77,8 @@ async function main() {
 
     const dir = makeServedDir(source);
     const server = await startServer({ vitrine, dir, editorDist: path.join(source, 'editor', 'dist'),
-                                       logFile: path.join(out, 'server.log') });
+                                       logFile: path.join(out, 'server.log'),
+                                       extraArgs: typeof opts.warm === 'string' ? ['--warm', opts.warm] : [] });
     console.log(`vitrine serve at ${server.url} (pid ${server.pid})`);
     const browser = await launchBrowser(source);
     try {
