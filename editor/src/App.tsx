@@ -17,6 +17,33 @@ import { schemaMap } from './graph/schema';
 import { isObject, type Json, type JsonObject, type NodeSchema, type Position } from './graph/types';
 import { PreviewStore } from './previews';
 
+/** The unsaved session of a file, kept in localStorage while there are unsaved edits (so that a closed tab, a
+ *  reload or a crash does not lose them) and offered back when the file is opened again. */
+interface Autosave {
+  path: string;
+  doc: JsonObject;
+  /** The file's merged document the edits were made on: the offer says when the file changed since. */
+  base: JsonObject;
+  at: number;
+}
+const autosaveKey = (path: string) => `vitrine.autosave:${path}`;
+function readAutosave(path: string): Autosave | null {
+  try {
+    const raw = window.localStorage.getItem(autosaveKey(path));
+    const value = raw ? (JSON.parse(raw) as Autosave) : null;
+    return value && value.path === path && isObject(value.doc) ? value : null;
+  } catch {
+    return null;
+  }
+}
+function dropAutosave(path: string) {
+  try {
+    window.localStorage.removeItem(autosaveKey(path));
+  } catch {
+    /* storage unavailable */
+  }
+}
+
 interface Loaded {
   file: OpenFile;
   doc: JsonObject;
@@ -57,6 +84,7 @@ function Editor() {
   const [viewer, setViewer] = useState<string | null>(null);
   const [abOpen, setAbOpen] = useState(false);
   const [files, setFiles] = useState<string[]>([]);
+  const [offer, setOffer] = useState<Autosave | null>(null);
   const store = useMemo(() => new PreviewStore(), []);
   useEffect(() => store.connect(), [store]);
   const previewsBusy = useSyncExternalStore(store.subscribe, () => store.busy());
@@ -79,6 +107,8 @@ function Editor() {
         const file = await openFile(path, api.readGraph);
         const map = schemaMap(list);
         setLoaded({ file, doc: file.merged, auto: autoLayout(file.merged, map) });
+        const kept = readAutosave(path);
+        setOffer(kept && !deepEqual(kept.doc, file.merged) ? kept : null);
         setDangling([]);
         setSelected(null);
         setErrors([]);
@@ -187,6 +217,7 @@ function Editor() {
   const write = useCallback(
     async (path: string, text: string, reopen: boolean) => {
       await track(api.writeGraph(path, text));
+      dropAutosave(path);
       setStatus(`saved ${path}`);
       const g = await api.listGraphs();
       setGraphs(g);
@@ -220,7 +251,9 @@ function Editor() {
             ? newVariantText(loaded.file, loaded.doc, path, description || undefined)
             : saveAsText(loaded.file, description ? { ...loaded.doc, description } : loaded.doc, path);
         await write(path, text, false);
+        dropAutosave(loaded.file.path); // the edits are in the new file now
         const file = await openFile(path, api.readGraph);
+        store.adopt(file); // the thumbnails stay (none re-rendered when the graph is the same)
         setLoaded((l) => (l ? { file, doc: file.merged, auto: l.auto } : l));
         const url = new URL(window.location.href);
         url.searchParams.set('graph', path);
@@ -229,7 +262,7 @@ function Editor() {
         setStatus(`save failed: ${(e as Error).message}`);
       }
     },
-    [loaded, write],
+    [loaded, write, store],
   );
 
   const deleteNode = useCallback(
@@ -245,8 +278,43 @@ function Editor() {
   const catchingUp = loaded !== null && schemas.size > 0 && (storeDoc.current !== loaded.doc || validated !== loaded.doc);
   const busy = pending > 0 || previewsBusy || catchingUp;
 
-  // Ctrl/Cmd+S saves. (No beforeunload prompt: the dirty mark says it, and a prompt would block scripted
-  // navigation in browser tests.)
+  // Unsaved edits: kept in localStorage (debounced) while the document differs from the file, and the browser asks
+  // before the page is closed or reloaded.
+  useEffect(() => {
+    if (!loaded || !dirty) return;
+    const timer = setTimeout(() => {
+      try {
+        const kept: Autosave = { path: loaded.file.path, doc: loaded.doc, base: loaded.file.merged, at: Date.now() };
+        window.localStorage.setItem(autosaveKey(loaded.file.path), JSON.stringify(kept));
+      } catch {
+        /* storage full or unavailable: the beforeunload guard still asks */
+      }
+    }, 300);
+    return () => clearTimeout(timer);
+  }, [loaded, dirty]);
+  useEffect(() => {
+    if (!dirty) return;
+    const guard = (e: BeforeUnloadEvent) => {
+      e.preventDefault();
+      e.returnValue = '';
+    };
+    window.addEventListener('beforeunload', guard);
+    return () => window.removeEventListener('beforeunload', guard);
+  }, [dirty]);
+  const restoreOffer = useCallback(() => {
+    if (!offer) return;
+    setLoaded((l) => (l && l.file.path === offer.path ? { ...l, doc: offer.doc } : l));
+    setStatus(`restored the unsaved edits of ${offer.path} from ${new Date(offer.at).toLocaleString()}`);
+    setOffer(null);
+  }, [offer]);
+  const discardOffer = useCallback(() => {
+    if (!offer) return;
+    dropAutosave(offer.path);
+    setStatus(`discarded the unsaved edits of ${offer.path}`);
+    setOffer(null);
+  }, [offer]);
+
+  // Ctrl/Cmd+S saves.
   useEffect(() => {
     const onKey = (e: KeyboardEvent) => {
       if ((e.ctrlKey || e.metaKey) && e.key === 's') {
@@ -275,6 +343,20 @@ function Editor() {
             onSaveAs={(m, p, d) => void saveAs(m, p, d)}
             onAB={() => setAbOpen(true)}
           />
+          {offer && loaded?.file.path === offer.path && (
+            <div className="autosave-offer" data-testid="autosave-offer">
+              <span>
+                Unsaved edits of {offer.path} from {new Date(offer.at).toLocaleString()}
+                {deepEqual(offer.base, loaded.file.merged) ? '' : ' (the file has changed on disk since)'}.
+              </span>
+              <button data-testid="autosave-restore" onClick={restoreOffer}>
+                Restore
+              </button>
+              <button data-testid="autosave-discard" onClick={discardOffer}>
+                Discard
+              </button>
+            </div>
+          )}
           <div className="main">
             <Palette schemas={schemaList} onAdd={addFromPalette} />
             <div className="canvas">

@@ -38,13 +38,21 @@ async function getJson<T>(url: string): Promise<T> {
   return (await res.json()) as T;
 }
 
+/** A POST; a 503 with Retry-After (the server's GPU queue is full: other tabs or scripts render) is tried again
+ *  after the time it names, up to 5 times, before its answer is handed back. */
 async function postJson(url: string, body: JsonObject, signal?: AbortSignal): Promise<Response> {
-  return fetch(url, {
-    method: 'POST',
-    headers: headers({ 'Content-Type': 'application/json' }),
-    body: JSON.stringify(body),
-    signal,
-  });
+  for (let attempt = 0; ; ++attempt) {
+    const res = await fetch(url, {
+      method: 'POST',
+      headers: headers({ 'Content-Type': 'application/json' }),
+      body: JSON.stringify(body),
+      signal,
+    });
+    const retry = Number(res.headers.get('Retry-After'));
+    if (res.status !== 503 || !(retry > 0) || attempt >= 5 || signal?.aborted) return res;
+    await new Promise((r) => setTimeout(r, Math.min(retry, 10) * 1000));
+    if (signal?.aborted) return res;
+  }
 }
 
 export interface GraphListEntry {

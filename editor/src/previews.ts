@@ -6,7 +6,8 @@
 import { ApiError, fetchImage, JobEvent, startRender, startRenderBatch, subscribeEvents } from './api';
 import { documentForServer, OpenFile } from './graph/files';
 import { nodeEntry, nodesOf, nodeType, stripUi, upstreamOf } from './graph/document';
-import type { JsonObject, SchemaMap } from './graph/types';
+import { dirname, join } from './graph/paths';
+import { isObject, type JsonObject, type SchemaMap } from './graph/types';
 
 export const PREVIEW_WIDTH = 160;
 export const PREVIEW_HEIGHT = 90;
@@ -110,6 +111,12 @@ export class PreviewStore {
     this.snapshots.set(key, { state: e.state, url: e.url, version: e.version, error: e.error, ms: e.ms });
   }
 
+  /** The open file was saved under another name (save as, save as variant): the previews stay; only those whose
+   *  inputs now resolve differently (relative paths from another folder) are rendered again by the next update. */
+  adopt(file: OpenFile): void {
+    this.file = file;
+  }
+
   /** The graph changed (or another file was opened): schedule what is now out of date. */
   update(file: OpenFile, doc: JsonObject, schemas: SchemaMap): void {
     if (file !== this.file && this.file?.path !== file.path) {
@@ -124,15 +131,25 @@ export class PreviewStore {
     this.doc = doc;
     const stripped = stripUi(doc);
     const keep = new Set<string>();
+    // What a preview depends on: the frame and its upstream nodes, with path params resolved from the file's folder
+    // (so that the same graph under another name keeps its previews, and one in another folder keeps those that
+    // name no file).
+    const dir = dirname(file.path);
+    const resolved = (n: string) => {
+      const entry = nodeEntry(stripped, n);
+      const schema = schemas.get(nodeType(stripped, n));
+      if (!entry || !schema || !isObject(entry.params)) return entry ?? null;
+      const params = { ...entry.params };
+      for (const p of schema.params)
+        if (p.type === 'path' && typeof params[p.name] === 'string' && params[p.name])
+          params[p.name] = join(dir, params[p.name] as string);
+      return { ...entry, params };
+    };
     for (const id of Object.keys(nodesOf(stripped))) {
       const schema = schemas.get(nodeType(stripped, id));
       if (!schema) continue;
       const upstream = [...upstreamOf(stripped, id)].sort();
-      const signature = JSON.stringify([
-        file.path,
-        stripped.frame ?? null,
-        upstream.map((n) => [n, nodeEntry(stripped, n)]),
-      ]);
+      const signature = JSON.stringify([stripped.frame ?? null, upstream.map((n) => [n, resolved(n)])]);
       for (const out of schema.outputs) {
         if (out.kind !== 'texture') continue;
         const key = `${id}.${out.name}`;

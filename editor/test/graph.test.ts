@@ -23,7 +23,7 @@ import {
 } from '../src/graph/document';
 import { newVariantText, openFile, serializeForSave, variantJson, documentForServer } from '../src/graph/files';
 import { dirname, join as pjoin, relative } from '../src/graph/paths';
-import { checkParam, hasExtension, pathExtensions } from '../src/graph/schema';
+import { checkParam, hasExtension, paramsSetByInputs, pathExtensions } from '../src/graph/schema';
 import type { Json, JsonObject, NodeSchema, ParamSchema } from '../src/graph/types';
 
 const REPO = join(process.cwd(), '..');
@@ -252,4 +252,30 @@ test('path pickers ask for the extensions a path param documents', () => {
   assert.equal(hasExtension('data/luts/Warm.CUBE', ['.cube']), true);
   assert.equal(hasExtension('data/luts/warm.png', ['.cube']), false);
   assert.equal(hasExtension('x.bin', []), true);
+});
+
+test('params a connected input replaces, from the input docs (the nodes\' wording)', () => {
+  const param = (name: string): ParamSchema => ({ name, type: 'float', default: 0 });
+  const schema = (inputs: [string, string][], params: string[]): NodeSchema => ({
+    type: 't',
+    inputs: inputs.map(([name, doc]) => ({ name, doc, kind: 'buffer' }) as unknown as NodeSchema['inputs'][number]),
+    outputs: [],
+    params: params.map(param),
+  });
+  // post.tonemap's and post.grain's docs as `vitrine nodes --json` prints them.
+  const tonemap = schema(
+    [
+      ['color', 'Linear HDR colour'],
+      ['camera_state', "camera.physical's state: when connected, its exposure replaces the `exposure` param"],
+    ],
+    ['exposure', 'operator', 'inverse'],
+  );
+  assert.deepEqual([...paramsSetByInputs(tonemap)], [['exposure', 'camera_state']]);
+  const grain = schema([['camera_state', "camera.physical's state: when connected, its ISO replaces the `iso` param"]], ['iso', 'amount']);
+  assert.deepEqual([...paramsSetByInputs(grain)], [['iso', 'camera_state']]);
+  // Several names; a name the node has no param of is left out; no wording, no entry.
+  const several = schema([['cam', 'replaces the `a`, `b` and `zz` params']], ['a', 'b', 'c']);
+  assert.deepEqual([...paramsSetByInputs(several)].sort(), [['a', 'cam'], ['b', 'cam']]);
+  assert.equal(paramsSetByInputs(schema([['color', 'Linear HDR colour']], ['exposure'])).size, 0);
+  assert.equal(paramsSetByInputs(undefined).size, 0);
 });

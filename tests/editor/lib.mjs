@@ -125,14 +125,15 @@ export async function startServer({ vitrine, dir, editorDist, logFile, extraArgs
     };
 }
 
-export async function launchBrowser(source) {
+// Extra command-line switches for Chromium in `args` (the rebinding test's --host-resolver-rules).
+export async function launchBrowser(source, args = []) {
     const require = createRequire(path.join(source, 'editor', 'package.json'));
     const { chromium } = require('playwright-core');
     return chromium.launch({
         executablePath: chromiumPath(),
         headless: true,
         // Root has no user namespaces for the sandbox; the pages are our own, on the loopback.
-        args: ['--no-sandbox', '--disable-dev-shm-usage', '--disable-gpu'],
+        args: ['--no-sandbox', '--disable-dev-shm-usage', '--disable-gpu', ...args],
     });
 }
 

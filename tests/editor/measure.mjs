@@ -3,12 +3,14 @@
 //  1. time from a param change to an updated preview thumbnail, for graphs/fxaa_zoneplate.json (fxaa.subpix ->
 //     tonemap's thumbnail) and graphs/museum.json (ao.intensity -> the final grain thumbnail; grain.strength ->
 //     the same), at the editor's preview size, on whatever Vulkan device the server picks (lavapipe here);
-//  2. the server's resident memory (/proc/PID/status VmRSS) every 10 of 100 edits of fxaa_zoneplate;
+//  2. the server's resident memory (/proc/PID/status VmRSS) every 10 of 100 edits of fxaa_zoneplate, and with
+//     --museum-edits N every 10 of N edits of the museum's grain.strength (each waits for the final thumbnail);
 //  3. the size of editor/dist (raw and gzip).
 // The time includes the editor's debounce (about 300 ms) and the PNG's transfer and decoding: what a user waits.
 //
 // usage: node tests/editor/measure.mjs --vitrine build/vitrine [--source .] [--out build/editor-measure]
-//                                      [--repeat 5] [--edits 100] [--skip zoneplate,museum]
+//                                      [--repeat 5] [--edits 100] [--skip zoneplate,museum] [--museum-edits 0]
+//                                      [--warm N] (the server's --warm)
 import fs from 'node:fs';
 import path from 'node:path';
 import zlib from 'node:zlib';
@@ -20,7 +22,7 @@ import {
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const opts = parseArgs(process.argv.slice(2), { source: path.resolve(here, '..', '..'), out: 'editor-measure',
-                                                repeat: '5', edits: '100', skip: '' });
+                                                repeat: '5', edits: '100', skip: '', 'museum-edits': '0' });
 const source = path.resolve(opts.source);
 const out = path.resolve(opts.out);
 const vitrine = opts.vitrine && path.resolve(opts.vitrine);
@@ -75,7 +77,8 @@ async function main() {
 
     const dir = makeServedDir(source);
     const server = await startServer({ vitrine, dir, editorDist: path.join(source, 'editor', 'dist'),
-                                       logFile: path.join(out, 'server.log') });
+                                       logFile: path.join(out, 'server.log'),
+                                       extraArgs: typeof opts.warm === 'string' ? ['--warm', opts.warm] : [] });
     console.log(`vitrine serve at ${server.url} (pid ${server.pid})`);
     const browser = await launchBrowser(source);
     try {
@@ -132,6 +135,23 @@ async function main() {
                 grain_strength_to_final: stats(await timeEdits(page, 'grain', 'strength', [0.02, 0.05, 0.01].slice(0, mn), 'preview-grain-color')),
             };
             results.museum_rss_kib = rssKiB(server.pid);
+            const museumEdits = Number(opts['museum-edits']);
+            if (museumEdits > 0) {
+                console.log(`server VmRSS over ${museumEdits} edits of the museum's grain.strength`);
+                const rss = [{ edits: 0, kib: rssKiB(server.pid) }];
+                await selectNode(page, 'grain');
+                for (let i = 1; i <= museumEdits; ++i) {
+                    const before = (await previewInfo(page, 'preview-grain-color')).version;
+                    await setParam(page, 'grain', 'strength', 0.01 + ((i * 37) % 100) / 2000);
+                    await waitPreview(page, 'preview-grain-color', before, 600000);
+                    if (i % 10 === 0) {
+                        await waitIdle(page, 600000);
+                        rss.push({ edits: i, kib: rssKiB(server.pid) });
+                        console.log(`  after ${i} edits: VmRSS ${(rss.at(-1).kib / 1024).toFixed(1)} MiB`);
+                    }
+                }
+                results.museum_rss = rss;
+            }
         }
     } finally {
         await browser.close().catch(() => {});

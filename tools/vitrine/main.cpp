@@ -52,6 +52,7 @@ commands:
       Plot the camera jitter patterns (halton, ordered, rotated, improved, stratified) as SVG:
       the first 16 samples numbered in order, later frames (sub-grid shifts) as dots.
   serve [DIR] [--port N] [--host ADDR] [--token T | --no-token] [--editor DIR] [--max-body BYTES] [--warm N]
+        [--max-queue N]
       HTTP server for the graph editor: the editor at /, a JSON API under /api/ (nodes, graphs under DIR,
       validate, render previews, compare, progress events). One Vulkan device and the last N (--warm,
       default 4) compiled graphs stay warm between requests. Binds 127.0.0.1:8420 by default (--port 0: any
@@ -59,6 +60,7 @@ commands:
       --token T picks it, --no-token drops it on the loopback). Answers only to the loopback names (or
       --host) and the server's own page (Host, Origin). Reads files under DIR only (default: the current
       directory) and writes only graph and variant .json files there (NAME.json.bak keeps what a PUT replaced).
+      At most N GPU jobs wait (--max-queue, default 16); past that a render gets 503 with Retry-After.
   sweep FILE [--out DIR] [--jobs N] [--retry-failed] [--devices 0,1] [--list]
       Quality-versus-cost study (README "Sweeps"): every point of the vitrine-sweep/1 FILE (axes of --set
       values, variant files, frame ranges) rendered as its own process, --jobs at once, compared with the
@@ -91,7 +93,7 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm",
+                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
                                      "jobs", "point", "collect", "devices", "from", "keep", "goldens", "class",
                                      "partition", "time", "gpus-per-task", "sbatch-arg"},
                                     {{"nodes", {"json"}}});

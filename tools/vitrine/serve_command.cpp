@@ -1,4 +1,5 @@
-// `vitrine serve [DIR] [--port N] [--host ADDR] [--token T | --no-token]`: the graph editor's server (tools/vitrine/serve/).
+// `vitrine serve [DIR] [--port N] [--host ADDR] [--token T | --no-token] [--max-queue N]`: the graph editor's server
+// (tools/vitrine/serve/).
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "tools/vitrine/cli.hpp"
@@ -8,10 +9,14 @@
 #include <httplib.h>
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <random>
 #include <thread>
+
+#include <sys/socket.h>
 
 namespace vitrine::cli {
 
@@ -20,6 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::atomic<int> gStopSignal{0};
+constexpr int kListenBacklog = 128;
 
 void onStopSignal(int signal) {
     gStopSignal = signal;
@@ -78,19 +84,33 @@ int serveCommand(const Args& args) {
     else if (options.token.empty())
         options.token = newToken();
     const uint32_t warm = args.getUint("warm", 4);
+    const uint32_t maxQueue = args.getUint("max-queue", 16);
+    if (maxQueue == 0 || maxQueue > 4096)
+        throw UserError("--max-queue: expected 1..4096 GPU jobs waiting, got " + std::to_string(maxQueue));
 
     serve::EventHub events;
     logInfo("serve: creating the Vulkan device");
-    serve::GpuWorker gpu(contextOptions(args), std::max(1u, warm));
+    serve::GpuWorker gpu(contextOptions(args), std::max(1u, warm), maxQueue);
     serve::Api api(options, gpu, events);
     httplib::Server server;
-    // Events streams hold a thread each while open.
-    server.new_task_queue = [] { return new httplib::ThreadPool(16); };
+    // Event streams and requests waiting on the GPU hold a thread each; both are bounded below the pool's size
+    // (api.hpp).
+    server.new_task_queue = [] { return new httplib::ThreadPool(serve::Api::kServerThreads); };
     api.install(server);
+    // cpp-httplib 0.11 listens with a backlog of 5: 32 clients connecting at once (a page's requests, a load test)
+    // overflow it and the kernel drops their SYNs, which costs each a 1 s retransmission before its request is even
+    // read. The listening socket is remembered here and its backlog raised once bound (listen() again on Linux).
+    int listening = -1;
+    server.set_socket_options([&listening](socket_t sock) {
+        httplib::default_socket_options(sock);
+        listening = sock;
+    });
 
     const int bound = port == 0 ? server.bind_to_any_port(host)
                                 : (server.bind_to_port(host, static_cast<int>(port)) ? static_cast<int>(port) : -1);
     if (bound < 0) throw UserError("serve: cannot listen on " + host + ":" + std::to_string(port) + " (in use?)");
+    if (listening >= 0 && ::listen(listening, kListenBacklog) != 0)
+        logWarning("serve: cannot raise the listen backlog: " + std::string(std::strerror(errno)));
     api.setPort(bound); // the Host and Origin headers must name it
     const std::string shownHost = host.find(':') != std::string::npos && host[0] != '[' ? "[" + host + "]" : host;
     const std::string url = "http://" + shownHost + ":" + std::to_string(bound) + "/";

@@ -224,7 +224,7 @@ export function GraphCanvas(props: GraphCanvasProps) {
       deleteKeyCode={['Delete', 'Backspace']}
       colorMode="dark"
       fitView
-      fitViewOptions={{ minZoom: 0.3, maxZoom: 1 }}
+      fitViewOptions={{ minZoom: 0.05, maxZoom: 1, padding: 0.05 }}
       minZoom={0.05}
       proOptions={{ hideAttribution: true }}
     >

@@ -1,6 +1,7 @@
 // The selected node's params, each with the widget its schema asks for.
 import { nodeEntry, nodeParams, nodeType } from '../graph/document';
 import { isObject, type Json, type JsonObject, type SchemaMap } from '../graph/types';
+import { paramsSetByInputs } from '../graph/schema';
 import { ParamField } from './ParamField';
 
 export interface InspectorProps {
@@ -27,6 +28,10 @@ export function Inspector(props: InspectorProps) {
   const schema = schemas.get(type);
   const params = nodeParams(doc, selected);
   const unknown = Object.keys(params).filter((k) => !schema?.params.some((p) => p.name === k));
+  // A param that a connected input replaces (tonemap's exposure while camera_state is wired) does nothing: shown
+  // disabled, naming the input.
+  const connected = isObject(node.in) ? node.in : {};
+  const setBy = paramsSetByInputs(schema);
   return (
     <aside className="inspector" data-testid="inspector">
       <div className="inspector-head">
@@ -44,6 +49,7 @@ export function Inspector(props: InspectorProps) {
           spec={spec}
           value={spec.name in params ? params[spec.name] : spec.default}
           explicit={spec.name in params}
+          setBy={setBy.has(spec.name) && setBy.get(spec.name)! in connected ? setBy.get(spec.name) : undefined}
           serverError={paramServerErrors.get(`${selected}/${spec.name}`)}
           files={files}
           pathValue={pathValue}

@@ -11,6 +11,8 @@ export interface ParamFieldProps {
   spec: ParamSchema;
   value: Json;
   explicit: boolean;
+  /** The connected input that replaces this param: the widget is disabled and says so. */
+  setBy?: string;
   serverError?: string;
   files: string[];
   /** Turns a DIR-relative path from the picker into the value written (relative to the graph file). */
@@ -112,7 +114,7 @@ function NumberEntry(props: {
 }
 
 export function ParamField(props: ParamFieldProps) {
-  const { node, spec, value, explicit, serverError, files, pathValue, onChange } = props;
+  const { node, spec, value, explicit, setBy, serverError, files, pathValue, onChange } = props;
   const [entryError, setEntryError] = useState<string | null>(null);
   const id = `param-${node}-${spec.name}`;
   const schemaError = checkParam(spec, value);
@@ -201,7 +203,7 @@ export function ParamField(props: ParamFieldProps) {
     }
   }
   return (
-    <div className={`param ${error ? 'has-error' : ''}`}>
+    <div className={`param ${error ? 'has-error' : ''} ${setBy ? 'set-by-input' : ''}`}>
       <label title={spec.doc}>
         <span className={explicit ? 'explicit' : ''}>{spec.name}</span>
         {hasRange && <span className="muted range">{`${spec.min}…${spec.max}`}</span>}
@@ -211,7 +213,14 @@ export function ParamField(props: ParamFieldProps) {
           </button>
         )}
       </label>
-      {widget}
+      {setBy ? (
+        <fieldset disabled className="set-by" data-testid={`param-setby-${node}-${spec.name}`}>
+          {widget}
+          <div className="muted">set by input {setBy}</div>
+        </fieldset>
+      ) : (
+        widget
+      )}
       {spec.doc && <div className="doc">{spec.doc}</div>}
       {error && (
         <div className="param-error" data-testid={`param-error-${node}-${spec.name}`}>

@@ -97,3 +97,16 @@ export function hasExtension(path: string, extensions: string[]): boolean {
   const lower = path.toLowerCase();
   return extensions.length === 0 || extensions.some((e) => lower.endsWith(e));
 }
+
+/** The params a connected input replaces, param name → input name: what an input's doc says it replaces
+ *  ("when connected, its exposure replaces the `exposure` param"; backquoted names, the nodes' convention). */
+export function paramsSetByInputs(schema: NodeSchema | undefined): Map<string, string> {
+  const replaced = new Map<string, string>();
+  for (const input of schema?.inputs ?? []) {
+    const m = (input.doc ?? '').match(/replaces the ((?:`[A-Za-z0-9_]+`(?:,? (?:and )?)?)+) params?\b/);
+    if (!m) continue;
+    for (const name of m[1].matchAll(/`([A-Za-z0-9_]+)`/g))
+      if (schema!.params.some((p) => p.name === name[1])) replaced.set(name[1], input.name);
+  }
+  return replaced;
+}

@@ -46,7 +46,18 @@ std::optional<ImageStore::Entry> ImageStore::get(const std::string& id) const {
 }
 
 Api::Api(const ServeOptions& options, GpuWorker& gpu, EventHub& events)
-    : mOptions(options), mSandbox(options.dir), mGpu(gpu), mEvents(events) {}
+    : mOptions(options), mSandbox(options.dir), mGpu(gpu), mEvents(events),
+      // Byte for byte what `vitrine nodes --json` and `vitrine schema` print.
+      mNodesJson(NodeRegistry::global().toJson().dump(2) + "\n"),
+      mSchemaJson(graphJsonSchema(NodeRegistry::global()).dump(2) + "\n") {}
+
+std::shared_ptr<void> Api::waitSlot() {
+    if (mWaiting.fetch_add(1) >= kMaxWaitingRequests) {
+        --mWaiting;
+        throw mGpu.queueFull();
+    }
+    return std::shared_ptr<void>(nullptr, [this](void*) { --mWaiting; });
+}
 
 std::string Api::newJobId() {
     return std::to_string(++mJobs);
@@ -76,6 +87,9 @@ Api::Handler Api::guarded(Handler handler) {
             handler(req, res);
         } catch (const HttpError& e) {
             replyError(res, e.status(), e.what(), e.detail());
+            // A 503 (the GPU queue or the event streams are full) says when to come back.
+            if (e.detail().contains("retry_after"))
+                res.set_header("Retry-After", std::to_string(e.detail()["retry_after"].get<int>()));
         } catch (const PathRefused& e) {
             nlohmann::json body = userErrorBody(e.what());
             replyError(res, 403, body["error"], body);
@@ -290,10 +304,22 @@ void Api::installWithBody(httplib::Server& server, const std::string& method, co
 }
 
 void Api::status(const httplib::Request&, httplib::Response& res) {
+    int streams = 0;
+    {
+        std::lock_guard lock(mStreamMutex);
+        streams = mStreams;
+    }
     replyJson(res, 200,
               {{"format", "vitrine-serve/1"},
                {"device", mGpu.deviceName()},
                {"queued", mGpu.queued()},
+               {"max_queued", mGpu.maxQueued()},
+               {"busy", mGpu.busy()},
+               {"waiting_requests", mWaiting.load()},
+               {"max_waiting_requests", kMaxWaitingRequests},
+               {"event_streams", streams},
+               {"max_event_streams", kMaxEventStreams},
+               {"max_event_streams_per_client", kMaxEventStreamsPerClient},
                {"warm_graphs", mGpu.warmGraphs()},
                {"editor", fs::is_directory(mOptions.editorDist)}});
 }
@@ -328,12 +354,11 @@ void Api::install(httplib::Server& server) {
             [this, route](const httplib::Request& req, httplib::Response& res) { (this->*route)(req, res); });
     };
     server.Get("/api/status", bind(&Api::status));
-    server.Get("/api/nodes", guarded([](const httplib::Request&, httplib::Response& res) {
-                   // Byte for byte what `vitrine nodes --json` prints.
-                   res.set_content(NodeRegistry::global().toJson().dump(2) + "\n", "application/json");
+    server.Get("/api/nodes", guarded([this](const httplib::Request&, httplib::Response& res) {
+                   res.set_content(mNodesJson, "application/json");
                }));
-    server.Get("/api/schema", guarded([](const httplib::Request&, httplib::Response& res) {
-                   res.set_content(graphJsonSchema(NodeRegistry::global()).dump(2) + "\n", "application/json");
+    server.Get("/api/schema", guarded([this](const httplib::Request&, httplib::Response& res) {
+                   res.set_content(mSchemaJson, "application/json");
                }));
     server.Get("/api/graphs", bind(&Api::listGraphs));
     server.Get("/api/files", bind(&Api::listFiles));

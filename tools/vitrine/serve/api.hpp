@@ -130,9 +130,28 @@ private:
     EventHub& mEvents;
     ImageStore mImages;
     std::atomic<uint64_t> mJobs{0};
-    // Open /api/events streams, at most kMaxEventStreams of the server's 16 threads (serve_command.cpp).
-    static constexpr int kMaxEventStreams = 8;
-    std::atomic<int> mStreams{0};
+    // /api/nodes and /api/schema: the registry does not change while serving, so the answers are made once.
+    std::string mNodesJson;
+    std::string mSchemaJson;
+
+public:
+    // Request threads are the scarce resource: an open event stream holds one, and so does a request that waits for
+    // the GPU (a render without "async", validate, compare). Both are bounded so that, whatever clients do, threads
+    // stay free to answer status, nodes, files and refusals at once.
+    static constexpr int kMaxEventStreams = 8;          // open /api/events streams, all clients together
+    static constexpr int kMaxEventStreamsPerClient = 4; // ... and from one client address
+    static constexpr int kMaxWaitingRequests = 8;       // requests waiting on the GPU queue
+    static constexpr int kServerThreads = 32;           // the HTTP thread pool (serve_command.cpp)
+    static_assert(kServerThreads >= kMaxEventStreams + kMaxWaitingRequests + 8,
+                  "threads must be left for the quick routes");
+
+private:
+    // A slot of kMaxWaitingRequests for a request that waits on the GPU; throws the queue's 503 when none is free.
+    std::shared_ptr<void> waitSlot();
+    std::atomic<int> mWaiting{0};
+    std::mutex mStreamMutex;
+    int mStreams = 0;
+    std::map<std::string, int> mStreamsByClient; // remote address -> open streams
 };
 
 } // namespace vitrine::serve

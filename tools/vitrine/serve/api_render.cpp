@@ -24,6 +24,7 @@ namespace {
 constexpr uint32_t kMaxSide = 8192;
 constexpr uint64_t kMaxPixels = 4096ull * 4096ull;
 constexpr uint32_t kMaxFrames = 4096;
+constexpr int kKeepAliveSeconds = 3;
 
 // "display": "thumbnail": what a preview of any texture shows. A texture whose green and blue are zero everywhere
 // (a single-channel one: AO, depth, CoC) becomes grey; one with values above 1 (scene-referred HDR, hundreds of cd/m²)
@@ -258,6 +259,7 @@ void Api::validate(const httplib::Request& req, httplib::Response& res) {
             return;
         }
         PreparedGraph prepared = prepare(doc, "");
+        const auto slot = waitSlot();
         std::promise<nlohmann::json> done;
         std::future<nlohmann::json> result = done.get_future();
         mGpu.post([&] {
@@ -293,6 +295,8 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
     auto png = [thumb = display == "thumbnail"](const Image& image) {
         return pngString(thumb ? thumbnail(image) : image);
     };
+    // A render without "async" holds its request thread until the GPU is done: one of kMaxWaitingRequests.
+    const std::shared_ptr<void> slot = async ? nullptr : waitSlot();
     PreparedGraph prepared = prepare(request, "", Defaults{});
     const std::string job = newJobId();
     const std::string file = prepared.desc.file;
@@ -322,37 +326,48 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
             for (const auto& id : ids) mImages.fail(id, status, body);
             mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", stage}, {"error", body.value("error", "")}});
         };
-        mGpu.post(
-            [this, shared, job, ids, start, progress, fail, publishImages, file, png] {
-                try {
-                    RenderResult r = mGpu.renderNow(*shared, progress, nodeProgress(job, "render", file));
-                    if (shared->previews.empty())
-                        mImages.fulfil(ids[0], png(r.image), r.image.width, r.image.height);
-                    else
-                        publishImages(*shared, r, ids);
-                    mEvents.publish("job", {{"job", job},
-                                            {"kind", "render"},
-                                            {"stage", "done"},
-                                            {"image", ids[0]},
-                                            {"ms", msSince(start)},
-                                            {"warm", r.warm}});
-                } catch (const UserError& e) {
-                    fail(422, userErrorBody(e.what()), "error");
-                } catch (const std::exception& e) {
-                    fail(500, {{"error", std::string("internal error: ") + e.what()}}, "error");
-                }
-            },
-            tag,
-            [fail, tag] {
-                fail(409,
-                     {{"error", "superseded: a newer request with tag \"" + tag + "\" came before this one started"},
-                      {"superseded", true}},
-                     "superseded");
-            });
+        // A full queue refuses the job (503): its images fail with the same answer, so none is left pending.
+        try {
+            mGpu.post(
+                [this, shared, job, ids, start, progress, fail, publishImages, file, png] {
+                    try {
+                        RenderResult r = mGpu.renderNow(*shared, progress, nodeProgress(job, "render", file));
+                        if (shared->previews.empty())
+                            mImages.fulfil(ids[0], png(r.image), r.image.width, r.image.height);
+                        else
+                            publishImages(*shared, r, ids);
+                        mEvents.publish("job", {{"job", job},
+                                                {"kind", "render"},
+                                                {"stage", "done"},
+                                                {"image", ids[0]},
+                                                {"ms", msSince(start)},
+                                                {"warm", r.warm}});
+                    } catch (const UserError& e) {
+                        fail(422, userErrorBody(e.what()), "error");
+                    } catch (const std::exception& e) {
+                        fail(500, {{"error", std::string("internal error: ") + e.what()}}, "error");
+                    }
+                },
+                tag,
+                [fail, tag] {
+                    fail(
+                        409,
+                        {{"error", "superseded: a newer request with tag \"" + tag + "\" came before this one started"},
+                         {"superseded", true}},
+                        "superseded");
+                });
+        } catch (const HttpError& e) {
+            nlohmann::json body = e.detail();
+            body["error"] = e.what();
+            body["status"] = e.status();
+            fail(e.status(), body, "refused");
+            throw;
+        }
         nlohmann::json answer = {{"job", job}, {"image", ids[0]}, {"url", "/api/images/" + ids[0]}};
         if (!shared->previews.empty()) {
             nlohmann::json urls = nlohmann::json::object();
-            for (size_t i = 0; i < shared->previews.size(); ++i) urls[shared->previews[i]] = "/api/images/" + ids[i];
+            for (size_t i = 0; i < shared->previews.size(); ++i)
+                urls[shared->previews[i]] = "/api/images/" + ids[i];
             answer = {{"job", job}, {"images", urls}};
         }
         replyJson(res, 202, answer);
@@ -383,7 +398,11 @@ void Api::render(const httplib::Request& req, httplib::Response& res) {
         res.set_header("X-Vitrine-Height", std::to_string(r.image.height));
         res.set_content(png(r.image), "image/png");
     } catch (const HttpError& e) {
-        mEvents.publish("job", {{"job", job}, {"kind", "render"}, {"stage", e.status() == 409 ? "superseded" : "error"},
+        mEvents.publish("job", {{"job", job},
+                                {"kind", "render"},
+                                {"stage", e.status() == 409   ? "superseded"
+                                          : e.status() == 503 ? "refused"
+                                                              : "error"},
                                 {"error", e.what()}});
         throw;
     } catch (const std::exception& e) {
@@ -405,6 +424,7 @@ void Api::compare(const httplib::Request& req, httplib::Response& res) {
     defaults.output = optionalString(request, "output");
     compare::PairOptions options;
     options.hdr = optionalBool(request, "hdr", false);
+    const auto slot = waitSlot();
     PreparedGraph a = prepare(specOf(request["a"], "/a"), "/a", defaults);
     PreparedGraph b = prepare(specOf(request["b"], "/b"), "/b", defaults);
 
@@ -474,16 +494,32 @@ void Api::events(const httplib::Request& req, httplib::Response& res) {
         if (!last.empty() && last.size() < 19 && last.find_first_not_of("0123456789") == std::string::npos)
             after = std::stoull(last);
     }
-    // Each open stream holds one of the server's threads: past kMaxEventStreams a new one gets 503 (the editor tries
-    // again 5 s later), so that open tabs or scripts never starve the API of threads.
-    if (mStreams.fetch_add(1) >= kMaxEventStreams) {
-        --mStreams;
-        res.set_header("Retry-After", "5");
-        throw HttpError(503, "too many event streams open (" + std::to_string(kMaxEventStreams) +
-                                 "): close another editor tab, or retry");
+    // Each open stream holds one of the server's threads: past kMaxEventStreams (or kMaxEventStreamsPerClient from
+    // one address) a new one gets 503 (the editor tries again 5 s later), so that open tabs or scripts never starve
+    // the API of threads, and one client cannot take every stream.
+    const std::string client = req.remote_addr;
+    {
+        std::lock_guard lock(mStreamMutex);
+        const bool full = mStreams >= kMaxEventStreams;
+        if (full || mStreamsByClient[client] >= kMaxEventStreamsPerClient) {
+            if (mStreamsByClient[client] == 0) mStreamsByClient.erase(client);
+            throw HttpError(503,
+                            full ? "too many event streams open (" + std::to_string(kMaxEventStreams) +
+                                       "): close another editor tab, or retry"
+                                 : "too many event streams open from " + client + " (" +
+                                       std::to_string(kMaxEventStreamsPerClient) +
+                                       "): close another editor tab, or retry",
+                            {{"reason", "event-streams"}, {"retry_after", 5}});
+        }
+        ++mStreams;
+        ++mStreamsByClient[client];
     }
     // Frees the slot when the response (and the provider holding this) goes away, however the stream ends.
-    auto slot = std::shared_ptr<void>(nullptr, [this](void*) { --mStreams; });
+    auto slot = std::shared_ptr<void>(nullptr, [this, client](void*) {
+        std::lock_guard lock(mStreamMutex);
+        --mStreams;
+        if (--mStreamsByClient[client] <= 0) mStreamsByClient.erase(client);
+    });
     res.set_header("Cache-Control", "no-store");
     EventHub* hub = &mEvents;
     auto first = std::make_shared<bool>(true);
@@ -493,12 +529,13 @@ void Api::events(const httplib::Request& req, httplib::Response& res) {
             const std::string hello = "retry: 2000\nevent: hello\ndata: {}\n\n";
             return sink.write(hello.data(), hello.size());
         }
-        std::vector<Event> events = hub->waitAfter(after, std::chrono::seconds(15));
+        std::vector<Event> events = hub->waitAfter(after, std::chrono::seconds(kKeepAliveSeconds));
         if (hub->closed()) {
             sink.done();
             return true;
         }
-        // A comment line every 15 s without events: a client that went away shows up as a failed write.
+        // A comment line every kKeepAliveSeconds without events: a client that went away shows up as a failed write
+        // (the second after it left), which frees its stream slot and thread.
         std::string text = events.empty() ? std::string(": keep-alive\n\n") : std::string();
         for (const Event& e : events) {
             text += EventHub::format(e);

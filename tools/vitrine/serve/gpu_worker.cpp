@@ -5,6 +5,10 @@
 #include "core/graph/executor.hpp"
 #include "tools/vitrine/serve/http_util.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
 namespace vitrine::serve {
 
 struct WarmGraphs::Entry {
@@ -54,7 +58,8 @@ void WarmGraphs::clear() {
     mEntries.clear();
 }
 
-GpuWorker::GpuWorker(const ContextOptions& options, size_t warmGraphs) : mOptions(options), mWarmCapacity(warmGraphs) {
+GpuWorker::GpuWorker(const ContextOptions& options, size_t warmGraphs, size_t maxQueued)
+    : mOptions(options), mWarmCapacity(warmGraphs), mMaxQueued(maxQueued) {
     std::promise<void> ready;
     std::future<void> started = ready.get_future();
     mThread = std::thread([this, &ready] {
@@ -96,11 +101,39 @@ size_t GpuWorker::queued() const {
     return mJobs.size();
 }
 
+namespace {
+
+int retryAfter(double meanJobSeconds, size_t queued) {
+    return static_cast<int>(std::clamp(std::ceil(meanJobSeconds * static_cast<double>(queued + 1)), 1.0, 60.0));
+}
+
+} // namespace
+
+int GpuWorker::retryAfterSeconds() const {
+    return retryAfter(mMeanJobSeconds.load(), queued());
+}
+
+HttpError GpuWorker::queueFull() const {
+    return fullError(queued());
+}
+
+HttpError GpuWorker::fullError(size_t queued) const {
+    const int seconds = retryAfter(mMeanJobSeconds.load(), queued);
+    return HttpError(503,
+                     "the GPU is busy: " + std::to_string(queued) + " jobs wait already (at most " +
+                         std::to_string(mMaxQueued) + ", --max-queue); retry in " + std::to_string(seconds) + " s",
+                     {{"reason", "queue-full"}, {"retry_after", seconds}, {"queued", queued}});
+}
+
 void GpuWorker::post(std::function<void()> job, const std::string& tag, std::function<void()> cancel) {
     std::vector<std::function<void()>> superseded;
     {
         std::lock_guard lock(mMutex);
         if (mStopping) throw InternalError("vitrine serve is stopping; the GPU queue takes no more work");
+        // A job that replaces a queued one with its tag takes that one's place.
+        const size_t replaced =
+            tag.empty() ? 0 : std::count_if(mJobs.begin(), mJobs.end(), [&](const Job& j) { return j.tag == tag; });
+        if (mJobs.size() - replaced >= mMaxQueued) throw fullError(mJobs.size());
         if (!tag.empty())
             std::erase_if(mJobs, [&](Job& queued) {
                 if (queued.tag != tag) return false;
@@ -122,8 +155,13 @@ void GpuWorker::loop() {
             if (mJobs.empty()) break; // stopping, and every job posted before has run
             job = std::move(mJobs.front().run);
             mJobs.pop_front();
+            mBusy = true;
         }
+        const auto start = std::chrono::steady_clock::now();
         job();
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        mMeanJobSeconds = 0.75 * mMeanJobSeconds.load() + 0.25 * seconds;
+        mBusy = false;
     }
     mWarm.reset();
     mShaders.reset();
