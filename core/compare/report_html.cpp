@@ -42,6 +42,7 @@ figcaption { margin-top: 6px; font-weight: 600; }
 .colorbar { width: 320px; height: 14px; border-radius: 2px; }
 .ticks { width: 320px; display: flex; justify-content: space-between; font-size: 12px; color: var(--dim); }
 table { border-collapse: collapse; background: var(--panel); }
+.table-scroll { max-width: 100%; overflow-x: auto; }
 th, td { padding: 5px 10px; border-bottom: 1px solid #333; text-align: right; white-space: nowrap; }
 th:first-child, td:first-child { text-align: left; }
 th { color: var(--dim); font-weight: 600; }
@@ -360,7 +361,8 @@ std::string renderReportHtml(const ReportInput& input) {
     }
 
     html += "<section id=\"metrics\"><h2>Metrics</h2>\n";
-    html += input.metrics.empty() ? "<p class=\"dim\">No metrics were computed.</p>\n" : metricsTable(input.metrics);
+    html += input.metrics.empty() ? "<p class=\"dim\">No metrics were computed.</p>\n"
+                                  : "<div class=\"table-scroll\">" + metricsTable(input.metrics) + "</div>\n";
     if (input.noiseFloor) html += noiseFloorSection(*input.noiseFloor);
     if (!input.temporal.empty()) html += "<h3>Temporal</h3>\n" + temporalTable(input.temporal);
     html += "</section>\n";
