@@ -76,7 +76,7 @@ commands:
       per point still to do (this vitrine binary, DIR on a folder every node sees), and a dependent job running
       --collect; squeue state shown while waiting. Options also from the sweep file's "slurm" block.
   sweep --collect DIR               Gather DIR/points/*/metrics.json into sweep.json, sweep.csv, report.html.
-  cache ls                          The bake cache (BVHs, lightmaps, references): kind, size, age, total.
+  cache ls                          The bake cache (BVHs, lightmaps, probes, ...): kind, size, age, total.
   cache rm NAME...|--all            Remove entries by the names `cache ls` prints (or a whole KIND); only
                                     files inside the bake cache folder. Cache folder: $VITRINE_CACHE_DIR,
                                     else $XDG_CACHE_HOME/vitrine, else ~/.cache/vitrine.
