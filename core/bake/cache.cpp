@@ -5,8 +5,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 
@@ -93,6 +95,46 @@ bool BakeCache::put(const BakeKey& key, std::span<const uint8_t> bytes) const {
         return false;
     }
     return true;
+}
+
+std::vector<BakeEntry> BakeCache::list() const {
+    std::vector<BakeEntry> entries;
+    std::error_code ec;
+    if (!fs::is_directory(mDir, ec)) return entries;
+    for (auto it = fs::recursive_directory_iterator(mDir, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec)) {
+        std::error_code fileEc;
+        if (!it->is_regular_file(fileEc)) continue;
+        BakeEntry e;
+        e.path = it->path();
+        e.name = fs::relative(e.path, mDir, fileEc).generic_string();
+        const fs::path relative(e.name);
+        e.kind = std::distance(relative.begin(), relative.end()) > 1 ? relative.begin()->string() : std::string();
+        e.bytes = it->file_size(fileEc);
+        e.modified = it->last_write_time(fileEc);
+        const std::string file = e.path.filename().string();
+        if (file.find(".tmp") != std::string::npos) {
+            e.problem = "temporary file of an interrupted write";
+        } else if (e.kind.empty()) {
+            e.problem = "not in a kind folder";
+        } else {
+            Header h{};
+            std::ifstream in(e.path, std::ios::binary);
+            char* end = nullptr;
+            const unsigned long long hash = std::strtoull(e.path.stem().string().c_str(), &end, 16);
+            if (!in.read(reinterpret_cast<char*>(&h), sizeof h))
+                e.problem = "shorter than the 32-byte header";
+            else if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0)
+                e.problem = "not a bake cache file (no VTBAKE01 magic)";
+            else if (e.path.extension() != ".bin" || *end != '\0' || h.key != hash)
+                e.problem = "the header's key is not the file name's";
+            else if (h.size != e.bytes - sizeof(Header))
+                e.problem = "truncated (the header says " + std::to_string(h.size) + " payload bytes)";
+        }
+        entries.push_back(std::move(e));
+    }
+    std::sort(entries.begin(), entries.end(), [](const BakeEntry& a, const BakeEntry& b) { return a.name < b.name; });
+    return entries;
 }
 
 } // namespace vitrine

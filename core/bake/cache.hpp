@@ -19,6 +19,19 @@ struct BakeKey {
     uint64_t hash = 0; // of all inputs: the scene's content hash, the baker's format version, its parameters
 };
 
+// One file of the cache as `vitrine cache ls` shows it.
+struct BakeEntry {
+    std::filesystem::path path; // the file
+    std::string name;           // relative to the cache's dir(): "<kind>/<hash>.bin"
+    std::string kind;           // the folder it is in
+    uint64_t bytes = 0;         // the whole file, header included
+    std::filesystem::file_time_type modified;
+    // Empty for a well-formed entry: the 32-byte header's magic is right, its key is the hash in the file name and
+    // its size is the file's (the payload's checksum is not read here; get() checks it). Otherwise what is wrong,
+    // e.g. "temporary file of an interrupted write".
+    std::string problem;
+};
+
 class BakeCache {
 public:
     // Results live in root/bake/<kind>/<hash>.bin. root: defaultCacheDir() (core/shader/compiler.hpp) for
@@ -33,6 +46,10 @@ public:
     // renamed, so a concurrent reader sees the old file or the new one, never a partial one. Returns false
     // (and leaves no temporary behind) when the cache cannot be written: the result is then just not cached.
     bool put(const BakeKey& key, std::span<const uint8_t> bytes) const;
+
+    // Every file under dir() (entries, damaged entries, leftover temporaries), sorted by name; empty when the
+    // folder does not exist.
+    std::vector<BakeEntry> list() const;
 
     std::filesystem::path pathOf(const BakeKey& key) const;
     const std::filesystem::path& dir() const { return mDir; }

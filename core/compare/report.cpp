@@ -94,6 +94,37 @@ nlohmann::json imageJson(const ReportImage& image) {
     return {{"label", image.label}, {"width", image.width}, {"height", image.height}};
 }
 
+nlohmann::json flipJson(const FlipStatistics& flip, bool hdr, double pixelsPerDegree) {
+    return {{"mode", hdr ? "hdr" : "ldr"},
+            {"pixelsPerDegree", pixelsPerDegree},
+            {"mean", flip.mean},
+            {"weightedMedian", flip.weightedMedian},
+            {"q1", flip.q1},
+            {"q3", flip.q3},
+            {"min", flip.minimum},
+            {"max", flip.maximum}};
+}
+
+nlohmann::json blocksJson(const BlockRatioStatistics& b) {
+    return {{"size", b.blockSize},          {"blocksX", b.blocksX},
+            {"blocksY", b.blocksY},         {"lit", b.litBlocks},
+            {"dark", b.darkBlocks},         {"floor", b.floor},
+            {"tolerance", kBlockTolerance}, {"withinShare", b.withinShare},
+            {"meanAbsLog2", b.meanAbsLog2}, {"meanAbsRelative", b.meanAbsRelative}};
+}
+
+const char* statusName(NoiseFloor::Status status) {
+    switch (status) {
+    case NoiseFloor::Status::Measured:
+        return "measured";
+    case NoiseFloor::Status::Unknown:
+        return "unknown";
+    case NoiseFloor::Status::Skipped:
+        return "skipped";
+    }
+    return "unknown";
+}
+
 } // namespace
 
 PairComparison comparePair(const std::string& testLabel, const Image& test, const std::string& referenceLabel,
@@ -116,6 +147,8 @@ PairComparison comparePair(const std::string& testLabel, const Image& test, cons
     }
     m.flip = flip;
     result.flipErrorMap = std::move(flip.errorMap);
+    result.blockRatio = blockLuminanceRatio(test, reference);
+    m.blocks = result.blockRatio;
     return result;
 }
 
@@ -132,6 +165,7 @@ nlohmann::json metricsJson(const ReportInput& input) {
     doc["title"] = input.title;
     doc["images"] = {{"a", imageJson(input.a)}, {"b", imageJson(input.b)}};
     if (input.reference) doc["images"]["reference"] = imageJson(*input.reference);
+    if (input.referenceHalf) doc["images"]["referenceHalf"] = imageJson(*input.referenceHalf);
 
     doc["pairs"] = nlohmann::json::array();
     for (const PairMetrics& m : input.metrics) {
@@ -140,16 +174,23 @@ nlohmann::json metricsJson(const ReportInput& input) {
             {"reference", m.reference},
             {"psnr", finiteOrNull(m.psnr)},
             {"ssim", m.ssim},
-            {"flip",
-             {{"mode", m.hdrFlip ? "hdr" : "ldr"},
-              {"pixelsPerDegree", m.pixelsPerDegree},
-              {"mean", m.flip.mean},
-              {"weightedMedian", m.flip.weightedMedian},
-              {"q1", m.flip.q1},
-              {"q3", m.flip.q3},
-              {"min", m.flip.minimum},
-              {"max", m.flip.maximum}}},
+            {"flip", flipJson(m.flip, m.hdrFlip, m.pixelsPerDegree)},
+            {"blocks", blocksJson(m.blocks)},
+            {"withinReferenceNoise",
+             m.withinReferenceNoise ? nlohmann::json(*m.withinReferenceNoise) : nlohmann::json(nullptr)},
         });
+    }
+
+    doc["noiseFloor"] = nullptr;
+    if (input.noiseFloor) {
+        const NoiseFloor& n = *input.noiseFloor;
+        nlohmann::json floor = {{"status", statusName(n.status)}, {"reason", n.reason}, {"factor", n.factor}};
+        if (n.status == NoiseFloor::Status::Measured && n.pair) {
+            floor["half"] = n.pair->test;
+            floor["flip"] = flipJson(n.pair->flip, n.pair->hdrFlip, n.pair->pixelsPerDegree);
+            floor["blocks"] = blocksJson(n.pair->blocks);
+        }
+        doc["noiseFloor"] = std::move(floor);
     }
 
     doc["temporal"] = nlohmann::json::array();

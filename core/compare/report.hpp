@@ -1,5 +1,6 @@
 #pragma once
 
+#include "core/compare/blocks.hpp"
 #include "core/compare/metrics.hpp"
 
 #include <nlohmann/json.hpp>
@@ -24,7 +25,7 @@ struct ReportImage {
     int height = 0;
 };
 
-// PSNR, SSIM and FLIP of one image against another.
+// PSNR, SSIM, FLIP and the block luminance ratio of one image against another.
 struct PairMetrics {
     std::string test;      // label of the image judged, e.g. "A"
     std::string reference; // label of what it is judged against, e.g. "B" or "reference"
@@ -33,6 +34,29 @@ struct PairMetrics {
     FlipStatistics flip;
     bool hdrFlip = false; // HDR-FLIP (scene-referred inputs) rather than LDR-FLIP
     double pixelsPerDegree = kDefaultPixelsPerDegree;
+    BlockRatioStatistics blocks; // test / reference, per 16×16 block (core/compare/blocks.hpp)
+    // Against the reference, when its noise floor was measured: FLIP mean <= kNoiseFloorFactor × the floor's FLIP
+    // mean. Unset for pairs not against the reference and when the floor is unknown or was skipped.
+    std::optional<bool> withinReferenceNoise;
+};
+
+// A pair whose FLIP mean is at most this many times the noise floor's is "within reference noise".
+inline constexpr double kNoiseFloorFactor = 1.5;
+
+// The noise of the reference itself: FLIP (and the block measure) between the reference and a second, independent
+// reference half (the same graph with every render.pathtrace node's seed changed, or a --reference-half file).
+struct NoiseFloor {
+    enum class Status { Measured, Unknown, Skipped };
+    Status status = Status::Unknown;
+    std::string reason; // why Unknown or Skipped; how the second half was made when Measured
+    double factor = kNoiseFloorFactor;
+    // Measured only: the second half (test) against the reference; pair->flip.mean is the noise floor.
+    std::optional<PairMetrics> pair;
+
+    // flipMean <= factor × the floor's FLIP mean; false unless Measured.
+    bool contains(double flipMean) const {
+        return status == Status::Measured && pair && flipMean <= factor * pair->flip.mean;
+    }
 };
 
 struct PairOptions {
@@ -43,10 +67,12 @@ struct PairOptions {
 
 struct PairComparison {
     PairMetrics metrics;
-    Image flipErrorMap; // for flipColorMap() and the report
+    Image flipErrorMap;          // for flipColorMap() and the report
+    BlockRatioResult blockRatio; // for blockRatioHeatMap() and the report
 };
 
-// Runs the three metrics on one pair; FLIP treats `reference` as the paper's reference image.
+// Runs the metrics on one pair; FLIP treats `reference` as the paper's reference image, and the block ratio is
+// test / reference.
 PairComparison comparePair(const std::string& testLabel, const Image& test, const std::string& referenceLabel,
                            const Image& reference, const PairOptions& options = {});
 
@@ -80,9 +106,12 @@ struct ReportInput {
     ReportImage a;
     ReportImage b;
     std::optional<ReportImage> reference;
-    std::vector<ReportImage> differenceMaps; // e.g. falseColor(absoluteDifference(A, B), …) as PNG
-    std::vector<ReportImage> flipMaps;       // flipColorMap() of FLIP error maps as PNG; shown with a colour bar
-    std::vector<PairMetrics> metrics;        // A vs B, A vs R, B vs R …
+    std::vector<ReportImage> differenceMaps;  // e.g. falseColor(absoluteDifference(A, B), …) as PNG
+    std::vector<ReportImage> flipMaps;        // flipColorMap() of FLIP error maps as PNG; shown with a colour bar
+    std::vector<ReportImage> blockMaps;       // blockRatioHeatMap() of each pair as PNG; shown with a colour bar
+    std::optional<ReportImage> referenceHalf; // the second reference half, when the noise floor was measured
+    std::vector<PairMetrics> metrics;         // A vs B, A vs R, B vs R …
+    std::optional<NoiseFloor> noiseFloor;     // set whenever there is a reference
     std::vector<TemporalMetrics> temporal;
     nlohmann::json graphA; // graph documents for "what differs"; null when not known
     nlohmann::json graphB;
@@ -98,12 +127,24 @@ void writeReport(const std::filesystem::path& path, const ReportInput& input);
 // {
 //   "format": "vitrine-compare/1",
 //   "title": string,
-//   "images": {"a": IMAGE, "b": IMAGE, "reference": IMAGE (only with a reference)},
+//   "images": {"a": IMAGE, "b": IMAGE, "reference": IMAGE (only with a reference),
+//              "referenceHalf": IMAGE (only when the noise floor was measured)},
 //             IMAGE = {"label": string, "width": int, "height": int}
 //   "pairs": [{"test": label, "reference": label,
 //              "psnr": number | null (null: identical images, PSNR = +inf), "ssim": number,
-//              "flip": {"mode": "ldr" | "hdr", "pixelsPerDegree": number, "mean": number,
-//                       "weightedMedian": number, "q1": number, "q3": number, "min": number, "max": number}}],
+//              "flip": FLIP,
+//              "blocks": BLOCKS (test / reference),
+//              "withinReferenceNoise": bool | null (null: not a pair against the reference, or no noise floor)}],
+//             FLIP = {"mode": "ldr" | "hdr", "pixelsPerDegree": number, "mean": number,
+//                     "weightedMedian": number, "q1": number, "q3": number, "min": number, "max": number}
+//             BLOCKS = {"size": int (px, 16), "blocksX": int, "blocksY": int, "lit": int, "dark": int,
+//                       "floor": number (absolute luminance: 1 % of the reference's mean luminance),
+//                       "tolerance": 0.15, "withinShare": number (share of lit blocks with |ratio - 1| <= 0.15),
+//                       "meanAbsLog2": number (stops), "meanAbsRelative": number (mean |ratio - 1|)}
+//   "noiseFloor": null (no reference) |
+//                 {"status": "measured" | "unknown" | "skipped", "reason": string, "factor": 1.5,
+//                  "half": label (measured only), "flip": FLIP (measured only: reference half vs reference),
+//                  "blocks": BLOCKS (measured only)},
 //   "temporal": [{"label": string, "frames": int, "flicker": number,
 //                 "flickerMotionCompensated": number | null (null: no velocities),
 //                 "errorPerFrame": {"metric": "psnr" | "flip-mean", "values": [number | null, …]}}],

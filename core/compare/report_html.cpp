@@ -1,6 +1,7 @@
 #include "core/compare/report.hpp"
 
 #include "core/base/error.hpp"
+#include "core/compare/blocks.hpp"
 #include "core/compare/magma.hpp"
 
 #include <algorithm>
@@ -41,6 +42,7 @@ figcaption { margin-top: 6px; font-weight: 600; }
 .colorbar { width: 320px; height: 14px; border-radius: 2px; }
 .ticks { width: 320px; display: flex; justify-content: space-between; font-size: 12px; color: var(--dim); }
 table { border-collapse: collapse; background: var(--panel); }
+.table-scroll { max-width: 100%; overflow-x: auto; }
 th, td { padding: 5px 10px; border-bottom: 1px solid #333; text-align: right; white-space: nowrap; }
 th:first-child, td:first-child { text-align: left; }
 th { color: var(--dim); font-weight: 600; }
@@ -50,6 +52,8 @@ ul.changes li { padding: 4px 0; border-bottom: 1px solid #2a2a2a; }
 .op.added { color: #7bd88f; } .op.removed { color: #fc6a6a; } .op.changed { color: var(--accent); }
 code { font-family: ui-monospace, Menlo, Consolas, monospace; font-size: 13px; }
 code.old { color: #fc9a9a; } code.new { color: #9ae6a8; }
+.noise { font-size: 12px; font-weight: 700; padding: 1px 6px; border-radius: 3px; }
+.noise.within { background: #2f5d3a; color: #c9f2d2; } .noise.beyond { background: #5d2f2f; color: #f2c9c9; }
 svg.spark polyline { fill: none; stroke: var(--accent); stroke-width: 1.5; }
 )css";
 
@@ -144,6 +148,50 @@ std::string colorBar() {
            "</span><span>0.5</span><span>0.75</span><span>1</span></div>\n";
 }
 
+// Blue (darker) – white – red (brighter), as blockRatioHeatMap() colours blocks.
+std::string blockColorBar() {
+    std::string gradient = "linear-gradient(to right";
+    constexpr int kStops = 8;
+    for (int i = 0; i <= kStops; ++i) {
+        const SrgbColor c = blockRatioColor(-1.0 + 2.0 * i / kStops);
+        gradient += ", " + hexColor({static_cast<float>(c.r), static_cast<float>(c.g), static_cast<float>(c.b)}) + " " +
+                    number(100.0 * i / kStops, 2) + "%";
+    }
+    gradient += ")";
+    const SrgbColor grey = blockRatioColor(std::nan(""));
+    return "<div class=\"colorbar\" style=\"background: " + gradient +
+           "\" title=\"log2(test / reference) of block luminance, -1 stop (left) to +1 stop (right)\"></div>\n"
+           "<div class=\"ticks\"><span>&minus;1 stop (darker)</span><span>0</span><span>+1 stop (brighter)</span>"
+           "</div>\n<p class=\"dim\">Mean luminance of each " +
+           std::to_string(kBlockSize) + "&times;" + std::to_string(kBlockSize) +
+           " px block, test over reference, saturated at &plusmn;1 stop; <span style=\"color: " +
+           hexColor({static_cast<float>(grey.r), static_cast<float>(grey.g), static_cast<float>(grey.b)}) +
+           "\">&#9632;</span> grey: both below the luminance floor (black).</p>\n";
+}
+
+std::string noiseBadge(const PairMetrics& m) {
+    if (!m.withinReferenceNoise) return "";
+    return *m.withinReferenceNoise ? "<span class=\"noise within\">within reference noise</span>"
+                                   : "<span class=\"noise beyond\">beyond reference noise</span>";
+}
+
+std::string noiseFloorSection(const NoiseFloor& n) {
+    std::string html = "<p id=\"noise-floor\">Noise floor: ";
+    if (n.status == NoiseFloor::Status::Measured && n.pair) {
+        html += "FLIP mean <b>" + number(n.pair->flip.mean, 5) + "</b> between the reference and " +
+                escapeHtml(n.pair->test) + " (" + escapeHtml(n.reason) + "); blocks within &plusmn;" +
+                number(100.0 * kBlockTolerance, 0) + " %: " + number(100.0 * n.pair->blocks.withinShare, 1) +
+                " %, mean |log2 ratio| " + number(n.pair->blocks.meanAbsLog2, 4) +
+                ". Pairs against the reference whose FLIP mean is at most " + number(n.factor, 1) +
+                "&times; the floor (" + number(n.factor * n.pair->flip.mean, 5) +
+                ") are within reference noise: FLIP cannot tell them from the reference.";
+    } else {
+        html += std::string(n.status == NoiseFloor::Status::Skipped ? "skipped" : "unknown") + " (" +
+                escapeHtml(n.reason) + ").";
+    }
+    return html + "</p>\n";
+}
+
 std::string splitSection(const std::vector<std::pair<std::string, const ReportImage*>>& images) {
     std::string options;
     for (size_t i = 0; i < images.size(); ++i) {
@@ -169,14 +217,16 @@ std::string splitSection(const std::vector<std::pair<std::string, const ReportIm
 std::string metricsTable(const std::vector<PairMetrics>& metrics) {
     std::string html = "<table><thead><tr><th>Pair</th><th>PSNR (dB)</th><th>SSIM</th><th>FLIP mean</th>"
                        "<th>FLIP weighted median</th><th>FLIP Q1</th><th>FLIP Q3</th><th>FLIP min</th>"
-                       "<th>FLIP max</th><th>FLIP variant</th></tr></thead><tbody>\n";
+                       "<th>FLIP max</th><th>FLIP variant</th><th>Blocks within &plusmn;15 %</th>"
+                       "<th>Mean |log2 block ratio|</th><th>Reference noise</th></tr></thead><tbody>\n";
     for (const PairMetrics& m : metrics) {
         html += "<tr><td>" + escapeHtml(m.test) + " vs " + escapeHtml(m.reference) + "</td><td>" + number(m.psnr, 2) +
                 "</td><td>" + number(m.ssim, 5) + "</td><td>" + number(m.flip.mean, 5) + "</td><td>" +
                 number(m.flip.weightedMedian, 5) + "</td><td>" + number(m.flip.q1, 5) + "</td><td>" +
                 number(m.flip.q3, 5) + "</td><td>" + number(m.flip.minimum, 5) + "</td><td>" +
                 number(m.flip.maximum, 5) + "</td><td>" + (m.hdrFlip ? "HDR" : "LDR") + ", " +
-                number(m.pixelsPerDegree, 1) + " ppd</td></tr>\n";
+                number(m.pixelsPerDegree, 1) + " ppd</td><td>" + number(100.0 * m.blocks.withinShare, 1) +
+                " %</td><td>" + number(m.blocks.meanAbsLog2, 4) + "</td><td>" + noiseBadge(m) + "</td></tr>\n";
     }
     return html + "</tbody></table>\n";
 }
@@ -263,6 +313,10 @@ std::string renderReportHtml(const ReportInput& input) {
 
     std::vector<std::pair<std::string, const ReportImage*>> images = {{"img-a", &input.a}, {"img-b", &input.b}};
     if (input.reference) images.emplace_back("img-reference", &*input.reference);
+    if (input.reference && input.referenceHalf) {
+        requirePng(*input.referenceHalf, "reference half");
+        images.emplace_back("img-reference-half", &*input.referenceHalf);
+    }
 
     const std::string title = escapeHtml(input.title);
     std::string html = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
@@ -277,7 +331,7 @@ std::string renderReportHtml(const ReportInput& input) {
 
     html += splitSection(images);
 
-    if (!input.differenceMaps.empty() || !input.flipMaps.empty()) {
+    if (!input.differenceMaps.empty() || !input.flipMaps.empty() || !input.blockMaps.empty()) {
         html += "<section id=\"errors\"><h2>Error maps</h2>\n";
         if (!input.differenceMaps.empty()) {
             html += "<h3>Absolute difference</h3>\n<div class=\"row\">\n";
@@ -295,11 +349,21 @@ std::string renderReportHtml(const ReportInput& input) {
             }
             html += "</div>\n" + colorBar();
         }
+        if (!input.blockMaps.empty()) {
+            html += "<h3>Block luminance ratio</h3>\n<div class=\"row\">\n";
+            for (size_t i = 0; i < input.blockMaps.size(); ++i) {
+                requirePng(input.blockMaps[i], "block ratio map");
+                html += card(input.blockMaps[i], "img-blocks-" + std::to_string(i));
+            }
+            html += "</div>\n" + blockColorBar();
+        }
         html += "</section>\n";
     }
 
     html += "<section id=\"metrics\"><h2>Metrics</h2>\n";
-    html += input.metrics.empty() ? "<p class=\"dim\">No metrics were computed.</p>\n" : metricsTable(input.metrics);
+    html += input.metrics.empty() ? "<p class=\"dim\">No metrics were computed.</p>\n"
+                                  : "<div class=\"table-scroll\">" + metricsTable(input.metrics) + "</div>\n";
+    if (input.noiseFloor) html += noiseFloorSection(*input.noiseFloor);
     if (!input.temporal.empty()) html += "<h3>Temporal</h3>\n" + temporalTable(input.temporal);
     html += "</section>\n";
 

@@ -39,5 +39,6 @@ int exportSceneCommand(const Args& args);
 int jitterCommand(const Args& args);
 int serveCommand(const Args& args);
 int sweepCommand(const Args& args);
+int cacheCommand(const Args& args);
 
 } // namespace vitrine::cli

@@ -1,6 +1,7 @@
-// `vitrine compare A B [--reference R]`: renders graphs or loads images, computes PSNR, SSIM and FLIP (and, over
-// --frames a:b, flicker and error per frame), writes the images, heat maps, metrics.json and one self-contained
-// report.html. The metrics and the report come from core/compare; this file only gathers the inputs.
+// `vitrine compare A B [--reference R]`: renders graphs or loads images, computes PSNR, SSIM, FLIP and the block
+// luminance ratio (and, over --frames a:b, flicker and error per frame), with a reference also its noise floor (FLIP
+// between the reference and a second, independently seeded half), writes the images, heat maps, metrics.json and one
+// self-contained report.html. The metrics and the report come from core/compare; this file only gathers the inputs.
 #include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
@@ -127,6 +128,46 @@ compare::ReportImage writeImage(OutputDir& out, const std::string& name, const s
     return r;
 }
 
+// The noise floor's second reference half: --reference-half FILE, or the reference graph with the seed of every
+// render.pathtrace node moved on by one. Empty (with `reason` set) when there is none.
+std::optional<Input> referenceHalf(const Input& reference, const Args& args, uint32_t frames,
+                                   compare::NoiseFloor& floor) {
+    if (args.has("no-noise-floor")) {
+        floor.status = compare::NoiseFloor::Status::Skipped;
+        floor.reason = "--no-noise-floor";
+        return std::nullopt;
+    }
+    if (args.has("reference-half")) {
+        Input half = openInput("reference half", "reference_half", args.get("reference-half"), args, frames);
+        floor.reason = "--reference-half " + half.path.string();
+        return half;
+    }
+    if (!reference.graph) {
+        floor.reason = "the reference is an image file; pass --reference-half FILE, an independent render of it";
+        return std::nullopt;
+    }
+    Input half = reference;
+    half.role = "reference half";
+    half.key = "reference_half";
+    std::string changed;
+    for (NodeDecl& node : half.graph->nodes) {
+        if (!node.schema || node.schema->type != "render.pathtrace") continue;
+        const int64_t seed = node.params.value("seed", int64_t(0));
+        const int64_t next = seed >= 2147483647 ? 0 : seed + 1; // the param's range is [0, 2^31 - 1]
+        node.params["seed"] = next;
+        half.graph->document["nodes"][node.id]["params"]["seed"] = next;
+        changed += (changed.empty() ? "" : ", ") + node.id + ".params.seed " + std::to_string(seed) + " -> " +
+                   std::to_string(next);
+    }
+    if (changed.empty()) {
+        floor.reason = "the reference graph has no render.pathtrace node to re-seed; pass --reference-half FILE, an "
+                       "independent render of it";
+        return std::nullopt;
+    }
+    floor.reason = "the reference graph with " + changed;
+    return half;
+}
+
 std::string formatPsnr(double psnr) {
     char buffer[32];
     if (std::isfinite(psnr))
@@ -149,9 +190,21 @@ int compareCommand(const Args& args) {
         reference = openInput("reference", "reference", args.get("reference"), args, askedFrames);
     std::vector<Input*> inputs = {&a, &b};
     if (reference) inputs.push_back(&*reference);
+    if (!reference && (args.has("reference-half") || args.has("no-noise-floor")))
+        throw UserError(std::string(args.has("reference-half") ? "--reference-half" : "--no-noise-floor") +
+                        ": expected --reference R too (the noise floor is the reference's own noise)");
+    std::optional<compare::NoiseFloor> noiseFloor;
+    std::optional<Input> half;
+    if (reference) {
+        noiseFloor.emplace();
+        half = referenceHalf(*reference, args, askedFrames, *noiseFloor);
+    }
+    // Rendered and compared as a still, never part of the temporal metrics.
+    std::vector<Input*> rendered = inputs;
+    if (half) rendered.push_back(&*half);
 
     uint32_t graphFrames = 1;
-    for (const Input* in : inputs)
+    for (const Input* in : rendered)
         if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
     const FrameRange range = frameRange(args, graphFrames);
     const bool hdr = args.has("hdr");
@@ -176,9 +229,13 @@ int compareCommand(const Args& args) {
     std::vector<std::string> names = {"a.png",        "a.exr",        "b.png",        "b.exr",        "diff_a_b.png",
                                       "diff_a_b.exr", "flip_a_b.png", "flip_a_b.exr", "metrics.json", "report.html"};
     if (reference)
-        names.insert(names.end(),
-                     {"reference.png", "reference.exr", "diff_a_reference.png", "diff_b_reference.png",
-                      "flip_a_reference.png", "flip_a_reference.exr", "flip_b_reference.png", "flip_b_reference.exr"});
+        names.insert(names.end(), {"reference.png", "reference.exr", "diff_a_reference.png", "diff_b_reference.png",
+                                   "flip_a_reference.png", "flip_a_reference.exr", "flip_b_reference.png",
+                                   "flip_b_reference.exr", "blocks_a_reference.png", "blocks_b_reference.png"});
+    names.push_back("blocks_a_b.png");
+    if (half)
+        names.insert(names.end(), {"reference_half.png", "reference_half.exr", "flip_reference_half.png",
+                                   "flip_reference_half.exr", "blocks_reference_half.png"});
     const std::string defaultOut =
         (fs::path("out") / "compare" / (a.path.stem().string() + "_vs_" + b.path.stem().string())).string();
     OutputDir out(args.get("out", defaultOut), args.has("force") || args.has("overwrite"));
@@ -190,12 +247,12 @@ int compareCommand(const Args& args) {
     std::unique_ptr<Context> ctx;
     std::unique_ptr<ShaderCompiler> shaders;
     uint32_t frameCount = range.last + 1;
-    for (const Input* in : inputs)
+    for (const Input* in : rendered)
         if (in->graph) frameCount = std::max(frameCount, in->graph->frame.frames);
     std::vector<uint32_t> wanted;
     for (uint32_t f = range.first; f <= range.last; ++f)
         wanted.push_back(f);
-    for (Input* in : inputs) {
+    for (Input* in : rendered) {
         if (in->graph) {
             if (!ctx) {
                 ctx = std::make_unique<Context>(contextOptions(args));
@@ -216,6 +273,7 @@ int compareCommand(const Args& args) {
     }
     requireSameSize(a, b);
     if (reference) requireSameSize(a, *reference);
+    if (half) requireSameSize(*reference, *half);
 
     logInfo("computing metrics");
     compare::PairOptions pairOptions;
@@ -231,6 +289,7 @@ int compareCommand(const Args& args) {
     report.a = writeImage(out, "a", label(a), a.still, true);
     report.b = writeImage(out, "b", label(b), b.still, true);
     if (reference) report.reference = writeImage(out, "reference", label(*reference), reference->still, true);
+    if (half) report.referenceHalf = writeImage(out, "reference_half", label(*half), half->still, true);
 
     const Image diff = compare::absoluteDifference(a.still, b.still);
     writeExr(out.claim("diff_a_b.exr"), diff, ExrPixelType::Float);
@@ -244,7 +303,10 @@ int compareCommand(const Args& args) {
         const Input* ref;
         std::string name;
     };
-    std::vector<PairJob> jobs = {{&a, &b, "a_b"}};
+    // The noise floor first, so the pairs against the reference can be marked as they are computed.
+    std::vector<PairJob> jobs;
+    if (half) jobs.push_back({&*half, &*reference, "reference_half"});
+    jobs.push_back({&a, &b, "a_b"});
     if (reference) {
         jobs.push_back({&a, &*reference, "a_reference"});
         jobs.push_back({&b, &*reference, "b_reference"});
@@ -261,8 +323,21 @@ int compareCommand(const Args& args) {
             writeImage(out, "flip_" + job.name,
                        std::string(hdr ? "HDR" : "LDR") + "-FLIP " + job.test->role + " vs " + job.ref->role,
                        compare::flipColorMap(pair.flipErrorMap), false));
+        report.blockMaps.push_back(writeImage(
+            out, "blocks_" + job.name,
+            "log2 block luminance " + job.test->role + " / " + job.ref->role + " (" +
+                std::to_string(compare::kBlockSize) + " px)",
+            compare::blockRatioHeatMap(pair.blockRatio, job.test->still.width, job.test->still.height), false));
+        if (half && job.test == &*half) {
+            noiseFloor->status = compare::NoiseFloor::Status::Measured;
+            noiseFloor->pair = pair.metrics;
+            continue;
+        }
+        if (reference && job.ref == &*reference && noiseFloor->status == compare::NoiseFloor::Status::Measured)
+            pair.metrics.withinReferenceNoise = noiseFloor->contains(pair.metrics.flip.mean);
         report.metrics.push_back(pair.metrics);
     }
+    report.noiseFloor = noiseFloor;
 
     if (range.temporal) {
         for (const Input* in : inputs) {
@@ -283,8 +358,25 @@ int compareCommand(const Args& args) {
     compare::writeReport(out.claim("report.html"), report);
 
     for (const compare::PairMetrics& m : report.metrics)
-        std::printf("%-3s vs %-10s PSNR %s   SSIM %.4f   FLIP mean %.4f (weighted median %.4f)\n", m.test.c_str(),
-                    m.reference.c_str(), formatPsnr(m.psnr).c_str(), m.ssim, m.flip.mean, m.flip.weightedMedian);
+        std::printf("%-3s vs %-10s PSNR %s   SSIM %.4f   FLIP mean %.4f (weighted median %.4f)   blocks within "
+                    "15%% %5.1f%%, mean |log2| %.3f%s\n",
+                    m.test.c_str(), m.reference.c_str(), formatPsnr(m.psnr).c_str(), m.ssim, m.flip.mean,
+                    m.flip.weightedMedian, 100.0 * m.blocks.withinShare, m.blocks.meanAbsLog2,
+                    !m.withinReferenceNoise   ? ""
+                    : *m.withinReferenceNoise ? "   within reference noise"
+                                              : "   beyond reference noise");
+    if (noiseFloor) {
+        if (noiseFloor->status == compare::NoiseFloor::Status::Measured)
+            std::printf("noise floor: FLIP mean %.4f between the reference and its other half (%s); blocks within 15%% "
+                        "%5.1f%%, mean |log2| %.3f; pairs with FLIP mean <= %.4f are within reference noise\n",
+                        noiseFloor->pair->flip.mean, noiseFloor->reason.c_str(),
+                        100.0 * noiseFloor->pair->blocks.withinShare, noiseFloor->pair->blocks.meanAbsLog2,
+                        noiseFloor->factor * noiseFloor->pair->flip.mean);
+        else
+            std::printf("noise floor: %s (%s)\n",
+                        noiseFloor->status == compare::NoiseFloor::Status::Skipped ? "skipped" : "unknown",
+                        noiseFloor->reason.c_str());
+    }
     for (const compare::TemporalMetrics& t : report.temporal)
         std::printf("%-9s flicker %.5f over %d frames\n", t.label.c_str(), t.flicker, t.frameCount);
     std::printf("wrote %s\n", (out.dir() / "report.html").string().c_str());

@@ -31,12 +31,16 @@ commands:
       --bvh: also the scene's ray-tracing BVH: build ms, nodes, memory, bake-cache load ms,
       and rays/s of primary (one per pixel) and incoherent (bounce) rays.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
-  compare A B [--reference R] [--frame N | --frames A:B] [--set K=V]... [--output NAME]
-          [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
+  compare A B [--reference R [--reference-half H | --no-noise-floor]] [--frame N | --frames A:B]
+          [--set K=V]... [--output NAME] [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
       A, B, R: graphs (variants too) or images (EXR/PNG), same size. Writes the images, |A-B|,
       FLIP error maps, metrics.json (PSNR, SSIM, FLIP; flicker and error per frame with
       --frames) and a self-contained report.html to DIR (default out/compare/A_vs_B).
       Files vitrine did not write there are not replaced without --force.
+      With R also the noise floor: FLIP between R and a second half of it (R's graph with every
+      render.pathtrace seed + 1, or --reference-half FILE); pairs within 1.5x of it are marked "within
+      reference noise". --no-noise-floor: no second half. Every pair also gets the luminance ratio of
+      16 px blocks (share within 15 %, mean |log2|) and its heat map (blocks_*.png).
   golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]... [--from DIR]
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
       `accept` (re)writes the golden EXRs, `check` compares with FLIP, per-pixel and block
@@ -74,6 +78,10 @@ commands:
       per point still to do (this vitrine binary, DIR on a folder every node sees), and a dependent job running
       --collect; squeue state shown while waiting. Options also from the sweep file's "slurm" block.
   sweep --collect DIR               Gather DIR/points/*/metrics.json into sweep.json, sweep.csv, report.html.
+  cache ls                          The bake cache (BVHs, lightmaps, probes, ...): kind, size, age, total.
+  cache rm NAME...|--all            Remove entries by the names `cache ls` prints (or a whole KIND); only
+                                    files inside the bake cache folder. Cache folder: $VITRINE_CACHE_DIR,
+                                    else $XDG_CACHE_HOME/vitrine, else ~/.cache/vitrine.
   devices                           List Vulkan devices.
 
 common options:
@@ -93,7 +101,7 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
+                                     "output", "ppd", "diff-scale", "reference-half", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
                                      "jobs", "point", "collect", "devices", "from", "keep", "goldens", "class",
                                      "partition", "time", "gpus-per-task", "sbatch-arg"},
                                     {{"nodes", {"json"}}});
@@ -116,6 +124,7 @@ int main(int argc, char** argv) {
         if (args.command == "jitter") return cli::jitterCommand(args);
         if (args.command == "serve") return cli::serveCommand(args);
         if (args.command == "sweep") return cli::sweepCommand(args);
+        if (args.command == "cache") return cli::cacheCommand(args);
         throw UserError("unknown command '" + args.command + "'; run `vitrine help`");
     } catch (const UserError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

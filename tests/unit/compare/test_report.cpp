@@ -191,6 +191,59 @@ TEST(MetricsJson, ParsesAndFollowsTheSchema) {
     EXPECT_FALSE(doc["graphChanges"][0].contains("before")); // an addition has no old value
 }
 
+// The noise floor and the block measure reach metrics.json and the page: a pair within the floor is marked, one beyond
+// it too, and the floor's own numbers are there.
+TEST(MetricsJson, NoiseFloorAndBlocks) {
+    ReportInput input = sampleInput();
+    NoiseFloor floor;
+    floor.status = NoiseFloor::Status::Measured;
+    floor.reason = "seed 0 -> 1";
+    PairMetrics half;
+    half.test = "reference half";
+    half.reference = "reference";
+    half.flip.mean = 0.2;
+    half.blocks.withinShare = 0.97;
+    half.blocks.meanAbsLog2 = 0.02;
+    floor.pair = half;
+    EXPECT_TRUE(floor.contains(0.3)); // 1.5 × 0.2
+    EXPECT_FALSE(floor.contains(0.31));
+    input.noiseFloor = floor;
+    input.metrics[0].withinReferenceNoise = true;
+    input.metrics[1].withinReferenceNoise = false;
+    input.metrics[0].blocks.withinShare = 0.875;
+    input.blockMaps.push_back({"log2 block luminance A / B", bytes("Ma"), 64, 64});
+    input.referenceHalf = ReportImage{"reference half", bytes("fooba"), 64, 64};
+    const nlohmann::json doc = nlohmann::json::parse(metricsJson(input).dump());
+    EXPECT_EQ(doc["pairs"][0]["withinReferenceNoise"], true);
+    EXPECT_EQ(doc["pairs"][1]["withinReferenceNoise"], false);
+    EXPECT_DOUBLE_EQ(doc["pairs"][0]["blocks"]["withinShare"].get<double>(), 0.875);
+    EXPECT_EQ(doc["pairs"][0]["blocks"]["size"], 16);
+    EXPECT_EQ(doc["noiseFloor"]["status"], "measured");
+    EXPECT_DOUBLE_EQ(doc["noiseFloor"]["flip"]["mean"].get<double>(), 0.2);
+    EXPECT_DOUBLE_EQ(doc["noiseFloor"]["factor"].get<double>(), 1.5);
+    EXPECT_EQ(doc["noiseFloor"]["half"], "reference half");
+    EXPECT_EQ(doc["images"]["referenceHalf"]["width"], 64);
+    EXPECT_TRUE(metricsJson(sampleInput())["noiseFloor"].is_null());
+    EXPECT_TRUE(metricsJson(sampleInput())["pairs"][0]["withinReferenceNoise"].is_null());
+
+    const std::string html = renderReportHtml(input);
+    EXPECT_NE(html.find(">within reference noise<"), std::string::npos);
+    EXPECT_NE(html.find(">beyond reference noise<"), std::string::npos);
+    EXPECT_NE(html.find("id=\"noise-floor\""), std::string::npos);
+    EXPECT_NE(html.find("0.20000"), std::string::npos);
+    EXPECT_NE(html.find("87.5 %"), std::string::npos);
+    EXPECT_NE(html.find("data:image/png;base64,TWE=\""), std::string::npos);     // the block map "Ma"
+    EXPECT_NE(html.find("data:image/png;base64,Zm9vYmE=\""), std::string::npos); // the half "fooba"
+    EXPECT_NE(html.find("Block luminance ratio"), std::string::npos);
+
+    NoiseFloor unknown;
+    unknown.reason = "the reference is an image file";
+    input.noiseFloor = unknown;
+    EXPECT_EQ(metricsJson(input)["noiseFloor"]["status"], "unknown");
+    EXPECT_FALSE(metricsJson(input)["noiseFloor"].contains("flip"));
+    EXPECT_NE(renderReportHtml(input).find("unknown (the reference is an image file)"), std::string::npos);
+}
+
 TEST(ComparePair, IdenticalImages) {
     const Image a = testing::colourfulImage(32, 32);
     const PairComparison c = comparePair("A", a, "R", a);
