@@ -104,8 +104,9 @@ Camera readCamera(const LoadContext& ctx, const tinygltf::Camera& c, const Json&
     return cam;
 }
 
+// width: values per key (the morph target count for weights, else 1).
 AnimationSampler readSampler(const LoadContext& ctx, const tinygltf::AnimationSampler& s, AnimationPath path,
-                             const std::string& e) {
+                             const std::string& e, uint32_t width = 1) {
     AnimationSampler out;
     if (s.interpolation == "LINEAR")
         out.interpolation = Interpolation::Linear;
@@ -116,12 +117,15 @@ AnimationSampler readSampler(const LoadContext& ctx, const tinygltf::AnimationSa
     else
         ctx.fail(e + ".interpolation", "'" + s.interpolation + "'; expected LINEAR, STEP or CUBICSPLINE");
     AccessorValues input = readAccessor(ctx, s.input, e + ".input", {1}, true);
-    int comps = path == AnimationPath::Rotation ? 4 : 3;
+    int comps = path == AnimationPath::Rotation ? 4 : path == AnimationPath::Weights ? 1 : 3;
     AccessorValues output = readAccessor(ctx, s.output, e + ".output", {comps});
-    size_t per = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
+    size_t per = (out.interpolation == Interpolation::CubicSpline ? 3 : 1) * size_t(width);
+    out.width = width;
     if (output.count != input.count * per) {
         ctx.fail(e + ".output", std::to_string(output.count) + " elements; expected " +
-                                    std::to_string(input.count * per) + " (input count" + (per == 3 ? " × 3)" : ")"));
+                                    std::to_string(input.count * per) + " (input count" +
+                                    (out.interpolation == Interpolation::CubicSpline ? " × 3" : "") +
+                                    (width != 1 ? " × " + std::to_string(width) + " morph targets)" : ")"));
     }
     out.times = input.data; // finite: readAccessor refuses NaN and infinities
     for (size_t i = 1; i < out.times.size(); ++i) {
@@ -136,6 +140,7 @@ AnimationPath toPath(const LoadContext& ctx, const std::string& path, const std:
     if (path == "translation") return AnimationPath::Translation;
     if (path == "rotation") return AnimationPath::Rotation;
     if (path == "scale") return AnimationPath::Scale;
+    if (path == "weights") return AnimationPath::Weights;
     ctx.fail(e, "'" + path + "'; expected translation, rotation, scale or weights");
 }
 
@@ -372,6 +377,36 @@ void loadNodesAndScene(LoadContext& ctx) {
         for (int child : n.children)
             node.children.push_back(static_cast<uint32_t>(remap[child]));
     }
+    // A node's morph `weights` override its mesh's: the first node that draws a mesh sets its rest pose.
+    std::vector<int> weightsFrom(scene.meshes.size(), -1);
+    for (size_t i = 0; i < model.nodes.size(); ++i) {
+        const tinygltf::Node& n = model.nodes[i];
+        if (remap[i] < 0 || n.mesh < 0 || static_cast<size_t>(n.mesh) >= scene.meshes.size()) continue;
+        std::string e = "nodes[" + std::to_string(i) + "].weights";
+        Mesh& mesh = scene.meshes[n.mesh];
+        std::vector<float> w(n.weights.begin(), n.weights.end());
+        if (w.empty()) w = mesh.weights;
+        if (w.size() != mesh.weights.size()) {
+            ctx.fail(e, std::to_string(w.size()) + " weights; expected " + std::to_string(mesh.weights.size()) +
+                            " (one per morph target of meshes[" + std::to_string(n.mesh) + "])");
+        }
+        if (weightsFrom[n.mesh] >= 0) {
+            if (w != mesh.weights) {
+                ctx.warn(e, "differ from those of nodes[" + std::to_string(weightsFrom[n.mesh]) +
+                                "], which draws the same mesh; vitrine morphs a mesh once, with the first node's weights");
+            }
+            continue;
+        }
+        weightsFrom[n.mesh] = static_cast<int>(i);
+        if (w == mesh.weights) continue;
+        for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+            const Primitive& p = scene.primitives[mesh.firstPrimitive + k];
+            std::vector<Vertex> morphed(p.vertexCount);
+            scene.morphVertices(mesh.firstPrimitive + k, w, morphed);
+            std::copy(morphed.begin(), morphed.end(), scene.vertices.begin() + p.vertexOffset);
+        }
+        mesh.weights = w;
+    }
 
     for (size_t i = 0; i < model.cameras.size(); ++i) {
         scene.cameras.push_back(
@@ -393,8 +428,14 @@ void loadNodesAndScene(LoadContext& ctx) {
         out.name = a.name;
         out.loop = ours ? boolean(ctx, *ours, "loop", false, e + ".extras.vitrine") : false;
         // Samplers that a kept channel uses, in file order (samplers only for morph weights go).
+        // Morph weights of a node without a morphed mesh have nothing to drive.
+        auto morphTargets = [&](const tinygltf::AnimationChannel& ch) -> size_t {
+            int mesh = ch.target_node >= 0 ? model.nodes[ch.target_node].mesh : -1;
+            return mesh >= 0 && static_cast<size_t>(mesh) < scene.meshes.size() ? scene.meshes[mesh].weights.size() : 0;
+        };
         auto kept = [&](const tinygltf::AnimationChannel& ch) {
-            return ch.target_path != "weights" && ch.target_node >= 0 && remap[ch.target_node] >= 0;
+            return ch.target_node >= 0 && remap[ch.target_node] >= 0 &&
+                   (ch.target_path != "weights" || morphTargets(ch) > 0);
         };
         std::vector<int> samplerRemap(a.samplers.size(), -1);
         for (const tinygltf::AnimationChannel& ch : a.channels)
@@ -408,18 +449,23 @@ void loadNodesAndScene(LoadContext& ctx) {
             const tinygltf::AnimationChannel& ch = a.channels[c];
             std::string ce = e + ".channels[" + std::to_string(c) + "]";
             if (!kept(ch)) {
-                ctx.warn(ce, ch.target_path == "weights" ? "morph target weights are not supported; ignored"
-                                                         : "targets no node; ignored");
+                ctx.warn(ce, ch.target_path == "weights" && ch.target_node >= 0
+                                 ? "drives morph weights of a node without a mesh with morph targets; ignored"
+                                 : "targets no node; ignored");
                 continue;
             }
             AnimationPath path = toPath(ctx, ch.target_path, ce + ".target.path");
             int s = samplerRemap[ch.sampler];
             std::string se = e + ".samplers[" + std::to_string(ch.sampler) + "]";
+            uint32_t width = path == AnimationPath::Weights ? static_cast<uint32_t>(morphTargets(ch)) : 1;
             if (samplerPath[s] < 0) {
-                out.samplers[s] = readSampler(ctx, a.samplers[ch.sampler], path, se);
+                out.samplers[s] = readSampler(ctx, a.samplers[ch.sampler], path, se, width);
                 samplerPath[s] = static_cast<int>(path);
-            } else if ((samplerPath[s] == int(AnimationPath::Rotation)) != (path == AnimationPath::Rotation)) {
-                ctx.fail(se, "drives both a rotation and a translation/scale; expected one kind of value");
+            } else if ((samplerPath[s] == int(AnimationPath::Rotation)) != (path == AnimationPath::Rotation) ||
+                       (samplerPath[s] == int(AnimationPath::Weights)) != (path == AnimationPath::Weights) ||
+                       out.samplers[s].width != width) {
+                ctx.fail(se, "drives values of different kinds (rotation, translation/scale, weights of another "
+                             "count); expected one kind of value");
             }
             out.channels.push_back({static_cast<uint32_t>(remap[ch.target_node]), path, static_cast<uint32_t>(s)});
         }

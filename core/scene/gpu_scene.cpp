@@ -109,8 +109,23 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
     try {
         const size_t vbytes = scene.vertices.size() * sizeof(scene::Vertex);
         const size_t ibytes = scene.indices.size() * sizeof(uint32_t);
-        mVertices = uploadBuffer(ctx, scene.vertices.data(), vbytes,
-                                 VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".vertices");
+        for (const scene::Animation& a : scene.animations) {
+            for (const scene::AnimationChannel& c : a.channels)
+                mMorphAnimated = mMorphAnimated || c.path == scene::AnimationPath::Weights;
+        }
+        if (mMorphAnimated && vbytes > 0) {
+            // Animated morph weights: update() re-morphs the vertices in place, so they live in host-visible memory.
+            mVertices = GpuBuffer(ctx, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                  true, scene.name + ".vertices");
+            std::memcpy(mVertices.mapped(), scene.vertices.data(), vbytes);
+            mMeshWeights.resize(scene.meshes.size());
+            for (size_t m = 0; m < scene.meshes.size(); ++m)
+                mMeshWeights[m] = scene.meshes[m].weights;
+        } else {
+            mVertices = uploadBuffer(ctx, scene.vertices.data(), vbytes,
+                                     VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                     scene.name + ".vertices");
+        }
         mIndices = uploadBuffer(ctx, scene.indices.data(), ibytes,
                                 VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".indices");
         mStats.geometryBytes = vbytes + ibytes;
@@ -435,6 +450,20 @@ void GpuScene::update(const scene::ScenePose& pose, const scene::ScenePose& prev
     }
     GpuCamera c = camera.gpu();
     std::memcpy(mCamera.mapped(), &c, sizeof(c));
+    if (mMorphAnimated) {
+        auto* vertices = static_cast<scene::Vertex*>(mVertices.mapped());
+        for (size_t m = 0; m < pose.meshWeights.size() && m < mScene.meshes.size(); ++m) {
+            const std::vector<float>& w = pose.meshWeights[m];
+            if (w.empty() || w == mMeshWeights[m]) continue;
+            const scene::Mesh& mesh = mScene.meshes[m];
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
+                mScene.morphVertices(mesh.firstPrimitive + k, w,
+                                     std::span<scene::Vertex>(vertices + p.vertexOffset, p.vertexCount));
+            }
+            mMeshWeights[m] = w;
+        }
+    }
 }
 
 std::vector<VkVertexInputBindingDescription> GpuScene::vertexBindings() {

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -64,6 +65,13 @@ struct Vertex {
 };
 static_assert(sizeof(Vertex) == 72, "Vertex must stay tightly packed: the GPU side mirrors it");
 
+// What one morph target adds to one vertex at weight 1 (glTF's POSITION, NORMAL and TANGENT displacements).
+struct MorphDelta {
+    glm::vec3 position{0.0f};
+    glm::vec3 normal{0.0f};
+    glm::vec3 tangent{0.0f};
+};
+
 // A draw: an indexed triangle list with one material. Indices are relative to vertexOffset, so a
 // primitive draws with vkCmdDrawIndexed(indexCount, 1, firstIndex, vertexOffset, 0).
 struct Primitive {
@@ -77,6 +85,10 @@ struct Primitive {
     // instances of such meshes get lightmaps (core/bake/lightmap_atlas.hpp).
     bool lightmapUvs = false;
     Aabb bounds; // object space
+    // Morph targets: target t's delta for vertex v is Scene::morphDeltas[firstDelta + t × vertexCount + v]. The
+    // vertices themselves are the rest pose, the mesh's weights already applied (Mesh::weights).
+    uint32_t firstDelta = 0;
+    uint32_t targetCount = 0;
 };
 
 // A mesh is a contiguous range of Scene::primitives.
@@ -85,6 +97,9 @@ struct Mesh {
     uint32_t firstPrimitive = 0;
     uint32_t primitiveCount = 0;
     Aabb bounds; // object space, set by Scene::finalize()
+    // Morph target weights of the rest pose (glTF's node or mesh `weights`), one per target of its primitives;
+    // empty without targets. An animation of the weights re-morphs from here (morphVertices()).
+    std::vector<float> weights;
 };
 
 struct Transform {
@@ -124,7 +139,7 @@ struct Camera {
     std::string name;
     Projection projection = Projection::Perspective;
     float yfov = 0.8f;              // radians, vertical
-    float aspectRatio = 0.0f;       // 0: use the frame's
+    float aspectRatio = 0.0f;       // as authored (0: none); the frame's aspect is what projects (see projection())
     float znear = 0.05f;            // metres
     float zfar = 0.0f;              // metres; 0 = infinite far plane (glTF)
     float xmag = 1.0f, ymag = 1.0f; // orthographic half-extents (metres)
@@ -173,7 +188,9 @@ struct CameraState {
     glm::mat4 view{1.0f};
 
     // Right-handed view space in, Vulkan clip space out: y points down, depth 0 (near) .. 1 (far), or
-    // 1 .. 0 when reverseZ. frameAspect = width / height, used when lens.aspectRatio is 0.
+    // 1 .. 0 when reverseZ. frameAspect = width / height. Never stretched by lens.aspectRatio, as the Khronos glTF
+    // Sample Viewer draws: perspective keeps lens.yfov (the frame's width sets the horizontal field of view);
+    // orthographic keeps ymag when frameAspect > 1 (xmag = ymag × frameAspect), else xmag (ymag = xmag / frameAspect).
     glm::mat4 projection(float frameAspect, bool reverseZ = false) const;
 };
 
@@ -181,7 +198,10 @@ struct CameraState {
 struct Sun {
     glm::vec3 toSun{0.0f, 1.0f, 0.0f}; // unit vector from the scene towards the sun
     glm::vec3 color{1.0f};             // linear, max component 1
-    float illuminance = 100000.0f;     // lux on a surface facing the sun; the shader's π convention is its own
+    // On a surface facing the sun: color × illuminance is the illuminance in linear Rec.709 whose luminance is in lux
+    // (for a white sun, illuminance is the lux), as glTF's KHR_lights_punctual directional color × intensity.
+    // The shader's π convention is its own.
+    float illuminance = 100000.0f;
     float angularDiameter = 0.00931f;  // radians (0.53°): shadow penumbra
 };
 
@@ -228,6 +248,9 @@ struct ReflectionProbe {
 struct ScenePose {
     std::vector<glm::mat4> nodeWorld;     // index = node
     std::vector<glm::mat4> instanceWorld; // index = instance
+    // Morph weights, index = mesh: empty unless an animation drives the weights of a node that draws the mesh (the
+    // vertex range is the mesh's, so every node that draws it shows them).
+    std::vector<std::vector<float>> meshWeights;
 };
 
 struct Scene {
@@ -237,6 +260,7 @@ struct Scene {
     std::vector<uint32_t> indices;
     std::vector<Primitive> primitives;
     std::vector<Mesh> meshes;
+    std::vector<MorphDelta> morphDeltas; // see Primitive::firstDelta
 
     std::vector<Material> materials;
     std::vector<Texture> textures;
@@ -266,6 +290,10 @@ struct Scene {
 
     // Node and instance world transforms with every animation applied at time t (seconds).
     ScenePose evaluate(double t) const;
+
+    // The vertices of primitive p with morph weights w instead of the rest weights (Mesh::weights):
+    // rest + Σ (w − rest) × delta per target; normals and tangents renormalised. out has p's vertexCount.
+    void morphVertices(uint32_t primitive, const std::vector<float>& weights, std::span<Vertex> out) const;
 
     // The named camera path at time t. UserError naming the path and listing the known ones if absent.
     CameraState cameraAt(std::string_view path, double t) const;
