@@ -15,7 +15,8 @@
 // reflection probes in VITRINE_reflection_probes (VITRINE_reflection_probes.md), morph targets (POSITION, NORMAL,
 // TANGENT displacements; mesh or node `weights` make the rest pose, animated weights are an animation channel). Any
 // other extension in extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning.
-// Skins and point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus
+// Skins (JOINTS_0/WEIGHTS_0, inverse bind matrices): the rest pose is skinned at load, animated joints re-skin on the
+// CPU every frame (GpuScene::update). Point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus
 // their sparse substitutions), as glTF says, indices included. Data URIs may be base64 or percent-encoded (RFC 2397). Embedded (data: URI, GLB) and external buffers and images both work.
 //
 // How glTF maps onto the scene model:
@@ -49,7 +50,7 @@ Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesyste
                          std::vector<std::string>& warnings);
 
 // Loads for a user, as the scene.gltf node and `vitrine export-scene` do: each distinct warning (an unsupported
-// extension in extensionsUsed, skins, morph targets, unused attributes, tinygltf's own warnings, ...) is printed once
+// extension in extensionsUsed, point and line primitives, unused attributes, tinygltf's own warnings, ...) is printed once
 // on stderr through logWarning(), as "warning: FILE: ELEMENT: WHAT (at /json/pointer)". strict: warnings are errors;
 // a UserError lists them all and nothing is printed.
 Scene loadGltfReporting(const std::filesystem::path& file, bool strict);

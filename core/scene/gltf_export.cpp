@@ -141,6 +141,7 @@ private:
     Json material(const Material& m) const;
     void cameras();
     void nodesAndScene();
+    void skins();
     void animations();
     void cameraPathAnimation(const CameraPath& path, int node);
 
@@ -171,7 +172,7 @@ void Exporter::meshes() {
             Json attributes = {
                 {"COLOR_0", accessor(vertexView, base + offsetof(Vertex, color), kFloat, p.vertexCount, "VEC3")},
                 {"_AO", accessor(vertexView, base + offsetof(Vertex, color) + 12, kFloat, p.vertexCount, "SCALAR")}};
-            if (p.targetCount == 0) { // a morphed primitive's POSITION and NORMAL are its base, see morphTargets()
+            if (p.targetCount == 0 && !p.skinned) { // else POSITION and NORMAL are its base, see morphTargets()
                 Aabb box;
                 for (uint32_t v = 0; v < p.vertexCount; ++v)
                     box.expand(mScene.vertices[p.vertexOffset + v].position);
@@ -194,7 +195,7 @@ void Exporter::meshes() {
                     accessor(vertexView, base + offsetof(Vertex, uv1), kFloat, p.vertexCount, "VEC2");
             int indices = accessor(indexView, size_t(p.firstIndex) * 4, kUnsignedInt, p.indexCount, "SCALAR");
             Json jp = {{"attributes", attributes}, {"indices", indices}, {"material", p.material}, {"mode", 4}};
-            if (p.targetCount > 0) morphTargets(mesh.firstPrimitive + k, jp);
+            if (p.targetCount > 0 || p.skinned) morphTargets(mesh.firstPrimitive + k, jp);
             jm["primitives"].push_back(jp);
         }
         if (!mesh.weights.empty()) jm["weights"] = mesh.weights;
@@ -204,10 +205,38 @@ void Exporter::meshes() {
 
 // glTF morphs from the unmorphed base, the scene stores the rest pose (Mesh::weights applied): POSITION and NORMAL are
 // written as the base (weights 0) in views of their own, then each target's displacements.
+// A skinned primitive's base is its bind-space vertices, with JOINTS_0 (unsigned short) and WEIGHTS_0.
 void Exporter::morphTargets(uint32_t primitive, Json& jp) {
     const Primitive& p = mScene.primitives[primitive];
     std::vector<Vertex> base(p.vertexCount);
     mScene.morphVertices(primitive, std::vector<float>(p.targetCount, 0.0f), base);
+    if (p.skinned) {
+        const Mesh* mesh = nullptr;
+        for (const Mesh& m : mScene.meshes) {
+            if (primitive >= m.firstPrimitive && primitive < m.firstPrimitive + m.primitiveCount) mesh = &m;
+        }
+        std::vector<uint16_t> joints;
+        std::vector<float> weights;
+        for (uint32_t v = 0; v < p.vertexCount; ++v) {
+            const SkinVertex& sv = mScene.skinVertices[p.firstSkinVertex + v];
+            glm::vec3 position = sv.position, normal = sv.normal;
+            for (uint32_t t = 0; mesh && t < p.targetCount; ++t) { // bind space holds the rest morph weights
+                const MorphDelta& d = mScene.morphDeltas[p.firstDelta + size_t(t) * p.vertexCount + v];
+                position -= mesh->weights[t] * d.position;
+                normal -= mesh->weights[t] * d.normal;
+            }
+            base[v].position = position;
+            base[v].normal = glm::length(normal) > 0.0f ? glm::normalize(normal) : sv.normal;
+            for (int k = 0; k < 4; ++k) {
+                joints.push_back(static_cast<uint16_t>(sv.joints[k]));
+                weights.push_back(sv.weights[k]);
+            }
+        }
+        size_t at = append(joints.data(), joints.size() * sizeof(uint16_t));
+        jp["attributes"]["JOINTS_0"] =
+            accessor(view(at, joints.size() * sizeof(uint16_t), 0, kArrayBuffer), 0, 5123, p.vertexCount, "VEC4");
+        jp["attributes"]["WEIGHTS_0"] = floats(weights, 4, "VEC4", false, kArrayBuffer);
+    }
     std::vector<float> position, normal;
     for (const Vertex& v : base) {
         position.insert(position.end(), {v.position.x, v.position.y, v.position.z});
@@ -428,6 +457,7 @@ void Exporter::nodesAndScene() {
         if (!n.children.empty()) j["children"] = n.children;
         if (n.mesh >= 0) j["mesh"] = n.mesh;
         if (n.camera >= 0) j["camera"] = n.camera;
+        if (n.skin >= 0) j["skin"] = n.skin;
         mDoc["nodes"].push_back(j);
     }
     Json roots = Json::array();
@@ -481,6 +511,18 @@ void Exporter::nodesAndScene() {
     if (!mScene.probes.empty()) scene["extensions"][kProbesExtension] = {{"probes", probejson::write(mScene.probes)}};
     mDoc["scenes"] = Json::array({scene});
     mDoc["scene"] = 0;
+}
+
+void Exporter::skins() {
+    for (const Skin& skin : mScene.skins) {
+        std::vector<float> matrices;
+        for (const glm::mat4& m : skin.inverseBind)
+            for (int c = 0; c < 16; ++c)
+                matrices.push_back(m[c / 4][c % 4]);
+        Json j = {{"joints", skin.joints}, {"inverseBindMatrices", floats(matrices, 16, "MAT4", false)}};
+        if (!skin.name.empty()) j["name"] = skin.name;
+        mDoc["skins"].push_back(j);
+    }
 }
 
 void Exporter::cameraPathAnimation(const CameraPath& path, int node) {
@@ -576,6 +618,7 @@ std::vector<uint8_t> Exporter::run() {
     cameras();
     animations(); // before the camera-path animations that nodesAndScene() adds
     nodesAndScene();
+    skins();
 
     Json used = Json::array();
     bool transforms = false, strength = false;

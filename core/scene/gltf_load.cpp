@@ -373,9 +373,56 @@ void loadNodesAndScene(LoadContext& ctx) {
         node.local = readTransform(ctx, n, e);
         node.mesh = n.mesh;
         node.camera = n.camera;
-        if (n.skin >= 0) ctx.warn(e + ".skin", "skinning is not supported; drawn rigidly");
+        node.skin = n.skin;
         for (int child : n.children)
             node.children.push_back(static_cast<uint32_t>(remap[child]));
+    }
+    // Skins: joints as scene nodes, inverse bind matrices (identity without an accessor).
+    for (size_t i = 0; i < model.skins.size(); ++i) {
+        const tinygltf::Skin& sk = model.skins[i];
+        std::string e = "skins[" + std::to_string(i) + "]";
+        Skin skin;
+        skin.name = sk.name;
+        for (size_t j = 0; j < sk.joints.size(); ++j) {
+            int joint = sk.joints[j];
+            if (joint < 0 || static_cast<size_t>(joint) >= model.nodes.size() || remap[joint] < 0)
+                ctx.fail(e + ".joints[" + std::to_string(j) + "]", "expected the index of a node");
+            skin.joints.push_back(static_cast<uint32_t>(remap[joint]));
+        }
+        skin.inverseBind.assign(skin.joints.size(), glm::mat4(1.0f));
+        if (sk.inverseBindMatrices >= 0) {
+            AccessorValues m = readAccessor(ctx, sk.inverseBindMatrices, e + ".inverseBindMatrices", {16}, true);
+            if (m.count != skin.joints.size()) {
+                ctx.fail(e + ".inverseBindMatrices", std::to_string(m.count) + " matrices; expected " +
+                                                         std::to_string(skin.joints.size()) + " (one per joint)");
+            }
+            for (size_t j = 0; j < m.count; ++j)
+                for (int c = 0; c < 16; ++c)
+                    skin.inverseBind[j][c / 4][c % 4] = m.data[j * 16 + c]; // column-major, as glTF
+        }
+        scene.skins.push_back(std::move(skin));
+    }
+    for (size_t i = 0; i < model.nodes.size(); ++i) {
+        const tinygltf::Node& n = model.nodes[i];
+        if (remap[i] < 0 || n.skin < 0) continue;
+        std::string e = "nodes[" + std::to_string(i) + "].skin";
+        if (static_cast<size_t>(n.skin) >= scene.skins.size()) ctx.fail(e, "expected the index of a skin");
+        if (n.mesh < 0) continue;
+        const Mesh& mesh = scene.meshes[n.mesh];
+        for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+            const Primitive& p = scene.primitives[mesh.firstPrimitive + k];
+            if (!p.skinned) continue;
+            for (uint32_t v = 0; v < p.vertexCount; ++v) {
+                glm::vec4 j = scene.skinVertices[p.firstSkinVertex + v].joints;
+                if (std::max({j.x, j.y, j.z, j.w}) >= float(scene.skins[n.skin].joints.size())) {
+                    ctx.fail("meshes[" + std::to_string(n.mesh) + "].primitives[" + std::to_string(k) +
+                                 "].attributes.JOINTS_0",
+                             "vertex " + std::to_string(v) + " names joint " +
+                                 std::to_string(int(std::max({j.x, j.y, j.z, j.w}))) + "; " + e + " has " +
+                                 std::to_string(scene.skins[n.skin].joints.size()) + " joints");
+                }
+            }
+        }
     }
     // A node's morph `weights` override its mesh's: the first node that draws a mesh sets its rest pose.
     std::vector<int> weightsFrom(scene.meshes.size(), -1);
@@ -492,6 +539,31 @@ void loadNodesAndScene(LoadContext& ctx) {
         readProbes(ctx, sceneJson, e);
     }
     scene.finalize();
+    // The rest pose of skinned meshes: skinned by the first node that draws each with a skin, joints at rest.
+    if (!scene.skins.empty()) {
+        ScenePose rest = scene.restPose();
+        std::vector<int> skinnedBy(scene.meshes.size(), -1);
+        for (size_t i = 0; i < scene.nodes.size(); ++i) {
+            const Node& n = scene.nodes[i];
+            if (n.skin < 0 || n.mesh < 0) continue;
+            if (skinnedBy[n.mesh] >= 0) {
+                if (scene.nodes[skinnedBy[n.mesh]].skin != n.skin)
+                    ctx.warn("nodes[" + std::to_string(i) + "].skin",
+                             "its mesh is skinned by another node's skin too; vitrine poses a mesh once, by the first");
+                continue;
+            }
+            skinnedBy[n.mesh] = static_cast<int>(i);
+            std::vector<glm::mat4> joints = scene.jointMatrices(static_cast<uint32_t>(i), rest);
+            const Mesh& mesh = scene.meshes[n.mesh];
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                const Primitive& p = scene.primitives[mesh.firstPrimitive + k];
+                std::vector<Vertex> posed(p.vertexCount);
+                scene.skinPrimitive(mesh.firstPrimitive + k, joints, posed);
+                std::copy(posed.begin(), posed.end(), scene.vertices.begin() + p.vertexOffset);
+            }
+        }
+        scene.finalize(); // bounds of the posed vertices
+    }
     readLights(ctx, remap);
 
     for (const auto& [index, path] : exportedPaths) {

@@ -85,8 +85,14 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     AccessorValues uv1 = read("TEXCOORD_1", {2});
     AccessorValues colors = read("COLOR_0", {3, 4});
     AccessorValues ao = read("_AO", {1});
+    AccessorValues joints = read("JOINTS_0", {4});
+    AccessorValues jointWeights = read("WEIGHTS_0", {4});
+    if ((joints.count > 0) != (jointWeights.count > 0))
+        ctx.fail(e + ".attributes", joints.count ? "JOINTS_0 without WEIGHTS_0; expected both for skinning"
+                                                 : "WEIGHTS_0 without JOINTS_0; expected both for skinning");
     for (const auto& [name, accessor] : p.attributes) {
-        static const char* kKnown[] = {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0", "_AO"};
+        static const char* kKnown[] = {"POSITION", "NORMAL",     "TANGENT", "TEXCOORD_0", "TEXCOORD_1",
+                                       "COLOR_0",  "_AO",        "JOINTS_0", "WEIGHTS_0"};
         if (std::find(std::begin(kKnown), std::end(kKnown), name) == std::end(kKnown)) {
             ctx.warn(e + ".attributes." + name, "not used by vitrine; ignored");
         }
@@ -175,6 +181,20 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
             deltas = std::move(flatDeltas);
         }
         vertices = std::move(flat);
+        if (joints.count) { // the skin attributes follow the vertices
+            AccessorValues flatJoints = joints, flatWeights = jointWeights;
+            flatJoints.count = flatWeights.count = indices.size();
+            flatJoints.data.resize(indices.size() * 4);
+            flatWeights.data.resize(indices.size() * 4);
+            for (size_t k = 0; k < indices.size(); ++k) {
+                for (int c = 0; c < 4; ++c) {
+                    flatJoints.data[k * 4 + c] = joints.data[indices[k] * 4 + c];
+                    flatWeights.data[k * 4 + c] = jointWeights.data[indices[k] * 4 + c];
+                }
+            }
+            joints = std::move(flatJoints);
+            jointWeights = std::move(flatWeights);
+        }
         std::iota(indices.begin(), indices.end(), 0u);
     }
     // The rest pose: the mesh's weights applied (normals and tangents renormalised).
@@ -210,6 +230,19 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     prim.vertexCount = static_cast<uint32_t>(vertices.size());
     prim.material = p.material >= 0 ? static_cast<uint32_t>(p.material) : defaultMaterial(ctx);
     prim.lightmapUvs = uv1.count > 0;
+    if (joints.count) {
+        // Bind space as loaded (rest morph weights applied); the loader skins the rest pose once the nodes are known.
+        prim.skinned = true;
+        prim.firstSkinVertex = static_cast<uint32_t>(scene.skinVertices.size());
+        for (size_t i = 0; i < vertices.size(); ++i) {
+            glm::vec4 w = jointWeights.get(i);
+            float sum = w.x + w.y + w.z + w.w;
+            if (!(sum > 0.0f)) ctx.fail(e + ".attributes.WEIGHTS_0", "vertex " + std::to_string(i) +
+                                                                      " has weights summing to 0; expected 1");
+            scene.skinVertices.push_back({vertices[i].position, vertices[i].normal, vertices[i].tangent,
+                                          joints.get(i), w / sum}); // glTF: weights sum to 1 (normalised here)
+        }
+    }
     prim.firstDelta = static_cast<uint32_t>(scene.morphDeltas.size());
     prim.targetCount = static_cast<uint32_t>(weights.size());
     scene.morphDeltas.insert(scene.morphDeltas.end(), deltas.begin(), deltas.end());

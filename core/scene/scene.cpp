@@ -151,6 +151,13 @@ void Scene::finalize() {
             stack.push_back({*it, world, node.dynamic});
         }
     }
+    // A skinned mesh moves with its joints: dynamic when one of them is.
+    for (MeshInstance& instance : instances) {
+        int32_t skin = nodes[instance.node].skin;
+        if (skin < 0 || static_cast<size_t>(skin) >= skins.size()) continue;
+        for (uint32_t j : skins[skin].joints)
+            instance.dynamic = instance.dynamic || (j < nodes.size() && nodes[j].dynamic);
+    }
     // Instances in node order, which is what both the loader and the builders think of as "the" order.
     std::stable_sort(instances.begin(), instances.end(),
                      [](const MeshInstance& a, const MeshInstance& b) { return a.node < b.node; });
@@ -181,6 +188,58 @@ void Scene::morphVertices(uint32_t primitive, const std::vector<float>& weights,
         if (n > 0.0f) v.normal /= n;
         if (tl > 0.0f) v.tangent = glm::vec4(glm::vec3(v.tangent) / tl, v.tangent.w);
     }
+}
+
+std::vector<glm::mat4> Scene::jointMatrices(uint32_t node, const ScenePose& pose) const {
+    const Skin& skin = skins[nodes[node].skin];
+    glm::mat4 toNode = glm::inverse(pose.nodeWorld[node]);
+    std::vector<glm::mat4> out(skin.joints.size());
+    for (size_t j = 0; j < skin.joints.size(); ++j) {
+        glm::mat4 inverseBind = j < skin.inverseBind.size() ? skin.inverseBind[j] : glm::mat4(1.0f);
+        out[j] = toNode * pose.nodeWorld[skin.joints[j]] * inverseBind;
+    }
+    return out;
+}
+
+void Scene::skinPrimitive(uint32_t primitive, const std::vector<glm::mat4>& joints, std::span<Vertex> out) const {
+    const Primitive& p = primitives[primitive];
+    const Vertex* rest = vertices.data() + p.vertexOffset;
+    std::copy(rest, rest + p.vertexCount, out.begin());
+    if (!p.skinned) return;
+    for (uint32_t v = 0; v < p.vertexCount; ++v) {
+        const SkinVertex& s = skinVertices[p.firstSkinVertex + v];
+        glm::mat4 m(0.0f);
+        for (int k = 0; k < 4; ++k) {
+            size_t j = static_cast<size_t>(s.joints[k]);
+            if (s.weights[k] != 0.0f && j < joints.size()) m += s.weights[k] * joints[j];
+        }
+        glm::mat3 n = glm::transpose(glm::inverse(glm::mat3(m)));
+        out[v].position = glm::vec3(m * glm::vec4(s.position, 1.0f));
+        glm::vec3 normal = n * s.normal, tangent = glm::mat3(m) * glm::vec3(s.tangent);
+        float nl = glm::length(normal), tl = glm::length(tangent);
+        out[v].normal = nl > 0.0f ? normal / nl : s.normal;
+        out[v].tangent = glm::vec4(tl > 0.0f ? tangent / tl : glm::vec3(s.tangent), s.tangent.w);
+    }
+}
+
+ScenePose Scene::restPose() const {
+    ScenePose pose;
+    pose.nodeWorld.assign(nodes.size(), glm::mat4(1.0f));
+    std::vector<uint32_t> stack;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes[i].parent < 0) stack.push_back(static_cast<uint32_t>(i));
+    }
+    while (!stack.empty()) {
+        uint32_t n = stack.back();
+        stack.pop_back();
+        glm::mat4 parent = nodes[n].parent >= 0 ? pose.nodeWorld[nodes[n].parent] : glm::mat4(1.0f);
+        pose.nodeWorld[n] = parent * nodes[n].local.matrix();
+        for (uint32_t child : nodes[n].children)
+            stack.push_back(child);
+    }
+    for (const MeshInstance& instance : instances)
+        pose.instanceWorld.push_back(pose.nodeWorld[instance.node]);
+    return pose;
 }
 
 ScenePose Scene::evaluate(double t) const {

@@ -72,6 +72,23 @@ struct MorphDelta {
     glm::vec3 tangent{0.0f};
 };
 
+// A skinned vertex in bind space: glTF's POSITION, NORMAL, TANGENT (the mesh's morph weights applied) with JOINTS_0
+// (indices into Skin::joints, held as floats) and WEIGHTS_0.
+struct SkinVertex {
+    glm::vec3 position{0.0f};
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};
+    glm::vec4 joints{0.0f};
+    glm::vec4 weights{0.0f};
+};
+
+// A glTF skin: joint nodes and their inverse bind matrices (identity when the file has none).
+struct Skin {
+    std::string name;
+    std::vector<uint32_t> joints;
+    std::vector<glm::mat4> inverseBind;
+};
+
 // A draw: an indexed triangle list with one material. Indices are relative to vertexOffset, so a
 // primitive draws with vkCmdDrawIndexed(indexCount, 1, firstIndex, vertexOffset, 0).
 struct Primitive {
@@ -89,6 +106,10 @@ struct Primitive {
     // vertices themselves are the rest pose, the mesh's weights already applied (Mesh::weights).
     uint32_t firstDelta = 0;
     uint32_t targetCount = 0;
+    // Skinned (JOINTS_0 and WEIGHTS_0): its bind-space vertices are Scene::skinVertices[firstSkinVertex + v]; the
+    // vertices themselves are the rest pose, skinned by the first node that draws the mesh with a skin.
+    bool skinned = false;
+    uint32_t firstSkinVertex = 0;
 };
 
 // A mesh is a contiguous range of Scene::primitives.
@@ -117,6 +138,7 @@ struct Node {
     std::vector<uint32_t> children;
     int32_t mesh = -1;
     int32_t camera = -1; // a lens in Scene::cameras, posed by this node
+    int32_t skin = -1;   // Scene::skins: its mesh's skinned primitives follow the skin's joints
     // True when an animation moves this node or one of its ancestors (set by Scene::finalize()).
     // Static meshes get lightmaps; dynamic ones are lit by probes only.
     bool dynamic = false;
@@ -261,6 +283,8 @@ struct Scene {
     std::vector<Primitive> primitives;
     std::vector<Mesh> meshes;
     std::vector<MorphDelta> morphDeltas; // see Primitive::firstDelta
+    std::vector<Skin> skins;
+    std::vector<SkinVertex> skinVertices; // see Primitive::firstSkinVertex
 
     std::vector<Material> materials;
     std::vector<Texture> textures;
@@ -294,6 +318,15 @@ struct Scene {
     // The vertices of primitive p with morph weights w instead of the rest weights (Mesh::weights):
     // rest + Σ (w − rest) × delta per target; normals and tangents renormalised. out has p's vertexCount.
     void morphVertices(uint32_t primitive, const std::vector<float>& weights, std::span<Vertex> out) const;
+
+    // The skin matrices of a node with a skin at a pose (glTF: inverse(world of the node) × world of joint j ×
+    // inverseBind j, so the node's own transform, applied when drawing, cancels as the specification asks).
+    std::vector<glm::mat4> jointMatrices(uint32_t node, const ScenePose& pose) const;
+    // The vertices of skinned primitive p under joint matrices: Σ weight × matrix × bind-space vertex; normals and
+    // tangents by the inverse transpose, renormalised. out has p's vertexCount.
+    void skinPrimitive(uint32_t primitive, const std::vector<glm::mat4>& joints, std::span<Vertex> out) const;
+    // World transforms of the nodes at rest (no animation), as finalize() poses the instances.
+    ScenePose restPose() const;
 
     // The named camera path at time t. UserError naming the path and listing the known ones if absent.
     CameraState cameraAt(std::string_view path, double t) const;

@@ -172,6 +172,20 @@ uint64_t Scene::hashContent(bool withProbes) const {
         for (const Mesh& m : meshes)
             h.array(m.weights);
     }
+    if (!skins.empty()) { // only with skins, so the hashes of scenes without stay what they were
+        h.array(skinVertices);
+        for (const Primitive& p : primitives) {
+            h.value(static_cast<uint32_t>(p.skinned));
+            h.value(p.firstSkinVertex);
+        }
+        for (const Skin& skin : skins) {
+            h.string(skin.name);
+            h.array(skin.joints);
+            h.array(skin.inverseBind);
+        }
+        for (const Node& n : nodes)
+            h.value(n.skin);
+    }
     h.value(hasSun);
     if (hasSun) h.value(sun);
     if (!lights.empty()) {
@@ -256,6 +270,8 @@ void Scene::validate() const {
         }
         if (uint64_t(p.firstDelta) + uint64_t(p.targetCount) * p.vertexCount > morphDeltas.size())
             c.fail(e, "morph target range is outside morphDeltas");
+        if (p.skinned && uint64_t(p.firstSkinVertex) + p.vertexCount > skinVertices.size())
+            c.fail(e, "skinned vertex range is outside skinVertices");
     }
     for (size_t i = 0; i < meshes.size(); ++i) {
         if (uint64_t(meshes[i].firstPrimitive) + meshes[i].primitiveCount > primitives.size()) {
@@ -296,6 +312,7 @@ void Scene::validate() const {
         const Node& n = nodes[i];
         std::string e = "nodes[" + std::to_string(i) + "]";
         if (n.mesh >= 0) c.index(e + ".mesh", n.mesh, meshes.size(), "meshes");
+        if (n.skin >= 0) c.index(e + ".skin", n.skin, skins.size(), "skins");
         if (n.camera >= 0) c.index(e + ".camera", n.camera, cameras.size(), "cameras");
         for (uint32_t child : n.children)
             c.index(e + ".children", child, nodes.size(), "nodes");
@@ -319,6 +336,10 @@ void Scene::validate() const {
         for (size_t k = 1; k < p.keys.size(); ++k) {
             if (p.keys[k].time < p.keys[k - 1].time) c.fail(e, "key times decrease");
         }
+    }
+    for (size_t i = 0; i < skins.size(); ++i) {
+        for (uint32_t j : skins[i].joints)
+            c.index("skins[" + std::to_string(i) + "].joints", j, nodes.size(), "nodes");
     }
     for (size_t i = 0; i < animations.size(); ++i) {
         const Animation& a = animations[i];

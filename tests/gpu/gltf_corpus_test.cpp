@@ -109,5 +109,36 @@ TEST_F(GltfCorpus, MorphTargetAtWeightHalfMovesTheSilhouetteHalfAUnit) {
     EXPECT_NEAR(animatedAtOne, pixelsFor(0.5), 1.0);
 }
 
+// skin_bend.gltf at t = 0 (straight) and t = 1 (joint 1 turned 90°): the orthographic camera (xmag = ymag = 2 at
+// (0, 1, 5)) maps (x, y) to pixel ((x + 2) / 4 × W, (3 − y) / 4 × H). CPU skinning puts the bent upper bone along
+// y = 1 from x = 0 to −1 (0.2 wide): the pixel at (−0.73, 0.98) is covered at t = 1 only, (0, 1.73) at t = 0 only.
+TEST_F(GltfCorpus, SkinnedTwoBoneBendDrawsWhereCpuSkinningPutsIt) {
+    const int w = 128, h = 128;
+    auto depthAt = [&](int frames) {
+        json graph = {{"format", "vitrine-graph/1"},
+                      {"frame", {{"width", w}, {"height", h}, {"frames", frames}}},
+                      {"nodes",
+                       {{"scene",
+                         {{"type", "scene.gltf"},
+                          {"params", {{"path", corpus("skin_bend.gltf").string()}, {"jitter", "off"}, {"fps", 1}}}}},
+                        {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}}}},
+                      {"outputs", {{"depth", "gbuffer.depth"}}}};
+        return runGraph(graph).at("depth");
+    };
+    auto covered = [&](const Image& depth, double x, double y) {
+        int px = static_cast<int>((x + 2.0) / 4.0 * w), py = static_cast<int>((3.0 - y) / 4.0 * h);
+        return depth.at(px, py)[0] > 0.0f;
+    };
+    Image straight = depthAt(1), bent = depthAt(2);
+    std::printf("skin: straight (0, 1.73) %d (-0.73, 0.98) %d; bent (0, 1.73) %d (-0.73, 0.98) %d\n",
+                covered(straight, 0.0, 1.73), covered(straight, -0.73, 0.98), covered(bent, 0.0, 1.73),
+                covered(bent, -0.73, 0.98));
+    EXPECT_TRUE(covered(straight, 0.0, 1.73));
+    EXPECT_FALSE(covered(straight, -0.73, 0.98));
+    EXPECT_FALSE(covered(bent, 0.0, 1.73));
+    EXPECT_TRUE(covered(bent, -0.73, 0.98));
+    EXPECT_TRUE(covered(bent, 0.0, 0.5)); // the lower bone stays
+}
+
 } // namespace
 } // namespace vitrine::test

@@ -159,6 +159,52 @@ TEST(GltfCorpus, MorphTargetsAtDefaultAndAnimatedWeights) {
     EXPECT_NEAR(plusXFace(back, v), 1.5f, 1e-6f);
 }
 
+// skin_bend.gltf: joint 1 at (0, 1) turns θ = 90° × min(t, 1) about +Z. Linear blend skinning written out here: a
+// vertex (x, y) of joint 1 goes to (x cos θ − (y − 1) sin θ, 1 + x sin θ + (y − 1) cos θ); joint 0 leaves it; the
+// row at y = 1 is the mean of the two.
+glm::dvec2 cpuSkinned(glm::dvec2 p, double theta) {
+    glm::dvec2 j1(p.x * std::cos(theta) - (p.y - 1) * std::sin(theta), 1 + p.x * std::sin(theta) + (p.y - 1) * std::cos(theta));
+    if (p.y < 1.0) return p;
+    if (p.y == 1.0) return 0.5 * (p + j1);
+    return j1;
+}
+
+TEST(GltfCorpus, SkinTwoBoneBendMatchesCpuSkinning) {
+    Scene s = loadGltf(test::dataDir() / "corpus" / "skin_bend.gltf");
+    ASSERT_EQ(s.skins.size(), 1u);
+    ASSERT_TRUE(s.primitives.at(0).skinned);
+    const uint32_t bar = 1;
+    ASSERT_EQ(s.nodes.at(bar).skin, 0);
+    ASSERT_EQ(s.vertices.size(), 10u);
+    EXPECT_TRUE(s.instances.at(0).dynamic); // its joints are animated: no lightmap
+    std::vector<Vertex> v(10);
+    for (double t : {0.0, 0.25, 0.5, 1.0, 2.0}) {
+        double theta = 0.5 * 3.14159265358979 * std::min(t, 1.0);
+        s.skinPrimitive(0, s.jointMatrices(bar, s.evaluate(t)), v);
+        for (size_t i = 0; i < v.size(); ++i) {
+            glm::dvec2 bind(s.skinVertices[i].position);
+            glm::dvec2 want = cpuSkinned(bind, theta);
+            EXPECT_NEAR(v[i].position.x, want.x, 2e-6) << "vertex " << i << " t=" << t;
+            EXPECT_NEAR(v[i].position.y, want.y, 2e-6) << "vertex " << i << " t=" << t;
+            EXPECT_NEAR(v[i].position.z, 0.0, 1e-6);
+        }
+    }
+    EXPECT_NEAR(v[9].position.x, -1.0f, 1e-6f); // the tip (0.1, 2) at t >= 1
+    EXPECT_NEAR(v[9].position.y, 1.1f, 1e-6f);
+    // The rest pose (joints as the nodes have them, θ = 0) is the straight bar.
+    for (size_t i = 0; i < v.size(); ++i)
+        EXPECT_EQ(s.vertices[i].position, s.skinVertices[i].position);
+
+    // Export keeps the skin: JOINTS_0, WEIGHTS_0, the skin and its joints, the same bend.
+    auto file = test::scratchDir() / "skin_bend.glb";
+    exportGlb(s, file);
+    Scene back = loadGltf(file);
+    ASSERT_EQ(back.skins.size(), 1u);
+    back.skinPrimitive(0, back.jointMatrices(bar, back.evaluate(1.0)), v);
+    EXPECT_NEAR(v[9].position.x, -1.0f, 1e-6f);
+    EXPECT_NEAR(v[9].position.y, 1.1f, 1e-6f);
+}
+
 TEST(GltfCorpus, MeshQuantizationIntegerAndNormalisedAttributes) {
     Scene s = loadGltf(test::dataDir() / "corpus" / "quantized.gltf");
     ASSERT_EQ(s.vertices.size(), 3u);

@@ -16,6 +16,8 @@ hand, written in the file's asset.extras.expect:
   morph_animated.gltf  the same at weight 0 with a LINEAR weights animation 0 -> 1 over 2 s: half a unit at t = 1.
   quantized.gltf       KHR_mesh_quantization: integer positions, normalised byte normals and short UVs
                        (tests/unit/scene/test_gltf_corpus.cpp checks the loaded vertices).
+  skin_bend.gltf       a two-bone bend (joint 1 rotates 0 -> 90° about Z over 1 s) against CPU-skinned vertices
+                       (unit test) and the rendered silhouette (GPU test).
 Regenerate after editing: python3 tests/data/gltf/corpus/make_corpus.py
 """
 import base64
@@ -203,6 +205,53 @@ def quantized_file():
     b.write("quantized.gltf")
 
 
+def skin_file():
+    """A two-bone bend: a flat bar 0.2 wide along +Y from 0 to 2 (rows at y = 0, 0.5, 1, 1.5, 2), joint 0 at the
+    origin, joint 1 its child at (0, 1, 0) (inverse bind matrix: translation by -1 in y). Rows below 1 follow joint 0,
+    the row at 1 both half and half, rows above joint 1. Joint 1's rotation about +Z goes LINEAR from 0 at t = 0 to 90°
+    at t = 1 (then holds): at t = 1 the tip (0, 2) is at (-1, 1). An orthographic camera (xmag = ymag = 2) at (0, 1, 5)
+    looks down -Z."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_unlit"]
+    b.doc["materials"] = [{"name": "white", "doubleSided": True,
+                           "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0},
+                           "extensions": {"KHR_materials_unlit": {}}}]
+    pos, nrm, joints, weights, idx = [], [], [], [], []
+    for r, y in enumerate([0.0, 0.5, 1.0, 1.5, 2.0]):
+        for x in (-0.1, 0.1):
+            pos.append([x, y, 0.0])
+            nrm.append([0.0, 0.0, 1.0])
+            # a joint of weight 0 is 0, as the validator asks
+            joints.append([0, 0, 0, 0] if y < 1 else [0, 1, 0, 0] if y == 1 else [1, 0, 0, 0])
+            weights.append([1.0, 0.0, 0.0, 0.0] if y != 1 else [0.5, 0.5, 0.0, 0.0])
+        if r:
+            a = 2 * (r - 1)
+            idx += [a, a + 1, a + 3, a, a + 3, a + 2]
+    jdata = struct.pack("<%dB" % (4 * len(joints)), *[j for row in joints for j in row])
+    b.doc["accessors"].append({"bufferView": b.view(jdata, 34962), "componentType": 5121, "count": len(joints),
+                               "type": "VEC4"})
+    jacc = len(b.doc["accessors"]) - 1
+    prim = {"attributes": {"POSITION": b.floats(pos, "VEC3", True, 34962), "NORMAL": b.floats(nrm, "VEC3", False, 34962),
+                           "JOINTS_0": jacc, "WEIGHTS_0": b.floats(weights, "VEC4", False, 34962)},
+            "indices": b.indices(idx), "material": 0}
+    b.doc["meshes"] = [{"name": "bar", "primitives": [prim]}]
+    identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+    down = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1]  # column-major translation (0, -1, 0)
+    b.doc["skins"] = [{"name": "arm", "joints": [2, 3], "inverseBindMatrices": b.floats([identity, down], "MAT4")}]
+    b.doc["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2.0, "ymag": 2.0, "znear": 0.1, "zfar": 20}}]
+    b.doc["nodes"] = [{"name": "camera", "camera": 0, "translation": [0, 1, 5]}, {"name": "bar", "mesh": 0, "skin": 0},
+                      {"name": "joint0", "children": [3]}, {"name": "joint1", "translation": [0, 1, 0]}]
+    b.doc["scenes"] = [{"nodes": [0, 1, 2]}]
+    b.doc["scene"] = 0
+    h = math.sqrt(0.5)
+    b.doc["animations"] = [{"name": "bend",
+                            "samplers": [{"input": b.floats([0.0, 1.0], "SCALAR", True),
+                                          "output": b.floats([[0, 0, 0, 1], [0, 0, h, h]], "VEC4"),
+                                          "interpolation": "LINEAR"}],
+                            "channels": [{"sampler": 0, "target": {"node": 3, "path": "rotation"}}]}]
+    b.write("skin_bend.gltf")
+
+
 def main():
     # Perspective: the marker sits at 60 % of the half-height to the right and 40 % up at depth 5, so in a square
     # frame it lands at NDC (0.6, -0.4) (Vulkan y down) when the vertical field of view is kept, and at x = 0.4
@@ -219,6 +268,7 @@ def main():
     morph_cube_file("morph_cube.gltf", False)
     morph_cube_file("morph_animated.gltf", True)
     quantized_file()
+    skin_file()
 
 
 main()
