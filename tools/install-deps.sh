@@ -63,3 +63,18 @@ if [ -f "$editor/package-lock.json" ]; then
         echo "$want" > "$stamp"
     fi
 fi
+
+# The Khronos glTF-Validator for ctest gltf.validator (tests/gltf/check_validator.py): npm gltf-validator exactly as
+# tools/gltf-validator/package-lock.json pins it, installed the same way, only when the lockfile changed.
+validator="$(dirname "$0")/gltf-validator"
+if [ -f "$validator/package-lock.json" ]; then
+    want="$(sha256sum < "$validator/package-lock.json" | cut -d' ' -f1) node $(node --version)"
+    stamp="$validator/node_modules/.vitrine-install-stamp"
+    if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
+        echo "install-deps: tools/gltf-validator/node_modules is current"
+    else
+        echo "install-deps: npm ci in tools/gltf-validator/ (from package-lock.json)"
+        (cd "$validator" && npm ci --no-audit --no-fund)
+        echo "$want" > "$stamp"
+    fi
+fi

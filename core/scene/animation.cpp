@@ -54,6 +54,40 @@ glm::vec4 AnimationSampler::sample(float t, AnimationPath path) const {
     return rotation ? normalizeRotation(p) : p;
 }
 
+std::vector<float> AnimationSampler::sampleWeights(float t) const {
+    std::vector<float> out(width, 0.0f);
+    if (times.empty()) return out;
+    bool cubic = interpolation == Interpolation::CubicSpline;
+    size_t per = cubic ? 3 * size_t(width) : width; // elements per key
+    size_t valueAt = cubic ? width : 0;             // the value's offset inside a key
+    auto value = [&](size_t key, size_t i) { return values[key * per + valueAt + i].x; };
+    size_t last = times.size() - 1;
+    if (t <= times.front() || t >= times.back()) {
+        size_t key = t <= times.front() ? 0 : last;
+        for (size_t i = 0; i < width; ++i)
+            out[i] = value(key, i);
+        return out;
+    }
+    size_t next = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+    size_t k = next - 1;
+    float td = times[next] - times[k];
+    float s = td > 0.0f ? (t - times[k]) / td : 0.0f;
+    for (size_t i = 0; i < width; ++i) {
+        float v0 = value(k, i), v1 = value(next, i);
+        if (interpolation == Interpolation::Step || td <= 0.0f) {
+            out[i] = v0;
+        } else if (interpolation == Interpolation::Linear) {
+            out[i] = v0 + (v1 - v0) * s;
+        } else {
+            float b0 = values[k * per + 2 * width + i].x, a1 = values[next * per + i].x;
+            float s2 = s * s, s3 = s2 * s;
+            out[i] = (2 * s3 - 3 * s2 + 1) * v0 + td * (s3 - 2 * s2 + s) * b0 + (-2 * s3 + 3 * s2) * v1 +
+                     td * (s3 - s2) * a1;
+        }
+    }
+    return out;
+}
+
 float Animation::startTime() const {
     float start = 0.0f;
     bool first = true;

@@ -13,17 +13,22 @@
 namespace vitrine::scene {
 
 enum class Interpolation : uint8_t { Step, Linear, CubicSpline };
-enum class AnimationPath : uint8_t { Translation, Rotation, Scale };
+enum class AnimationPath : uint8_t { Translation, Rotation, Scale, Weights };
 
 struct AnimationSampler {
     Interpolation interpolation = Interpolation::Linear;
     std::vector<float> times; // seconds, non-decreasing
     // Translation/scale: xyz (w unused, 0). Rotation: a quaternion as x, y, z, w.
     // CubicSpline: three per key, in-tangent, value, out-tangent (glTF order); tangents are per second.
+    // Weights (morph targets): `width` elements per key (per in-tangent, value and out-tangent when cubic), the
+    // weight in x, as glTF lays them out.
     std::vector<glm::vec4> values;
+    uint32_t width = 1;
 
     // The value at time t (clamped to the keys). Rotations are slerped (linear) or normalised (cubic).
     glm::vec4 sample(float t, AnimationPath path) const;
+    // The `width` morph weights at time t (clamped to the keys), each interpolated like a scalar.
+    std::vector<float> sampleWeights(float t) const;
 };
 
 struct AnimationChannel {

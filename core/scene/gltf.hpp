@@ -12,9 +12,11 @@
 // KHR_lights_punctual (the first directional light becomes the sun; point and spot lights are kept with their
 // nodes), KHR_materials_unlit, KHR_materials_transmission (the factor; its texture is ignored with a warning),
 // KHR_materials_ior, KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's
-// reflection probes in VITRINE_reflection_probes (VITRINE_reflection_probes.md). Any other
-// extension in extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning. Skins,
-// morph targets and point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus
+// reflection probes in VITRINE_reflection_probes (VITRINE_reflection_probes.md), morph targets (POSITION, NORMAL,
+// TANGENT displacements; mesh or node `weights` make the rest pose, animated weights are an animation channel). Any
+// other extension in extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning.
+// Skins (JOINTS_0/WEIGHTS_0, inverse bind matrices): the rest pose is skinned at load, animated joints re-skin on the
+// CPU every frame (GpuScene::update). Point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus
 // their sparse substitutions), as glTF says, indices included. Data URIs may be base64 or percent-encoded (RFC 2397). Embedded (data: URI, GLB) and external buffers and images both work.
 //
 // How glTF maps onto the scene model:
@@ -48,16 +50,24 @@ Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesyste
                          std::vector<std::string>& warnings);
 
 // Loads for a user, as the scene.gltf node and `vitrine export-scene` do: each distinct warning (an unsupported
-// extension in extensionsUsed, skins, morph targets, unused attributes, tinygltf's own warnings, ...) is printed once
+// extension in extensionsUsed, point and line primitives, unused attributes, tinygltf's own warnings, ...) is printed once
 // on stderr through logWarning(), as "warning: FILE: ELEMENT: WHAT (at /json/pointer)". strict: warnings are errors;
 // a UserError lists them all and nothing is printed.
 Scene loadGltfReporting(const std::filesystem::path& file, bool strict);
 
-// Writes the scene as one self-contained .glb: geometry (one interleaved vertex buffer view), materials
-// with VITRINE_material_layers plus a plain metallic-roughness fallback made from layer 0, textures as
-// embedded PNG, cameras, camera paths as animated camera nodes, the sun as a KHR_lights_punctual light,
-// reflection probes in VITRINE_reflection_probes, rooms and exact physical parameters in `extras`. loadGltf() of
-// the result gives back a scene with the same contentHash(). UserError when the file cannot be written.
+// Writes the scene as one self-contained .glb that the Khronos glTF-Validator reports without errors or warnings:
+// geometry (one interleaved vertex buffer view; TANGENT only where the material has a normal map, TEXCOORD_0 only
+// where a texture samples it or TEXCOORD_1 is written), materials as plain metallic-roughness plus
+// VITRINE_material_layers where the core material cannot express the layer stack exactly, textures as embedded PNG, cameras, camera paths as animated camera
+// nodes (a one-key path LINEAR, as CUBICSPLINE needs two keys), the sun as a KHR_lights_punctual directional light
+// whose color × intensity is Sun::color × Sun::illuminance, reflection probes in VITRINE_reflection_probes, rooms and
+// exact physical parameters in `extras`. loadGltf() of the result gives back a scene with the same contentHash() as
+// dropUnusedAttributes() of the input. UserError when the file cannot be written.
 void exportGlb(const Scene& scene, const std::filesystem::path& file);
+
+// What exportGlb() does not write, set to what loadGltf() makes of its absence: per primitive, uv0 = (0, 0) unless a
+// texture of its material samples TEXCOORD_0 or TEXCOORD_1 is written (lightmap UVs), and tangents generated (tangents.hpp) unless its material has a normal
+// map. Neither changes a rendered pixel: the shaders read uv0 only through textures and tangents only for normal maps.
+void dropUnusedAttributes(Scene& scene);
 
 } // namespace vitrine::scene

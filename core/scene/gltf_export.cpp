@@ -3,6 +3,7 @@
 #include "core/scene/gltf.hpp"
 #include "core/scene/gltf_detail.hpp"
 #include "core/scene/probe_json.hpp"
+#include "core/scene/tangents.hpp"
 
 #include "core/base/atomic_file.hpp"
 #include "core/base/error.hpp"
@@ -11,6 +12,7 @@
 #include <cstddef>
 #include <cstring>
 #include <fstream>
+#include <span>
 
 #include <glm/gtc/constants.hpp>
 #include <stb/stb_image_write.h>
@@ -74,6 +76,15 @@ float channelMean(const Scene& scene, const TextureRef& ref, uint32_t channel) {
     return count ? float(sum) / (255.0f * count) : 1.0f;
 }
 
+// TEXCOORD_1 is the lightmap parameterisation (or a UV set a material samples); TEXCOORD_0 is written when a texture
+// samples it or when TEXCOORD_1 is written (glTF's TEXCOORD_n must be continuous from 0).
+bool writesUv1(const Scene& scene, const Primitive& p) {
+    return p.lightmapUvs || usesUvSet(scene.materials[p.material], 1);
+}
+bool writesUv0(const Scene& scene, const Primitive& p) {
+    return usesUvSet(scene.materials[p.material], 0) || writesUv1(scene, p);
+}
+
 class Exporter {
 public:
     explicit Exporter(const Scene& scene) : mScene(scene) {}
@@ -104,10 +115,10 @@ private:
                                      {"type", type}});
         return static_cast<int>(mDoc["accessors"].size()) - 1;
     }
-    // Float data in a view of its own (animation keys).
-    int floats(const std::vector<float>& data, int components, const char* type, bool withBounds) {
+    // Float data in a view of its own (animation keys; morph targets with target = kArrayBuffer).
+    int floats(const std::vector<float>& data, int components, const char* type, bool withBounds, int target = 0) {
         size_t at = append(data.data(), data.size() * sizeof(float));
-        int a = accessor(view(at, data.size() * sizeof(float)), 0, kFloat, data.size() / components, type);
+        int a = accessor(view(at, data.size() * sizeof(float), 0, target), 0, kFloat, data.size() / components, type);
         if (withBounds) {
             Json mn = Json::array(), mx = Json::array();
             for (int c = 0; c < components; ++c) {
@@ -124,11 +135,13 @@ private:
     }
 
     void meshes();
+    void morphTargets(uint32_t primitive, Json& jp);
     void images();
     void materials();
     Json material(const Material& m) const;
     void cameras();
     void nodesAndScene();
+    void skins();
     void animations();
     void cameraPathAnimation(const CameraPath& path, int node);
 
@@ -155,29 +168,95 @@ void Exporter::meshes() {
         for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
             const Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
             size_t base = size_t(p.vertexOffset) * sizeof(Vertex);
-            Aabb box;
-            for (uint32_t v = 0; v < p.vertexCount; ++v)
-                box.expand(mScene.vertices[p.vertexOffset + v].position);
-            int position = accessor(vertexView, base + offsetof(Vertex, position), kFloat, p.vertexCount, "VEC3");
-            mDoc["accessors"][position]["min"] = vec(box.min);
-            mDoc["accessors"][position]["max"] = vec(box.max);
+            const Material& material = mScene.materials[p.material];
             Json attributes = {
-                {"POSITION", position},
-                {"NORMAL", accessor(vertexView, base + offsetof(Vertex, normal), kFloat, p.vertexCount, "VEC3")},
-                {"TANGENT", accessor(vertexView, base + offsetof(Vertex, tangent), kFloat, p.vertexCount, "VEC4")},
-                {"TEXCOORD_0", accessor(vertexView, base + offsetof(Vertex, uv0), kFloat, p.vertexCount, "VEC2")},
                 {"COLOR_0", accessor(vertexView, base + offsetof(Vertex, color), kFloat, p.vertexCount, "VEC3")},
                 {"_AO", accessor(vertexView, base + offsetof(Vertex, color) + 12, kFloat, p.vertexCount, "SCALAR")}};
+            if (p.targetCount == 0 && !p.skinned) { // else POSITION and NORMAL are its base, see morphTargets()
+                Aabb box;
+                for (uint32_t v = 0; v < p.vertexCount; ++v)
+                    box.expand(mScene.vertices[p.vertexOffset + v].position);
+                int position = accessor(vertexView, base + offsetof(Vertex, position), kFloat, p.vertexCount, "VEC3");
+                mDoc["accessors"][position]["min"] = vec(box.min);
+                mDoc["accessors"][position]["max"] = vec(box.max);
+                attributes["POSITION"] = position;
+                attributes["NORMAL"] = accessor(vertexView, base + offsetof(Vertex, normal), kFloat, p.vertexCount, "VEC3");
+            }
+            // Only what the material uses (dropUnusedAttributes() says what the loader makes of the rest): tangents
+            // for a normal map, TEXCOORD_0 for a texture that samples it.
+            if (usesNormalMap(material))
+                attributes["TANGENT"] = accessor(vertexView, base + offsetof(Vertex, tangent), kFloat, p.vertexCount, "VEC4");
+            if (writesUv0(mScene, p))
+                attributes["TEXCOORD_0"] = accessor(vertexView, base + offsetof(Vertex, uv0), kFloat, p.vertexCount, "VEC2");
             // TEXCOORD_1 is the lightmap parameterisation (or a UV set a material samples); without it the
             // loader marks the primitive as not lightmapped.
-            if (p.lightmapUvs || usesUvSet(mScene.materials[p.material], 1))
+            if (writesUv1(mScene, p))
                 attributes["TEXCOORD_1"] =
                     accessor(vertexView, base + offsetof(Vertex, uv1), kFloat, p.vertexCount, "VEC2");
             int indices = accessor(indexView, size_t(p.firstIndex) * 4, kUnsignedInt, p.indexCount, "SCALAR");
-            jm["primitives"].push_back(
-                {{"attributes", attributes}, {"indices", indices}, {"material", p.material}, {"mode", 4}});
+            Json jp = {{"attributes", attributes}, {"indices", indices}, {"material", p.material}, {"mode", 4}};
+            if (p.targetCount > 0 || p.skinned) morphTargets(mesh.firstPrimitive + k, jp);
+            jm["primitives"].push_back(jp);
         }
+        if (!mesh.weights.empty()) jm["weights"] = mesh.weights;
         mDoc["meshes"].push_back(jm);
+    }
+}
+
+// glTF morphs from the unmorphed base, the scene stores the rest pose (Mesh::weights applied): POSITION and NORMAL are
+// written as the base (weights 0) in views of their own, then each target's displacements.
+// A skinned primitive's base is its bind-space vertices, with JOINTS_0 (unsigned short) and WEIGHTS_0.
+void Exporter::morphTargets(uint32_t primitive, Json& jp) {
+    const Primitive& p = mScene.primitives[primitive];
+    std::vector<Vertex> base(p.vertexCount);
+    mScene.morphVertices(primitive, std::vector<float>(p.targetCount, 0.0f), base);
+    if (p.skinned) {
+        const Mesh* mesh = nullptr;
+        for (const Mesh& m : mScene.meshes) {
+            if (primitive >= m.firstPrimitive && primitive < m.firstPrimitive + m.primitiveCount) mesh = &m;
+        }
+        std::vector<uint16_t> joints;
+        std::vector<float> weights;
+        for (uint32_t v = 0; v < p.vertexCount; ++v) {
+            const SkinVertex& sv = mScene.skinVertices[p.firstSkinVertex + v];
+            glm::vec3 position = sv.position, normal = sv.normal;
+            for (uint32_t t = 0; mesh && t < p.targetCount; ++t) { // bind space holds the rest morph weights
+                const MorphDelta& d = mScene.morphDeltas[p.firstDelta + size_t(t) * p.vertexCount + v];
+                position -= mesh->weights[t] * d.position;
+                normal -= mesh->weights[t] * d.normal;
+            }
+            base[v].position = position;
+            base[v].normal = glm::length(normal) > 0.0f ? glm::normalize(normal) : sv.normal;
+            for (int k = 0; k < 4; ++k) {
+                joints.push_back(static_cast<uint16_t>(sv.joints[k]));
+                weights.push_back(sv.weights[k]);
+            }
+        }
+        size_t at = append(joints.data(), joints.size() * sizeof(uint16_t));
+        jp["attributes"]["JOINTS_0"] =
+            accessor(view(at, joints.size() * sizeof(uint16_t), 0, kArrayBuffer), 0, 5123, p.vertexCount, "VEC4");
+        jp["attributes"]["WEIGHTS_0"] = floats(weights, 4, "VEC4", false, kArrayBuffer);
+    }
+    std::vector<float> position, normal;
+    for (const Vertex& v : base) {
+        position.insert(position.end(), {v.position.x, v.position.y, v.position.z});
+        normal.insert(normal.end(), {v.normal.x, v.normal.y, v.normal.z});
+    }
+    jp["attributes"]["POSITION"] = floats(position, 3, "VEC3", true, kArrayBuffer);
+    jp["attributes"]["NORMAL"] = floats(normal, 3, "VEC3", false, kArrayBuffer);
+    bool tangents = jp["attributes"].contains("TANGENT");
+    for (uint32_t t = 0; t < p.targetCount; ++t) {
+        const MorphDelta* d = mScene.morphDeltas.data() + p.firstDelta + size_t(t) * p.vertexCount;
+        std::vector<float> dp, dn, dt;
+        for (uint32_t v = 0; v < p.vertexCount; ++v) {
+            dp.insert(dp.end(), {d[v].position.x, d[v].position.y, d[v].position.z});
+            dn.insert(dn.end(), {d[v].normal.x, d[v].normal.y, d[v].normal.z});
+            dt.insert(dt.end(), {d[v].tangent.x, d[v].tangent.y, d[v].tangent.z});
+        }
+        Json target = {{"POSITION", floats(dp, 3, "VEC3", true, kArrayBuffer)},
+                       {"NORMAL", floats(dn, 3, "VEC3", false, kArrayBuffer)}};
+        if (tangents) target["TANGENT"] = floats(dt, 3, "VEC3", false, kArrayBuffer);
+        jp["targets"].push_back(target);
     }
 }
 
@@ -221,33 +300,53 @@ Json Exporter::material(const Material& m) const {
 
     // The fallback for viewers without our extension: layer 0 in glTF's metallic-roughness terms.
     // glTF keeps factors in [0, 1]; our layers may brighten a dark texture with a factor above 1.
-    Json pbr = {{"baseColorFactor", vec(glm::clamp(base.albedo.factor, 0.0f, 1.0f))}};
-    if (base.albedo.texture.valid())
+    // `core` is what the loader makes of the core material written here (readMetallicRoughness, the same float
+    // operations): when it is the whole stack, VITRINE_material_layers is left out.
+    MaterialLayer core;
+    core.name = "base";
+    core.albedo.factor = glm::clamp(base.albedo.factor, 0.0f, 1.0f);
+    Json pbr = {{"baseColorFactor", vec(core.albedo.factor)}};
+    if (base.albedo.texture.valid()) {
         pbr["baseColorTexture"] = writeTextureInfo(base.albedo.texture, base.albedo.texture.texture);
+        core.albedo.texture = base.albedo.texture;
+    }
     const ScalarParam& sh = base.shininess;
     const ScalarParam& me = base.metallic;
     bool packed = sh.texture.valid() && sh.texture == me.texture && sh.channel == 1 && sh.atZero == 1.0f &&
                   me.channel == 2 && me.atZero == 0.0f;
+    float roughness, metallic;
     if (packed) {
-        pbr["roughnessFactor"] = glm::clamp(1.0f - sh.factor, 0.0f, 1.0f);
-        pbr["metallicFactor"] = glm::clamp(me.factor, 0.0f, 1.0f);
+        roughness = glm::clamp(1.0f - sh.factor, 0.0f, 1.0f);
+        metallic = glm::clamp(me.factor, 0.0f, 1.0f);
         pbr["metallicRoughnessTexture"] = writeTextureInfo(sh.texture, sh.texture.texture);
+        core.shininess.texture = core.metallic.texture = sh.texture;
+        core.shininess.channel = 1;
+        core.metallic.channel = 2;
     } else {
         // Textures that glTF cannot express become their average value.
         auto mean = [&](const ScalarParam& p) {
             return p.texture.valid() ? p.evaluate(channelMean(mScene, p.texture, p.channel)) : p.factor;
         };
-        pbr["roughnessFactor"] = glm::clamp(1.0f - mean(sh), 0.0f, 1.0f);
-        pbr["metallicFactor"] = glm::clamp(mean(me), 0.0f, 1.0f);
+        roughness = glm::clamp(1.0f - mean(sh), 0.0f, 1.0f);
+        metallic = glm::clamp(mean(me), 0.0f, 1.0f);
     }
+    pbr["roughnessFactor"] = roughness;
+    pbr["metallicFactor"] = metallic;
+    core.shininess.factor = 1.0f - roughness;
+    core.shininess.atZero = 1.0f;
+    core.metallic.factor = metallic;
     j["pbrMetallicRoughness"] = pbr;
     if (base.normal.texture.valid()) {
         j["normalTexture"] = writeTextureInfo(base.normal.texture, base.normal.texture.texture);
         j["normalTexture"]["scale"] = base.normal.scale;
+        core.normal = base.normal;
     }
     if (base.cavity.texture.valid() && base.cavity.factor == 1.0f && base.cavity.channel == 0) {
+        float strength = glm::clamp(1.0f - base.cavity.atZero, 0.0f, 1.0f);
         j["occlusionTexture"] = writeTextureInfo(base.cavity.texture, base.cavity.texture.texture);
-        j["occlusionTexture"]["strength"] = glm::clamp(1.0f - base.cavity.atZero, 0.0f, 1.0f);
+        j["occlusionTexture"]["strength"] = strength;
+        core.cavity = ScalarParam{1.0f, 1.0f - strength, {}, 0};
+        core.cavity.texture = base.cavity.texture;
     }
 
     if (m.emissiveFactor != glm::vec3(0.0f)) j["emissiveFactor"] = vec(m.emissiveFactor); // [0,1]: strength is apart
@@ -261,6 +360,8 @@ Json Exporter::material(const Material& m) const {
     if (m.unlit) j["extensions"][gltf::kUnlit] = Json::object();
     if (m.transmission != 0.0f) j["extensions"][gltf::kTransmission] = {{"transmissionFactor", m.transmission}};
     if (m.ior != 1.5f) j["extensions"][gltf::kIor] = {{"ior", m.ior}};
+
+    if (m.layers.size() == 1 && base == core) return j; // the core material says it all
 
     auto scalar = [](const ScalarParam& p) {
         Json s = {{"factor", p.factor}, {"atZero", p.atZero}, {"channel", p.channel}};
@@ -356,6 +457,7 @@ void Exporter::nodesAndScene() {
         if (!n.children.empty()) j["children"] = n.children;
         if (n.mesh >= 0) j["mesh"] = n.mesh;
         if (n.camera >= 0) j["camera"] = n.camera;
+        if (n.skin >= 0) j["skin"] = n.skin;
         mDoc["nodes"].push_back(j);
     }
     Json roots = Json::array();
@@ -411,16 +513,30 @@ void Exporter::nodesAndScene() {
     mDoc["scene"] = 0;
 }
 
+void Exporter::skins() {
+    for (const Skin& skin : mScene.skins) {
+        std::vector<float> matrices;
+        for (const glm::mat4& m : skin.inverseBind)
+            for (int c = 0; c < 16; ++c)
+                matrices.push_back(m[c / 4][c % 4]);
+        Json j = {{"joints", skin.joints}, {"inverseBindMatrices", floats(matrices, 16, "MAT4", false)}};
+        if (!skin.name.empty()) j["name"] = skin.name;
+        mDoc["skins"].push_back(j);
+    }
+}
+
 void Exporter::cameraPathAnimation(const CameraPath& path, int node) {
     std::vector<float> times, positions, rotations;
     Json fov = Json::array();
+    // glTF's CUBICSPLINE needs two keys or more; one key is a still camera whichever way it is interpolated.
+    bool cubic = path.smooth && path.keys.size() >= 2;
     for (size_t k = 0; k < path.keys.size(); ++k) {
         const CameraKey& key = path.keys[k];
         times.push_back(key.time);
         glm::vec3 tangent = path.tangent(k);
-        if (path.smooth) positions.insert(positions.end(), {tangent.x, tangent.y, tangent.z});
+        if (cubic) positions.insert(positions.end(), {tangent.x, tangent.y, tangent.z});
         positions.insert(positions.end(), {key.position.x, key.position.y, key.position.z});
-        if (path.smooth) positions.insert(positions.end(), {tangent.x, tangent.y, tangent.z});
+        if (cubic) positions.insert(positions.end(), {tangent.x, tangent.y, tangent.z});
         rotations.insert(rotations.end(), {key.orientation.x, key.orientation.y, key.orientation.z, key.orientation.w});
         fov.push_back(key.yfov);
     }
@@ -428,7 +544,7 @@ void Exporter::cameraPathAnimation(const CameraPath& path, int node) {
     Json samplers =
         Json::array({{{"input", input},
                       {"output", floats(positions, 3, "VEC3", false)},
-                      {"interpolation", path.smooth ? "CUBICSPLINE" : "LINEAR"}},
+                      {"interpolation", cubic ? "CUBICSPLINE" : "LINEAR"}},
                      {{"input", input}, {"output", floats(rotations, 4, "VEC4", false)}, {"interpolation", "LINEAR"}}});
     Json channels = Json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", "translation"}}}},
                                  {{"sampler", 1}, {"target", {{"node", node}, {"path", "rotation"}}}}});
@@ -448,31 +564,43 @@ void Exporter::animations() {
                 throw UserError("exportGlb: animations[" + std::to_string(a) + "].samplers[" + std::to_string(s) +
                                 "] has no keys; glTF cannot store it");
             }
-            bool rotation = true;
+            bool rotation = true, weights = false;
             for (const AnimationChannel& c : anim.channels) {
-                if (c.sampler == s) rotation = c.path == AnimationPath::Rotation;
+                if (c.sampler == s) rotation = c.path == AnimationPath::Rotation, weights = c.path == AnimationPath::Weights;
             }
+            // CUBICSPLINE needs two keys or more (glTF 2.0 §3.11); one key is a constant, written LINEAR.
+            bool oneKeyCubic = smp.interpolation == Interpolation::CubicSpline && smp.times.size() < 2;
             std::vector<float> values;
-            for (const glm::vec4& v : smp.values)
+            for (size_t i = oneKeyCubic ? smp.width : 0; i < (oneKeyCubic ? 2 * smp.width : smp.values.size()); ++i) {
+                const glm::vec4& v = smp.values[i];
                 values.insert(values.end(), {v.x, v.y, v.z, v.w});
-            if (!rotation) { // VEC3 on disk
+            }
+            if (weights) { // SCALAR on disk, `width` per key
+                std::vector<float> x;
+                for (size_t i = 0; i < values.size(); i += 4)
+                    x.push_back(values[i]);
+                values = x;
+            } else if (!rotation) { // VEC3 on disk
                 std::vector<float> xyz;
                 for (size_t i = 0; i < values.size(); i += 4)
                     xyz.insert(xyz.end(), {values[i], values[i + 1], values[i + 2]});
                 values = xyz;
             }
-            const char* mode = smp.interpolation == Interpolation::Step     ? "STEP"
-                               : smp.interpolation == Interpolation::Linear ? "LINEAR"
+            const char* mode = smp.interpolation == Interpolation::Step                     ? "STEP"
+                               : smp.interpolation == Interpolation::Linear || oneKeyCubic ? "LINEAR"
                                                                             : "CUBICSPLINE";
             samplers.push_back({{"input", floats(smp.times, 1, "SCALAR", true)},
-                                {"output", floats(values, rotation ? 4 : 3, rotation ? "VEC4" : "VEC3", false)},
+                                {"output", weights    ? floats(values, 1, "SCALAR", false)
+                                           : rotation ? floats(values, 4, "VEC4", false)
+                                                      : floats(values, 3, "VEC3", false)},
                                 {"interpolation", mode}});
         }
         Json channels = Json::array();
         for (const AnimationChannel& c : anim.channels) {
             const char* path = c.path == AnimationPath::Translation ? "translation"
                                : c.path == AnimationPath::Rotation  ? "rotation"
-                                                                    : "scale";
+                               : c.path == AnimationPath::Scale     ? "scale"
+                                                                    : "weights";
             channels.push_back({{"sampler", c.sampler}, {"target", {{"node", c.node}, {"path", path}}}});
         }
         Json j = {{"samplers", samplers}, {"channels", channels}};
@@ -490,12 +618,14 @@ std::vector<uint8_t> Exporter::run() {
     cameras();
     animations(); // before the camera-path animations that nodesAndScene() adds
     nodesAndScene();
+    skins();
 
-    Json used = Json::array({std::string(kLayersExtension)});
+    Json used = Json::array();
     bool transforms = false, strength = false;
     for (const Material& m : mScene.materials)
         strength = strength || m.emissiveStrength != 1.0f;
     std::string text = mDoc.dump();
+    if (text.find(kLayersExtension) != std::string::npos) used.push_back(kLayersExtension);
     transforms = text.find(gltf::kTextureTransform) != std::string::npos;
     if (transforms) used.push_back(gltf::kTextureTransform);
     if (strength) used.push_back(gltf::kEmissiveStrength);
@@ -510,7 +640,7 @@ std::vector<uint8_t> Exporter::run() {
     if (transmission) used.push_back(gltf::kTransmission);
     if (ior) used.push_back(gltf::kIor);
     if (!mScene.probes.empty()) used.push_back(kProbesExtension);
-    mDoc["extensionsUsed"] = used;
+    if (!used.empty()) mDoc["extensionsUsed"] = used; // glTF forbids an empty list
     while (mBin.size() % 4)
         mBin.push_back(0);
     if (!mBin.empty()) mDoc["buffers"] = Json::array({{{"byteLength", mBin.size()}}});
@@ -541,6 +671,19 @@ std::vector<uint8_t> Exporter::run() {
 }
 
 } // namespace
+
+void dropUnusedAttributes(Scene& scene) {
+    for (const Primitive& p : scene.primitives) {
+        const Material& material = scene.materials[p.material];
+        std::span<Vertex> vertices(scene.vertices.data() + p.vertexOffset, p.vertexCount);
+        if (!writesUv0(scene, p)) {
+            for (Vertex& v : vertices)
+                v.uv0 = glm::vec2(0.0f);
+        }
+        if (!usesNormalMap(material))
+            generateTangents(vertices, std::span<const uint32_t>(scene.indices.data() + p.firstIndex, p.indexCount));
+    }
+}
 
 void exportGlb(const Scene& scene, const std::filesystem::path& file) {
     scene.validate();

@@ -104,8 +104,9 @@ Camera readCamera(const LoadContext& ctx, const tinygltf::Camera& c, const Json&
     return cam;
 }
 
+// width: values per key (the morph target count for weights, else 1).
 AnimationSampler readSampler(const LoadContext& ctx, const tinygltf::AnimationSampler& s, AnimationPath path,
-                             const std::string& e) {
+                             const std::string& e, uint32_t width = 1) {
     AnimationSampler out;
     if (s.interpolation == "LINEAR")
         out.interpolation = Interpolation::Linear;
@@ -116,12 +117,15 @@ AnimationSampler readSampler(const LoadContext& ctx, const tinygltf::AnimationSa
     else
         ctx.fail(e + ".interpolation", "'" + s.interpolation + "'; expected LINEAR, STEP or CUBICSPLINE");
     AccessorValues input = readAccessor(ctx, s.input, e + ".input", {1}, true);
-    int comps = path == AnimationPath::Rotation ? 4 : 3;
+    int comps = path == AnimationPath::Rotation ? 4 : path == AnimationPath::Weights ? 1 : 3;
     AccessorValues output = readAccessor(ctx, s.output, e + ".output", {comps});
-    size_t per = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
+    size_t per = (out.interpolation == Interpolation::CubicSpline ? 3 : 1) * size_t(width);
+    out.width = width;
     if (output.count != input.count * per) {
         ctx.fail(e + ".output", std::to_string(output.count) + " elements; expected " +
-                                    std::to_string(input.count * per) + " (input count" + (per == 3 ? " × 3)" : ")"));
+                                    std::to_string(input.count * per) + " (input count" +
+                                    (out.interpolation == Interpolation::CubicSpline ? " × 3" : "") +
+                                    (width != 1 ? " × " + std::to_string(width) + " morph targets)" : ")"));
     }
     out.times = input.data; // finite: readAccessor refuses NaN and infinities
     for (size_t i = 1; i < out.times.size(); ++i) {
@@ -136,6 +140,7 @@ AnimationPath toPath(const LoadContext& ctx, const std::string& path, const std:
     if (path == "translation") return AnimationPath::Translation;
     if (path == "rotation") return AnimationPath::Rotation;
     if (path == "scale") return AnimationPath::Scale;
+    if (path == "weights") return AnimationPath::Weights;
     ctx.fail(e, "'" + path + "'; expected translation, rotation, scale or weights");
 }
 
@@ -368,9 +373,86 @@ void loadNodesAndScene(LoadContext& ctx) {
         node.local = readTransform(ctx, n, e);
         node.mesh = n.mesh;
         node.camera = n.camera;
-        if (n.skin >= 0) ctx.warn(e + ".skin", "skinning is not supported; drawn rigidly");
+        node.skin = n.skin;
         for (int child : n.children)
             node.children.push_back(static_cast<uint32_t>(remap[child]));
+    }
+    // Skins: joints as scene nodes, inverse bind matrices (identity without an accessor).
+    for (size_t i = 0; i < model.skins.size(); ++i) {
+        const tinygltf::Skin& sk = model.skins[i];
+        std::string e = "skins[" + std::to_string(i) + "]";
+        Skin skin;
+        skin.name = sk.name;
+        for (size_t j = 0; j < sk.joints.size(); ++j) {
+            int joint = sk.joints[j];
+            if (joint < 0 || static_cast<size_t>(joint) >= model.nodes.size() || remap[joint] < 0)
+                ctx.fail(e + ".joints[" + std::to_string(j) + "]", "expected the index of a node");
+            skin.joints.push_back(static_cast<uint32_t>(remap[joint]));
+        }
+        skin.inverseBind.assign(skin.joints.size(), glm::mat4(1.0f));
+        if (sk.inverseBindMatrices >= 0) {
+            AccessorValues m = readAccessor(ctx, sk.inverseBindMatrices, e + ".inverseBindMatrices", {16}, true);
+            if (m.count != skin.joints.size()) {
+                ctx.fail(e + ".inverseBindMatrices", std::to_string(m.count) + " matrices; expected " +
+                                                         std::to_string(skin.joints.size()) + " (one per joint)");
+            }
+            for (size_t j = 0; j < m.count; ++j)
+                for (int c = 0; c < 16; ++c)
+                    skin.inverseBind[j][c / 4][c % 4] = m.data[j * 16 + c]; // column-major, as glTF
+        }
+        scene.skins.push_back(std::move(skin));
+    }
+    for (size_t i = 0; i < model.nodes.size(); ++i) {
+        const tinygltf::Node& n = model.nodes[i];
+        if (remap[i] < 0 || n.skin < 0) continue;
+        std::string e = "nodes[" + std::to_string(i) + "].skin";
+        if (static_cast<size_t>(n.skin) >= scene.skins.size()) ctx.fail(e, "expected the index of a skin");
+        if (n.mesh < 0) continue;
+        const Mesh& mesh = scene.meshes[n.mesh];
+        for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+            const Primitive& p = scene.primitives[mesh.firstPrimitive + k];
+            if (!p.skinned) continue;
+            for (uint32_t v = 0; v < p.vertexCount; ++v) {
+                glm::vec4 j = scene.skinVertices[p.firstSkinVertex + v].joints;
+                if (std::max({j.x, j.y, j.z, j.w}) >= float(scene.skins[n.skin].joints.size())) {
+                    ctx.fail("meshes[" + std::to_string(n.mesh) + "].primitives[" + std::to_string(k) +
+                                 "].attributes.JOINTS_0",
+                             "vertex " + std::to_string(v) + " names joint " +
+                                 std::to_string(int(std::max({j.x, j.y, j.z, j.w}))) + "; " + e + " has " +
+                                 std::to_string(scene.skins[n.skin].joints.size()) + " joints");
+                }
+            }
+        }
+    }
+    // A node's morph `weights` override its mesh's: the first node that draws a mesh sets its rest pose.
+    std::vector<int> weightsFrom(scene.meshes.size(), -1);
+    for (size_t i = 0; i < model.nodes.size(); ++i) {
+        const tinygltf::Node& n = model.nodes[i];
+        if (remap[i] < 0 || n.mesh < 0 || static_cast<size_t>(n.mesh) >= scene.meshes.size()) continue;
+        std::string e = "nodes[" + std::to_string(i) + "].weights";
+        Mesh& mesh = scene.meshes[n.mesh];
+        std::vector<float> w(n.weights.begin(), n.weights.end());
+        if (w.empty()) w = mesh.weights;
+        if (w.size() != mesh.weights.size()) {
+            ctx.fail(e, std::to_string(w.size()) + " weights; expected " + std::to_string(mesh.weights.size()) +
+                            " (one per morph target of meshes[" + std::to_string(n.mesh) + "])");
+        }
+        if (weightsFrom[n.mesh] >= 0) {
+            if (w != mesh.weights) {
+                ctx.warn(e, "differ from those of nodes[" + std::to_string(weightsFrom[n.mesh]) +
+                                "], which draws the same mesh; vitrine morphs a mesh once, with the first node's weights");
+            }
+            continue;
+        }
+        weightsFrom[n.mesh] = static_cast<int>(i);
+        if (w == mesh.weights) continue;
+        for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+            const Primitive& p = scene.primitives[mesh.firstPrimitive + k];
+            std::vector<Vertex> morphed(p.vertexCount);
+            scene.morphVertices(mesh.firstPrimitive + k, w, morphed);
+            std::copy(morphed.begin(), morphed.end(), scene.vertices.begin() + p.vertexOffset);
+        }
+        mesh.weights = w;
     }
 
     for (size_t i = 0; i < model.cameras.size(); ++i) {
@@ -393,8 +475,14 @@ void loadNodesAndScene(LoadContext& ctx) {
         out.name = a.name;
         out.loop = ours ? boolean(ctx, *ours, "loop", false, e + ".extras.vitrine") : false;
         // Samplers that a kept channel uses, in file order (samplers only for morph weights go).
+        // Morph weights of a node without a morphed mesh have nothing to drive.
+        auto morphTargets = [&](const tinygltf::AnimationChannel& ch) -> size_t {
+            int mesh = ch.target_node >= 0 ? model.nodes[ch.target_node].mesh : -1;
+            return mesh >= 0 && static_cast<size_t>(mesh) < scene.meshes.size() ? scene.meshes[mesh].weights.size() : 0;
+        };
         auto kept = [&](const tinygltf::AnimationChannel& ch) {
-            return ch.target_path != "weights" && ch.target_node >= 0 && remap[ch.target_node] >= 0;
+            return ch.target_node >= 0 && remap[ch.target_node] >= 0 &&
+                   (ch.target_path != "weights" || morphTargets(ch) > 0);
         };
         std::vector<int> samplerRemap(a.samplers.size(), -1);
         for (const tinygltf::AnimationChannel& ch : a.channels)
@@ -408,18 +496,23 @@ void loadNodesAndScene(LoadContext& ctx) {
             const tinygltf::AnimationChannel& ch = a.channels[c];
             std::string ce = e + ".channels[" + std::to_string(c) + "]";
             if (!kept(ch)) {
-                ctx.warn(ce, ch.target_path == "weights" ? "morph target weights are not supported; ignored"
-                                                         : "targets no node; ignored");
+                ctx.warn(ce, ch.target_path == "weights" && ch.target_node >= 0
+                                 ? "drives morph weights of a node without a mesh with morph targets; ignored"
+                                 : "targets no node; ignored");
                 continue;
             }
             AnimationPath path = toPath(ctx, ch.target_path, ce + ".target.path");
             int s = samplerRemap[ch.sampler];
             std::string se = e + ".samplers[" + std::to_string(ch.sampler) + "]";
+            uint32_t width = path == AnimationPath::Weights ? static_cast<uint32_t>(morphTargets(ch)) : 1;
             if (samplerPath[s] < 0) {
-                out.samplers[s] = readSampler(ctx, a.samplers[ch.sampler], path, se);
+                out.samplers[s] = readSampler(ctx, a.samplers[ch.sampler], path, se, width);
                 samplerPath[s] = static_cast<int>(path);
-            } else if ((samplerPath[s] == int(AnimationPath::Rotation)) != (path == AnimationPath::Rotation)) {
-                ctx.fail(se, "drives both a rotation and a translation/scale; expected one kind of value");
+            } else if ((samplerPath[s] == int(AnimationPath::Rotation)) != (path == AnimationPath::Rotation) ||
+                       (samplerPath[s] == int(AnimationPath::Weights)) != (path == AnimationPath::Weights) ||
+                       out.samplers[s].width != width) {
+                ctx.fail(se, "drives values of different kinds (rotation, translation/scale, weights of another "
+                             "count); expected one kind of value");
             }
             out.channels.push_back({static_cast<uint32_t>(remap[ch.target_node]), path, static_cast<uint32_t>(s)});
         }
@@ -446,6 +539,31 @@ void loadNodesAndScene(LoadContext& ctx) {
         readProbes(ctx, sceneJson, e);
     }
     scene.finalize();
+    // The rest pose of skinned meshes: skinned by the first node that draws each with a skin, joints at rest.
+    if (!scene.skins.empty()) {
+        ScenePose rest = scene.restPose();
+        std::vector<int> skinnedBy(scene.meshes.size(), -1);
+        for (size_t i = 0; i < scene.nodes.size(); ++i) {
+            const Node& n = scene.nodes[i];
+            if (n.skin < 0 || n.mesh < 0) continue;
+            if (skinnedBy[n.mesh] >= 0) {
+                if (scene.nodes[skinnedBy[n.mesh]].skin != n.skin)
+                    ctx.warn("nodes[" + std::to_string(i) + "].skin",
+                             "its mesh is skinned by another node's skin too; vitrine poses a mesh once, by the first");
+                continue;
+            }
+            skinnedBy[n.mesh] = static_cast<int>(i);
+            std::vector<glm::mat4> joints = scene.jointMatrices(static_cast<uint32_t>(i), rest);
+            const Mesh& mesh = scene.meshes[n.mesh];
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                const Primitive& p = scene.primitives[mesh.firstPrimitive + k];
+                std::vector<Vertex> posed(p.vertexCount);
+                scene.skinPrimitive(mesh.firstPrimitive + k, joints, posed);
+                std::copy(posed.begin(), posed.end(), scene.vertices.begin() + p.vertexOffset);
+            }
+        }
+        scene.finalize(); // bounds of the posed vertices
+    }
     readLights(ctx, remap);
 
     for (const auto& [index, path] : exportedPaths) {

@@ -50,7 +50,9 @@ std::vector<uint32_t> toTriangleList(const LoadContext& ctx, std::vector<uint32_
 }
 
 // indexAccessor: the primitive's `indices` as the file has it (tinygltf's copy may lack it, see tinygltfInput).
-void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAccessor, const std::string& e) {
+// weights: the mesh's rest weights, one per morph target (every primitive of a glTF mesh has as many targets).
+void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAccessor, const std::vector<float>& weights,
+                   const std::string& e) {
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
     if (mode <= TINYGLTF_MODE_LINE_STRIP) {
         ctx.warn(e, "points and lines are not drawn; primitive skipped");
@@ -83,13 +85,45 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     AccessorValues uv1 = read("TEXCOORD_1", {2});
     AccessorValues colors = read("COLOR_0", {3, 4});
     AccessorValues ao = read("_AO", {1});
+    AccessorValues joints = read("JOINTS_0", {4});
+    AccessorValues jointWeights = read("WEIGHTS_0", {4});
+    if ((joints.count > 0) != (jointWeights.count > 0))
+        ctx.fail(e + ".attributes", joints.count ? "JOINTS_0 without WEIGHTS_0; expected both for skinning"
+                                                 : "WEIGHTS_0 without JOINTS_0; expected both for skinning");
     for (const auto& [name, accessor] : p.attributes) {
-        static const char* kKnown[] = {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1", "COLOR_0", "_AO"};
+        static const char* kKnown[] = {"POSITION", "NORMAL",     "TANGENT", "TEXCOORD_0", "TEXCOORD_1",
+                                       "COLOR_0",  "_AO",        "JOINTS_0", "WEIGHTS_0"};
         if (std::find(std::begin(kKnown), std::end(kKnown), name) == std::end(kKnown)) {
             ctx.warn(e + ".attributes." + name, "not used by vitrine; ignored");
         }
     }
-    if (!p.targets.empty()) ctx.warn(e + ".targets", "morph targets are not supported; ignored");
+    // Morph targets: POSITION, NORMAL and TANGENT displacements, target-major (Primitive::firstDelta).
+    if (p.targets.size() != weights.size()) {
+        ctx.fail(e + ".targets", std::to_string(p.targets.size()) + " morph targets; expected " +
+                                     std::to_string(weights.size()) +
+                                     " (the mesh's weights, and every primitive of a mesh has as many targets)");
+    }
+    std::vector<MorphDelta> deltas(p.targets.size() * n);
+    for (size_t t = 0; t < p.targets.size(); ++t) {
+        std::string te = e + ".targets[" + std::to_string(t) + "]";
+        for (const auto& [name, accessor] : p.targets[t]) {
+            glm::vec3 MorphDelta::*field = name == "POSITION" ? &MorphDelta::position
+                                           : name == "NORMAL" ? &MorphDelta::normal
+                                           : name == "TANGENT" ? &MorphDelta::tangent
+                                                              : nullptr;
+            if (!field) {
+                ctx.warn(te + "." + name, "morph displacements of this attribute are not used by vitrine; ignored");
+                continue;
+            }
+            AccessorValues v = readAccessor(ctx, accessor, te + "." + name, {3});
+            if (v.count != n) {
+                ctx.fail(te + "." + name,
+                         std::to_string(v.count) + " elements; expected " + std::to_string(n) + " like POSITION");
+            }
+            for (size_t i = 0; i < n; ++i)
+                deltas[t * n + i].*field = glm::vec3(v.get(i));
+        }
+    }
 
     std::vector<uint32_t> indices(n);
     if (indexAccessor >= 0) {
@@ -138,8 +172,47 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
             a.normal = b.normal = c.normal = fn;
             flat.insert(flat.end(), {a, b, c});
         }
+        if (!deltas.empty()) { // the targets follow the vertices; flat normals stay flat (their deltas go)
+            std::vector<MorphDelta> flatDeltas(weights.size() * indices.size());
+            for (size_t t = 0; t < weights.size(); ++t)
+                for (size_t k = 0; k < indices.size(); ++k)
+                    flatDeltas[t * indices.size() + k] = {deltas[t * n + indices[k]].position, glm::vec3(0.0f),
+                                                          glm::vec3(0.0f)};
+            deltas = std::move(flatDeltas);
+        }
         vertices = std::move(flat);
+        if (joints.count) { // the skin attributes follow the vertices
+            AccessorValues flatJoints = joints, flatWeights = jointWeights;
+            flatJoints.count = flatWeights.count = indices.size();
+            flatJoints.data.resize(indices.size() * 4);
+            flatWeights.data.resize(indices.size() * 4);
+            for (size_t k = 0; k < indices.size(); ++k) {
+                for (int c = 0; c < 4; ++c) {
+                    flatJoints.data[k * 4 + c] = joints.data[indices[k] * 4 + c];
+                    flatWeights.data[k * 4 + c] = jointWeights.data[indices[k] * 4 + c];
+                }
+            }
+            joints = std::move(flatJoints);
+            jointWeights = std::move(flatWeights);
+        }
         std::iota(indices.begin(), indices.end(), 0u);
+    }
+    // The rest pose: the mesh's weights applied (normals and tangents renormalised).
+    for (size_t t = 0; t < weights.size(); ++t) {
+        if (weights[t] == 0.0f) continue;
+        for (size_t i = 0; i < vertices.size(); ++i) {
+            const MorphDelta& d = deltas[t * vertices.size() + i];
+            vertices[i].position += weights[t] * d.position;
+            vertices[i].normal += weights[t] * d.normal;
+            vertices[i].tangent += glm::vec4(weights[t] * d.tangent, 0.0f);
+        }
+    }
+    if (!weights.empty()) {
+        for (Vertex& v : vertices) {
+            float len = glm::length(v.normal), tl = glm::length(glm::vec3(v.tangent));
+            if (len > 0.0f) v.normal /= len;
+            if (tl > 0.0f) v.tangent = glm::vec4(glm::vec3(v.tangent) / tl, v.tangent.w);
+        }
     }
     if (!tangents.count || !normals.count) generateTangents(vertices, indices);
 
@@ -157,6 +230,22 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     prim.vertexCount = static_cast<uint32_t>(vertices.size());
     prim.material = p.material >= 0 ? static_cast<uint32_t>(p.material) : defaultMaterial(ctx);
     prim.lightmapUvs = uv1.count > 0;
+    if (joints.count) {
+        // Bind space as loaded (rest morph weights applied); the loader skins the rest pose once the nodes are known.
+        prim.skinned = true;
+        prim.firstSkinVertex = static_cast<uint32_t>(scene.skinVertices.size());
+        for (size_t i = 0; i < vertices.size(); ++i) {
+            glm::vec4 w = jointWeights.get(i);
+            float sum = w.x + w.y + w.z + w.w;
+            if (!(sum > 0.0f)) ctx.fail(e + ".attributes.WEIGHTS_0", "vertex " + std::to_string(i) +
+                                                                      " has weights summing to 0; expected 1");
+            scene.skinVertices.push_back({vertices[i].position, vertices[i].normal, vertices[i].tangent,
+                                          joints.get(i), w / sum}); // glTF: weights sum to 1 (normalised here)
+        }
+    }
+    prim.firstDelta = static_cast<uint32_t>(scene.morphDeltas.size());
+    prim.targetCount = static_cast<uint32_t>(weights.size());
+    scene.morphDeltas.insert(scene.morphDeltas.end(), deltas.begin(), deltas.end());
     scene.indices.insert(scene.indices.end(), indices.begin(), indices.end());
     scene.vertices.insert(scene.vertices.end(), vertices.begin(), vertices.end());
     scene.primitives.push_back(prim);
@@ -171,10 +260,21 @@ void loadMeshes(LoadContext& ctx) {
         mesh.name = model.meshes[i].name;
         mesh.firstPrimitive = static_cast<uint32_t>(ctx.scene->primitives.size());
         const Json& primsJson = ctx.doc["meshes"][i]["primitives"];
+        // Morph weights: the mesh's `weights`, else zeros, one per target of its first primitive.
+        size_t targets = model.meshes[i].primitives.empty() ? 0 : model.meshes[i].primitives[0].targets.size();
+        const std::vector<double>& w = model.meshes[i].weights;
+        if (!w.empty() && w.size() != targets) {
+            ctx.fail("meshes[" + std::to_string(i) + "].weights",
+                     std::to_string(w.size()) + " weights; expected " + std::to_string(targets) +
+                         " (one per morph target)");
+        }
+        mesh.weights.assign(targets, 0.0f);
+        for (size_t k = 0; k < w.size(); ++k)
+            mesh.weights[k] = static_cast<float>(w[k]);
         for (size_t j = 0; j < model.meshes[i].primitives.size(); ++j) {
             std::string e = "meshes[" + std::to_string(i) + "].primitives[" + std::to_string(j) + "]";
             int indexAccessor = static_cast<int>(integer(ctx, primsJson[j], "indices", -1, e));
-            loadPrimitive(ctx, model.meshes[i].primitives[j], indexAccessor, e);
+            loadPrimitive(ctx, model.meshes[i].primitives[j], indexAccessor, mesh.weights, e);
         }
         mesh.primitiveCount = static_cast<uint32_t>(ctx.scene->primitives.size()) - mesh.firstPrimitive;
         ctx.scene->meshes.push_back(mesh);

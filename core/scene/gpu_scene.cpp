@@ -177,8 +177,34 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
     try {
         const size_t vbytes = scene.vertices.size() * sizeof(scene::Vertex);
         const size_t ibytes = scene.indices.size() * sizeof(uint32_t);
-        mVertices = uploadBuffer(ctx, scene.vertices.data(), vbytes,
-                                 VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".vertices");
+        for (const scene::Animation& a : scene.animations) {
+            for (const scene::AnimationChannel& c : a.channels)
+                mMorphAnimated = mMorphAnimated || c.path == scene::AnimationPath::Weights;
+        }
+        for (const scene::MeshInstance& instance : scene.instances) {
+            const scene::Node& node = scene.nodes[instance.node];
+            if (node.skin < 0 || !instance.dynamic) continue; // a still skin stays in its rest pose
+            const scene::Mesh& mesh = scene.meshes[instance.mesh];
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                if (scene.primitives[mesh.firstPrimitive + k].skinned) {
+                    mSkinnedNodes.push_back(instance.node);
+                    break;
+                }
+            }
+        }
+        if ((mMorphAnimated || !mSkinnedNodes.empty()) && vbytes > 0) {
+            // Animated morph weights or joints: update() re-poses the vertices in place, in host-visible memory.
+            mVertices = GpuBuffer(ctx, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                  true, scene.name + ".vertices");
+            std::memcpy(mVertices.mapped(), scene.vertices.data(), vbytes);
+            mMeshWeights.resize(scene.meshes.size());
+            for (size_t m = 0; m < scene.meshes.size(); ++m)
+                mMeshWeights[m] = scene.meshes[m].weights;
+        } else {
+            mVertices = uploadBuffer(ctx, scene.vertices.data(), vbytes,
+                                     VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                     scene.name + ".vertices");
+        }
         mIndices = uploadBuffer(ctx, scene.indices.data(), ibytes,
                                 VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".indices");
         mStats.geometryBytes = vbytes + ibytes;
@@ -479,6 +505,36 @@ void GpuScene::update(const scene::ScenePose& pose, const scene::ScenePose& prev
     }
     GpuCamera c = camera.gpu();
     std::memcpy(mCamera.mapped(), &c, sizeof(c));
+    std::vector<int32_t> skinnedMesh(mSkinnedNodes.empty() ? 0 : mScene.meshes.size(), 0);
+    if (!mSkinnedNodes.empty() && pose.nodeWorld.size() == mScene.nodes.size()) {
+        auto* vertices = static_cast<scene::Vertex*>(mVertices.mapped());
+        for (uint32_t n : mSkinnedNodes) {
+            const scene::Mesh& mesh = mScene.meshes[mScene.nodes[n].mesh];
+            if (skinnedMesh[mScene.nodes[n].mesh]++) continue; // a mesh is posed once, by its first skinned node
+            std::vector<glm::mat4> joints = mScene.jointMatrices(n, pose);
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
+                if (p.skinned)
+                    mScene.skinPrimitive(mesh.firstPrimitive + k, joints,
+                                         std::span<scene::Vertex>(vertices + p.vertexOffset, p.vertexCount));
+            }
+        }
+    }
+    if (mMorphAnimated) {
+        auto* vertices = static_cast<scene::Vertex*>(mVertices.mapped());
+        for (size_t m = 0; m < pose.meshWeights.size() && m < mScene.meshes.size(); ++m) {
+            const std::vector<float>& w = pose.meshWeights[m];
+            if (w.empty() || w == mMeshWeights[m]) continue;
+            const scene::Mesh& mesh = mScene.meshes[m];
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
+                if (p.skinned && m < skinnedMesh.size() && skinnedMesh[m]) continue; // the skin poses it (bind pose)
+                mScene.morphVertices(mesh.firstPrimitive + k, w,
+                                     std::span<scene::Vertex>(vertices + p.vertexOffset, p.vertexCount));
+            }
+            mMeshWeights[m] = w;
+        }
+    }
 }
 
 std::vector<VkVertexInputBindingDescription> GpuScene::vertexBindings() {

@@ -92,7 +92,9 @@ public:
     GpuScene(const GpuScene&) = delete;
     GpuScene& operator=(const GpuScene&) = delete;
 
-    // Writes this frame's instance transforms (with last frame's for velocity) and camera. Safe while
+    // Writes this frame's instance transforms (with last frame's for velocity) and camera, re-skins the meshes of
+    // nodes whose skin has animated joints and re-morphs those whose morph weights an animation changed
+    // (pose.meshWeights). The vertex buffer is then host-visible; velocity and the ray-tracing BVH do not follow. Safe while
     // recording: the render graph runs one frame in flight, so the GPU is done with the last frame.
     void update(const scene::ScenePose& pose, const scene::ScenePose& previous, const CameraFrame& camera);
 
@@ -146,6 +148,9 @@ private:
     std::vector<GpuDraw> mTransparentDraws;
     GpuSceneStats mStats;
     float mAnisotropy = -1.0f;
+    bool mMorphAnimated = false;                  // an animation drives morph weights
+    std::vector<std::vector<float>> mMeshWeights; // the weights the vertex buffer holds, per mesh
+    std::vector<uint32_t> mSkinnedNodes;          // nodes whose skin moves: update() skins their mesh every frame
 };
 
 // What travels on a Scene port. CPU data from setup(); the GPU copy once a pass asks for it.

@@ -168,5 +168,7 @@ struct Material {
 
 // True when any texture of the material samples the given UV set (0 or 1).
 bool usesUvSet(const Material& material, uint32_t uvSet);
+// True when a layer of the material has a normal texture: only then do its vertices' tangents matter.
+bool usesNormalMap(const Material& material);
 
 } // namespace vitrine::scene

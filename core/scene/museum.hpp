@@ -27,6 +27,11 @@ struct MuseumOptions {
     uint32_t textureSize = 1024;
 };
 
+// The daylight the museum is lit by: graphs/museum.json's sky.procedural turbidity (Preetham). The scene's sun takes
+// its colour and illuminance from the same model (shading::PreethamSky::sunIlluminance()), so the KHR_lights_punctual
+// sun that export-scene writes is the sun the museum is rendered with (test GltfExport.MuseumSunIsTheSkyNodesSun).
+inline constexpr double kMuseumSkyTurbidity = 2.5;
+
 // UserError when an option is out of range. The result is finalized and valid.
 Scene buildMuseum(const MuseumOptions& options = {});
 

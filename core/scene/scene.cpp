@@ -48,13 +48,18 @@ glm::vec3 CameraPath::tangent(size_t key) const {
 }
 
 glm::mat4 CameraState::projection(float frameAspect, bool reverseZ) const {
-    float aspect = lens.aspectRatio > 0.0f ? lens.aspectRatio : frameAspect;
+    // The authored aspectRatio never stretches the image (the Khronos glTF Sample Viewer's rule): a perspective camera
+    // keeps its vertical field of view and the frame's width decides the horizontal one; an orthographic camera keeps
+    // ymag on a landscape frame (xmag = ymag × aspect) and xmag on a square or portrait one (ymag = xmag / aspect).
+    float aspect = frameAspect;
     float n = lens.znear, f = lens.zfar;
     glm::mat4 m(0.0f);
     if (lens.projection == Projection::Orthographic) {
         float far = f > n ? f : n + 1000.0f;
-        m[0][0] = 1.0f / lens.xmag;
-        m[1][1] = -1.0f / lens.ymag; // Vulkan's y points down
+        float xmag = aspect > 1.0f ? lens.ymag * aspect : lens.xmag;
+        float ymag = aspect > 1.0f ? lens.ymag : lens.xmag / aspect;
+        m[0][0] = 1.0f / xmag;
+        m[1][1] = -1.0f / ymag; // Vulkan's y points down
         m[2][2] = -1.0f / (far - n);
         m[3][2] = -n / (far - n);
         m[3][3] = 1.0f;
@@ -146,18 +151,113 @@ void Scene::finalize() {
             stack.push_back({*it, world, node.dynamic});
         }
     }
+    // A skinned mesh moves with its joints: dynamic when one of them is.
+    for (MeshInstance& instance : instances) {
+        int32_t skin = nodes[instance.node].skin;
+        if (skin < 0 || static_cast<size_t>(skin) >= skins.size()) continue;
+        for (uint32_t j : skins[skin].joints)
+            instance.dynamic = instance.dynamic || (j < nodes.size() && nodes[j].dynamic);
+    }
     // Instances in node order, which is what both the loader and the builders think of as "the" order.
     std::stable_sort(instances.begin(), instances.end(),
                      [](const MeshInstance& a, const MeshInstance& b) { return a.node < b.node; });
+}
+
+void Scene::morphVertices(uint32_t primitive, const std::vector<float>& weights, std::span<Vertex> out) const {
+    const Primitive& p = primitives[primitive];
+    const Vertex* rest = vertices.data() + p.vertexOffset;
+    std::copy(rest, rest + p.vertexCount, out.begin());
+    const Mesh* mesh = nullptr;
+    for (const Mesh& m : meshes) {
+        if (primitive >= m.firstPrimitive && primitive < m.firstPrimitive + m.primitiveCount) mesh = &m;
+    }
+    if (!mesh || p.targetCount == 0) return;
+    for (uint32_t t = 0; t < p.targetCount; ++t) {
+        float restWeight = t < mesh->weights.size() ? mesh->weights[t] : 0.0f;
+        float w = (t < weights.size() ? weights[t] : restWeight) - restWeight;
+        if (w == 0.0f) continue;
+        const MorphDelta* d = morphDeltas.data() + p.firstDelta + size_t(t) * p.vertexCount;
+        for (uint32_t v = 0; v < p.vertexCount; ++v) {
+            out[v].position += w * d[v].position;
+            out[v].normal += w * d[v].normal;
+            out[v].tangent += glm::vec4(w * d[v].tangent, 0.0f);
+        }
+    }
+    for (Vertex& v : out) {
+        float n = glm::length(v.normal), tl = glm::length(glm::vec3(v.tangent));
+        if (n > 0.0f) v.normal /= n;
+        if (tl > 0.0f) v.tangent = glm::vec4(glm::vec3(v.tangent) / tl, v.tangent.w);
+    }
+}
+
+std::vector<glm::mat4> Scene::jointMatrices(uint32_t node, const ScenePose& pose) const {
+    const Skin& skin = skins[nodes[node].skin];
+    glm::mat4 toNode = glm::inverse(pose.nodeWorld[node]);
+    std::vector<glm::mat4> out(skin.joints.size());
+    for (size_t j = 0; j < skin.joints.size(); ++j) {
+        glm::mat4 inverseBind = j < skin.inverseBind.size() ? skin.inverseBind[j] : glm::mat4(1.0f);
+        out[j] = toNode * pose.nodeWorld[skin.joints[j]] * inverseBind;
+    }
+    return out;
+}
+
+void Scene::skinPrimitive(uint32_t primitive, const std::vector<glm::mat4>& joints, std::span<Vertex> out) const {
+    const Primitive& p = primitives[primitive];
+    const Vertex* rest = vertices.data() + p.vertexOffset;
+    std::copy(rest, rest + p.vertexCount, out.begin());
+    if (!p.skinned) return;
+    for (uint32_t v = 0; v < p.vertexCount; ++v) {
+        const SkinVertex& s = skinVertices[p.firstSkinVertex + v];
+        glm::mat4 m(0.0f);
+        for (int k = 0; k < 4; ++k) {
+            size_t j = static_cast<size_t>(s.joints[k]);
+            if (s.weights[k] != 0.0f && j < joints.size()) m += s.weights[k] * joints[j];
+        }
+        glm::mat3 n = glm::transpose(glm::inverse(glm::mat3(m)));
+        out[v].position = glm::vec3(m * glm::vec4(s.position, 1.0f));
+        glm::vec3 normal = n * s.normal, tangent = glm::mat3(m) * glm::vec3(s.tangent);
+        float nl = glm::length(normal), tl = glm::length(tangent);
+        out[v].normal = nl > 0.0f ? normal / nl : s.normal;
+        out[v].tangent = glm::vec4(tl > 0.0f ? tangent / tl : glm::vec3(s.tangent), s.tangent.w);
+    }
+}
+
+ScenePose Scene::restPose() const {
+    ScenePose pose;
+    pose.nodeWorld.assign(nodes.size(), glm::mat4(1.0f));
+    std::vector<uint32_t> stack;
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        if (nodes[i].parent < 0) stack.push_back(static_cast<uint32_t>(i));
+    }
+    while (!stack.empty()) {
+        uint32_t n = stack.back();
+        stack.pop_back();
+        glm::mat4 parent = nodes[n].parent >= 0 ? pose.nodeWorld[nodes[n].parent] : glm::mat4(1.0f);
+        pose.nodeWorld[n] = parent * nodes[n].local.matrix();
+        for (uint32_t child : nodes[n].children)
+            stack.push_back(child);
+    }
+    for (const MeshInstance& instance : instances)
+        pose.instanceWorld.push_back(pose.nodeWorld[instance.node]);
+    return pose;
 }
 
 ScenePose Scene::evaluate(double t) const {
     std::vector<Transform> local(nodes.size());
     for (size_t i = 0; i < nodes.size(); ++i)
         local[i] = nodes[i].local;
+    ScenePose pose;
     for (const Animation& animation : animations) {
         float at = animation.localTime(t);
         for (const AnimationChannel& channel : animation.channels) {
+            if (channel.path == AnimationPath::Weights) {
+                int32_t mesh = nodes[channel.node].mesh;
+                if (mesh < 0) continue;
+                pose.meshWeights.resize(meshes.size());
+                pose.meshWeights[mesh] = animation.samplers[channel.sampler].sampleWeights(at);
+                pose.meshWeights[mesh].resize(meshes[mesh].weights.size(), 0.0f);
+                continue;
+            }
             glm::vec4 v = animation.samplers[channel.sampler].sample(at, channel.path);
             Transform& tr = local[channel.node];
             switch (channel.path) {
@@ -170,11 +270,12 @@ ScenePose Scene::evaluate(double t) const {
             case AnimationPath::Scale:
                 tr.scale = glm::vec3(v);
                 break;
+            case AnimationPath::Weights:
+                break;
             }
         }
     }
 
-    ScenePose pose;
     pose.nodeWorld.assign(nodes.size(), glm::mat4(1.0f));
     std::vector<uint32_t> stack;
     for (size_t i = 0; i < nodes.size(); ++i) {

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -64,6 +65,30 @@ struct Vertex {
 };
 static_assert(sizeof(Vertex) == 72, "Vertex must stay tightly packed: the GPU side mirrors it");
 
+// What one morph target adds to one vertex at weight 1 (glTF's POSITION, NORMAL and TANGENT displacements).
+struct MorphDelta {
+    glm::vec3 position{0.0f};
+    glm::vec3 normal{0.0f};
+    glm::vec3 tangent{0.0f};
+};
+
+// A skinned vertex in bind space: glTF's POSITION, NORMAL, TANGENT (the mesh's morph weights applied) with JOINTS_0
+// (indices into Skin::joints, held as floats) and WEIGHTS_0.
+struct SkinVertex {
+    glm::vec3 position{0.0f};
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    glm::vec4 tangent{1.0f, 0.0f, 0.0f, 1.0f};
+    glm::vec4 joints{0.0f};
+    glm::vec4 weights{0.0f};
+};
+
+// A glTF skin: joint nodes and their inverse bind matrices (identity when the file has none).
+struct Skin {
+    std::string name;
+    std::vector<uint32_t> joints;
+    std::vector<glm::mat4> inverseBind;
+};
+
 // A draw: an indexed triangle list with one material. Indices are relative to vertexOffset, so a
 // primitive draws with vkCmdDrawIndexed(indexCount, 1, firstIndex, vertexOffset, 0).
 struct Primitive {
@@ -77,6 +102,14 @@ struct Primitive {
     // instances of such meshes get lightmaps (core/bake/lightmap_atlas.hpp).
     bool lightmapUvs = false;
     Aabb bounds; // object space
+    // Morph targets: target t's delta for vertex v is Scene::morphDeltas[firstDelta + t × vertexCount + v]. The
+    // vertices themselves are the rest pose, the mesh's weights already applied (Mesh::weights).
+    uint32_t firstDelta = 0;
+    uint32_t targetCount = 0;
+    // Skinned (JOINTS_0 and WEIGHTS_0): its bind-space vertices are Scene::skinVertices[firstSkinVertex + v]; the
+    // vertices themselves are the rest pose, skinned by the first node that draws the mesh with a skin.
+    bool skinned = false;
+    uint32_t firstSkinVertex = 0;
 };
 
 // A mesh is a contiguous range of Scene::primitives.
@@ -85,6 +118,9 @@ struct Mesh {
     uint32_t firstPrimitive = 0;
     uint32_t primitiveCount = 0;
     Aabb bounds; // object space, set by Scene::finalize()
+    // Morph target weights of the rest pose (glTF's node or mesh `weights`), one per target of its primitives;
+    // empty without targets. An animation of the weights re-morphs from here (morphVertices()).
+    std::vector<float> weights;
 };
 
 struct Transform {
@@ -102,6 +138,7 @@ struct Node {
     std::vector<uint32_t> children;
     int32_t mesh = -1;
     int32_t camera = -1; // a lens in Scene::cameras, posed by this node
+    int32_t skin = -1;   // Scene::skins: its mesh's skinned primitives follow the skin's joints
     // True when an animation moves this node or one of its ancestors (set by Scene::finalize()).
     // Static meshes get lightmaps; dynamic ones are lit by probes only.
     bool dynamic = false;
@@ -124,7 +161,7 @@ struct Camera {
     std::string name;
     Projection projection = Projection::Perspective;
     float yfov = 0.8f;              // radians, vertical
-    float aspectRatio = 0.0f;       // 0: use the frame's
+    float aspectRatio = 0.0f;       // as authored (0: none); the frame's aspect is what projects (see projection())
     float znear = 0.05f;            // metres
     float zfar = 0.0f;              // metres; 0 = infinite far plane (glTF)
     float xmag = 1.0f, ymag = 1.0f; // orthographic half-extents (metres)
@@ -173,7 +210,9 @@ struct CameraState {
     glm::mat4 view{1.0f};
 
     // Right-handed view space in, Vulkan clip space out: y points down, depth 0 (near) .. 1 (far), or
-    // 1 .. 0 when reverseZ. frameAspect = width / height, used when lens.aspectRatio is 0.
+    // 1 .. 0 when reverseZ. frameAspect = width / height. Never stretched by lens.aspectRatio, as the Khronos glTF
+    // Sample Viewer draws: perspective keeps lens.yfov (the frame's width sets the horizontal field of view);
+    // orthographic keeps ymag when frameAspect > 1 (xmag = ymag × frameAspect), else xmag (ymag = xmag / frameAspect).
     glm::mat4 projection(float frameAspect, bool reverseZ = false) const;
 };
 
@@ -181,7 +220,10 @@ struct CameraState {
 struct Sun {
     glm::vec3 toSun{0.0f, 1.0f, 0.0f}; // unit vector from the scene towards the sun
     glm::vec3 color{1.0f};             // linear, max component 1
-    float illuminance = 100000.0f;     // lux on a surface facing the sun; the shader's π convention is its own
+    // On a surface facing the sun: color × illuminance is the illuminance in linear Rec.709 whose luminance is in lux
+    // (for a white sun, illuminance is the lux), as glTF's KHR_lights_punctual directional color × intensity.
+    // The shader's π convention is its own.
+    float illuminance = 100000.0f;
     float angularDiameter = 0.00931f;  // radians (0.53°): shadow penumbra
 };
 
@@ -228,6 +270,9 @@ struct ReflectionProbe {
 struct ScenePose {
     std::vector<glm::mat4> nodeWorld;     // index = node
     std::vector<glm::mat4> instanceWorld; // index = instance
+    // Morph weights, index = mesh: empty unless an animation drives the weights of a node that draws the mesh (the
+    // vertex range is the mesh's, so every node that draws it shows them).
+    std::vector<std::vector<float>> meshWeights;
 };
 
 struct Scene {
@@ -237,6 +282,9 @@ struct Scene {
     std::vector<uint32_t> indices;
     std::vector<Primitive> primitives;
     std::vector<Mesh> meshes;
+    std::vector<MorphDelta> morphDeltas; // see Primitive::firstDelta
+    std::vector<Skin> skins;
+    std::vector<SkinVertex> skinVertices; // see Primitive::firstSkinVertex
 
     std::vector<Material> materials;
     std::vector<Texture> textures;
@@ -266,6 +314,19 @@ struct Scene {
 
     // Node and instance world transforms with every animation applied at time t (seconds).
     ScenePose evaluate(double t) const;
+
+    // The vertices of primitive p with morph weights w instead of the rest weights (Mesh::weights):
+    // rest + Σ (w − rest) × delta per target; normals and tangents renormalised. out has p's vertexCount.
+    void morphVertices(uint32_t primitive, const std::vector<float>& weights, std::span<Vertex> out) const;
+
+    // The skin matrices of a node with a skin at a pose (glTF: inverse(world of the node) × world of joint j ×
+    // inverseBind j, so the node's own transform, applied when drawing, cancels as the specification asks).
+    std::vector<glm::mat4> jointMatrices(uint32_t node, const ScenePose& pose) const;
+    // The vertices of skinned primitive p under joint matrices: Σ weight × matrix × bind-space vertex; normals and
+    // tangents by the inverse transpose, renormalised. out has p's vertexCount.
+    void skinPrimitive(uint32_t primitive, const std::vector<glm::mat4>& joints, std::span<Vertex> out) const;
+    // World transforms of the nodes at rest (no animation), as finalize() poses the instances.
+    ScenePose restPose() const;
 
     // The named camera path at time t. UserError naming the path and listing the known ones if absent.
     CameraState cameraAt(std::string_view path, double t) const;

@@ -5,6 +5,7 @@
 
 #include "core/base/error.hpp"
 
+#include <algorithm>
 #include <string>
 
 namespace vitrine::scene {
@@ -80,6 +81,10 @@ bool usesUvSet(const Material& m, uint32_t uvSet) {
     return uses(m.emissiveTexture);
 }
 
+bool usesNormalMap(const Material& m) {
+    return std::any_of(m.layers.begin(), m.layers.end(), [](const MaterialLayer& l) { return l.normal.texture.valid(); });
+}
+
 uint64_t Scene::contentHash() const { return hashContent(true); }
 
 uint64_t Scene::lightTransportHash() const { return hashContent(false); }
@@ -149,6 +154,7 @@ uint64_t Scene::hashContent(bool withProbes) const {
             h.value(s.interpolation);
             h.array(s.times);
             h.array(s.values);
+            if (s.width != 1) h.value(s.width); // morph weights; absent before, so older hashes stay
         }
         h.value(a.channels.size());
         for (const AnimationChannel& ch : a.channels) {
@@ -156,6 +162,29 @@ uint64_t Scene::hashContent(bool withProbes) const {
             h.value(ch.path);
             h.value(ch.sampler);
         }
+    }
+    if (!morphDeltas.empty()) { // only with morph targets, so the hashes of scenes without stay what they were
+        h.array(morphDeltas);
+        for (const Primitive& p : primitives) {
+            h.value(p.firstDelta);
+            h.value(p.targetCount);
+        }
+        for (const Mesh& m : meshes)
+            h.array(m.weights);
+    }
+    if (!skins.empty()) { // only with skins, so the hashes of scenes without stay what they were
+        h.array(skinVertices);
+        for (const Primitive& p : primitives) {
+            h.value(static_cast<uint32_t>(p.skinned));
+            h.value(p.firstSkinVertex);
+        }
+        for (const Skin& skin : skins) {
+            h.string(skin.name);
+            h.array(skin.joints);
+            h.array(skin.inverseBind);
+        }
+        for (const Node& n : nodes)
+            h.value(n.skin);
     }
     h.value(hasSun);
     if (hasSun) h.value(sun);
@@ -239,10 +268,18 @@ void Scene::validate() const {
         for (uint32_t k = 0; k < p.indexCount; ++k) {
             if (indices[p.firstIndex + k] >= p.vertexCount) c.fail(e, "an index exceeds the vertex range");
         }
+        if (uint64_t(p.firstDelta) + uint64_t(p.targetCount) * p.vertexCount > morphDeltas.size())
+            c.fail(e, "morph target range is outside morphDeltas");
+        if (p.skinned && uint64_t(p.firstSkinVertex) + p.vertexCount > skinVertices.size())
+            c.fail(e, "skinned vertex range is outside skinVertices");
     }
     for (size_t i = 0; i < meshes.size(); ++i) {
         if (uint64_t(meshes[i].firstPrimitive) + meshes[i].primitiveCount > primitives.size()) {
             c.fail("meshes[" + std::to_string(i) + "]", "primitive range is outside");
+        }
+        for (uint32_t k = 0; k < meshes[i].primitiveCount && meshes[i].firstPrimitive + k < primitives.size(); ++k) {
+            if (primitives[meshes[i].firstPrimitive + k].targetCount != meshes[i].weights.size())
+                c.fail("meshes[" + std::to_string(i) + "]", "a primitive's morph target count differs from weights");
         }
     }
     for (size_t i = 0; i < images.size(); ++i) {
@@ -275,6 +312,7 @@ void Scene::validate() const {
         const Node& n = nodes[i];
         std::string e = "nodes[" + std::to_string(i) + "]";
         if (n.mesh >= 0) c.index(e + ".mesh", n.mesh, meshes.size(), "meshes");
+        if (n.skin >= 0) c.index(e + ".skin", n.skin, skins.size(), "skins");
         if (n.camera >= 0) c.index(e + ".camera", n.camera, cameras.size(), "cameras");
         for (uint32_t child : n.children)
             c.index(e + ".children", child, nodes.size(), "nodes");
@@ -299,12 +337,16 @@ void Scene::validate() const {
             if (p.keys[k].time < p.keys[k - 1].time) c.fail(e, "key times decrease");
         }
     }
+    for (size_t i = 0; i < skins.size(); ++i) {
+        for (uint32_t j : skins[i].joints)
+            c.index("skins[" + std::to_string(i) + "].joints", j, nodes.size(), "nodes");
+    }
     for (size_t i = 0; i < animations.size(); ++i) {
         const Animation& a = animations[i];
         std::string e = "animations[" + std::to_string(i) + "]";
         for (size_t s = 0; s < a.samplers.size(); ++s) {
             const AnimationSampler& smp = a.samplers[s];
-            size_t per = smp.interpolation == Interpolation::CubicSpline ? 3 : 1;
+            size_t per = (smp.interpolation == Interpolation::CubicSpline ? 3 : 1) * size_t(smp.width);
             if (smp.values.size() != smp.times.size() * per) {
                 c.fail(e + ".samplers[" + std::to_string(s) + "]", "value count does not match the key count");
             }

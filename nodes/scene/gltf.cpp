@@ -11,12 +11,14 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "scene.gltf";
     s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
-            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, KHR_lights_punctual.";
+            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, KHR_lights_punctual, "
+            "node and morph-weight animations, morph targets, skins.";
     s.pass = PassKind::Transfer;
     s.params = {{"path", ParamType::Path, "", {}, {}, {}, "The .gltf or .glb file (relative to the graph file)"},
                 {"strict", ParamType::Bool, false, {}, {}, {},
                  "Refuse the file when loading it gives warnings (what vitrine ignores: unsupported extensions in "
-                 "extensionsUsed, skins, morph targets, ...) instead of printing them; `--strict` on the command line"}};
+                 "extensionsUsed, point and line primitives, unused attributes, ...) instead of printing them; `--strict` on the "
+                 "command line"}};
     addSceneNodeSchema(s);
     return s;
 }

@@ -33,9 +33,11 @@ double msSince(Clock::time_point start) {
 std::vector<GpuRay> primaryRays(const CameraFrame& camera) {
     const scene::CameraState& s = camera.state;
     const uint32_t w = camera.width, h = camera.height;
-    const float aspect = s.lens.aspectRatio > 0.0f ? s.lens.aspectRatio : static_cast<float>(w) / static_cast<float>(h);
+    const float aspect = static_cast<float>(w) / static_cast<float>(h); // as CameraState::projection()
     const float tanHalf = std::tan(0.5f * s.lens.yfov);
     const bool ortho = s.lens.projection == scene::Projection::Orthographic;
+    const glm::mat4 proj = s.projection(aspect); // the orthographic half-extents fitted to the frame
+    const float xmag = 1.0f / proj[0][0], ymag = -1.0f / proj[1][1];
     std::vector<GpuRay> rays;
     rays.reserve(static_cast<size_t>(w) * h);
     for (uint32_t y = 0; y < h; ++y)
@@ -44,7 +46,7 @@ std::vector<GpuRay> primaryRays(const CameraFrame& camera) {
             const float ny = 1.0f - 2.0f * (static_cast<float>(y) + 0.5f) / static_cast<float>(h);
             glm::vec3 origin = s.position, dir;
             if (ortho) {
-                origin = glm::vec3(s.world * glm::vec4(nx * s.lens.xmag, ny * s.lens.ymag, 0.0f, 1.0f));
+                origin = glm::vec3(s.world * glm::vec4(nx * xmag, ny * ymag, 0.0f, 1.0f));
                 dir = glm::vec3(s.world * glm::vec4(0.0f, 0.0f, -1.0f, 0.0f));
             } else {
                 dir = glm::normalize(glm::vec3(s.world * glm::vec4(nx * tanHalf * aspect, ny * tanHalf, -1.0f, 0.0f)));

@@ -6,7 +6,9 @@
 #include "core/scene/museum/context.hpp"
 
 #include "core/base/error.hpp"
+#include "core/shading/sky.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
@@ -301,8 +303,12 @@ Scene buildMuseum(const MuseumOptions& options) {
     // From the south, a little east, 46° up: through the south windows onto the nave floor and through
     // the skylights' louvres onto the north aisle.
     scene.sun.toSun = glm::normalize(glm::vec3(0.3f, 0.72f, -0.63f));
-    scene.sun.color = glm::vec3(1.0f, 0.96f, 0.9f);
-    scene.sun.illuminance = 90000.0f;
+    // The Preetham sun of the museum's sky for that direction (the ground albedo does not change it): color ×
+    // illuminance is its RGB illuminance, colour normalised to a largest component of 1.
+    glm::dvec3 e = shading::PreethamSky(kMuseumSkyTurbidity, glm::dvec3(scene.sun.toSun), 0.3).sunIlluminance();
+    double peak = std::max({e.x, e.y, e.z});
+    scene.sun.color = glm::vec3(e / peak);
+    scene.sun.illuminance = static_cast<float>(peak);
     scene.finalize();
     scene.validate();
     return scene;
