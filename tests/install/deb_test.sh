@@ -2,9 +2,11 @@
 # ctest install.deb: cpack builds the .deb (DEB generator, cmake/install.cmake); its file list (dpkg-deb -c) must hold
 # the binary, shaders, data and graphs under /usr, and its Depends the Debian runtime packages of the linked libraries
 # (computed by dpkg-shlibdeps; libvulkan1 stands for them here, as every build links it).
-# Usage: deb_test.sh BUILD_DIR
+# When the editor is built (SOURCE_DIR/editor/dist/index.html), its bundle must be in the package too.
+# Usage: deb_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build="$(cd "$1" && pwd)"
+src="$(cd "$2" && pwd)"
 work="$build/deb-test"
 rm -rf "$work"
 mkdir -p "$work"
@@ -19,6 +21,9 @@ for f in ./usr/bin/vitrine ./usr/share/vitrine/shaders/common/brdf.glsl ./usr/sh
          ./usr/share/vitrine/data/luts/warm_film.cube ./usr/share/vitrine/graphs/museum.json; do
     grep -qxF "$f" "$work/files.txt" || fail "$f is not in $deb (list: $work/files.txt)"
 done
+if [ -f "$src/editor/dist/index.html" ]; then
+    grep -qxF ./usr/share/vitrine/editor/dist/index.html "$work/files.txt" || fail "the editor bundle is not in $deb"
+fi
 depends="$(dpkg-deb -f "$deb" Depends)"
 [[ "$depends" == *libvulkan1* ]] || fail "Depends lacks libvulkan1: '$depends'"
 [[ "$depends" == *libc6* ]] || fail "Depends lacks libc6: '$depends'"
