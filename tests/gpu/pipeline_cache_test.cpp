@@ -5,6 +5,7 @@
 #include "core/gpu/pipeline_cache.hpp"
 #include "core/gpu/vk_check.hpp"
 #include "core/shader/compiler.hpp"
+#include "tests/gpu/cli.hpp"
 
 #include <gtest/gtest.h>
 
@@ -177,6 +178,36 @@ TEST(PipelineCache, BadFilesAreIgnoredWithOneWarning) {
         EXPECT_GT(next.loadedBytes, 0u);
         EXPECT_EQ(countOf(next.stderrText, "pipeline cache ignored"), 0u) << next.stderrText;
     }
+}
+
+// The CLI's context uses the cache folder's pipeline/ (VITRINE_CACHE_DIR): `run` twice loads the file the first run
+// saved; a damaged file costs one warning and the run still succeeds.
+TEST(PipelineCacheCli, RunSavesLoadsAndSurvivesADamagedFile) {
+    const fs::path cache = freshDir("cli_cache");
+    const fs::path out = freshDir("cli_out");
+    const std::string env = "VITRINE_CACHE_DIR=" + test::quote(cache.string());
+    const std::string args = "run " + test::quote(std::string(VITRINE_SOURCE_DIR) + "/graphs/fxaa_zoneplate.json") +
+                             " --set frame.width=64 --set frame.height=36 --exr none --overwrite --validate --verbose"
+                             " --out " + test::quote(out.string());
+    test::CliResult first = test::vitrine(args, env);
+    ASSERT_EQ(first.status, 0) << first.output;
+    EXPECT_EQ(first.output.find("pipeline cache: loaded"), std::string::npos) << first.output;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(cache / "pipeline")) files.push_back(e.path());
+    ASSERT_EQ(files.size(), 1u) << "one file for the one device";
+
+    test::CliResult second = test::vitrine(args, env);
+    ASSERT_EQ(second.status, 0) << second.output;
+    EXPECT_NE(second.output.find("pipeline cache: loaded"), std::string::npos) << second.output;
+    EXPECT_EQ(countOf(second.output, "pipeline cache ignored"), 0u) << second.output;
+
+    std::vector<char> bytes = readBytes(files[0]);
+    bytes.resize(bytes.size() / 2);
+    writeBytes(files[0], bytes);
+    test::CliResult damaged = test::vitrine(args, env);
+    EXPECT_EQ(damaged.status, 0) << damaged.output;
+    EXPECT_EQ(countOf(damaged.output, "pipeline cache ignored"), 1u) << damaged.output;
+    EXPECT_NE(damaged.output.find("truncated"), std::string::npos) << damaged.output;
 }
 
 } // namespace
