@@ -15,6 +15,7 @@ packages=(
     libgtest-dev libgmock-dev libbenchmark-dev
     python3-jsonschema
     libcpp-httplib-dev
+    dpkg-dev  # dpkg-shlibdeps: the .deb's Depends (cmake/install.cmake)
     slurmctld slurmd slurm-client munge
 )
 if [ "${1:-}" = "--fuzz" ]; then

@@ -78,7 +78,7 @@ RayBatchTracer::RayBatchTracer(Context& ctx, ShaderCompiler& shaders) : mCtx(ctx
     pl.pushConstantRangeCount = 1;
     pl.pPushConstantRanges = &range;
     VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &mLayout));
-    mPipeline = createComputePipeline(device, shader, mLayout);
+    mPipeline = createComputePipeline(ctx, shader, mLayout);
 }
 
 RayBatchTracer::~RayBatchTracer() {

@@ -2,7 +2,9 @@
 
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
+#include "core/base/paths.hpp"
 #include "core/gpu/allocator.hpp"
+#include "core/gpu/pipeline_cache.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -267,6 +269,10 @@ Context::Context(const ContextOptions& options)
     VK_CHECK(vkCreateCommandPool(mDevice, &poolInfo, nullptr, &mCommandPool));
 
     mAllocator = std::make_unique<Allocator>(*this);
+    mPipelineCache = std::make_unique<PipelineCache>(
+        mDevice, mProperties,
+        !options.pipelineCache ? std::filesystem::path()
+        : options.pipelineCacheDir.empty() ? cacheDir() / "pipeline" : options.pipelineCacheDir);
 }
 
 Context::~Context() {
@@ -275,6 +281,7 @@ Context::~Context() {
         mCompleted = mSubmitted;
         collectGarbage();
         mAllocator.reset();
+        mPipelineCache.reset(); // saves the file
         for (auto& p : mPending) vkDestroyFence(mDevice, p.fence, nullptr);
         for (VkFence f : mFreeFences) vkDestroyFence(mDevice, f, nullptr);
         vkDestroyCommandPool(mDevice, mCommandPool, nullptr);

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -13,6 +14,7 @@
 namespace vitrine {
 
 class Allocator;
+class PipelineCache;
 
 // The validation messages of a context. Shared so that a test harness can still read what the layer said while
 // the context was being destroyed (leaked objects are reported then).
@@ -34,6 +36,10 @@ struct ContextOptions {
     std::string device;       // index ("0") or a case-insensitive substring of the device name; empty: best
     bool printValidation = true;
     std::shared_ptr<ValidationLog> log; // where messages go; made by the context when empty
+    // The persistent pipeline cache (pipeline_cache.hpp) in this folder; empty: cacheDir()/pipeline
+    // (core/base/paths.hpp). pipelineCache = false: an in-memory cache only, nothing read or written.
+    bool pipelineCache = true;
+    std::filesystem::path pipelineCacheDir;
 };
 
 struct DeviceInfo {
@@ -65,6 +71,8 @@ public:
     bool dualSourceBlend() const { return mDualSourceBlend; }
     const DeviceInfo& deviceInfo() const { return mDeviceInfo; }
     Allocator& allocator() { return *mAllocator; }
+    // Every pipeline is created through it; saved to disk when the context ends.
+    PipelineCache& pipelineCache() { return *mPipelineCache; }
     bool validationEnabled() const { return mValidation; }
 
     // Validation messages (warnings and errors) seen since the context was made. Tests fail on any.
@@ -117,6 +125,7 @@ private:
     VkCommandPool mCommandPool = VK_NULL_HANDLE;
     PFN_vkSetDebugUtilsObjectNameEXT mSetName = nullptr;
     std::unique_ptr<Allocator> mAllocator;
+    std::unique_ptr<PipelineCache> mPipelineCache;
 
     uint64_t mSubmitted = 0;
     uint64_t mCompleted = 0;

@@ -1,5 +1,6 @@
 #include "core/gpu/pipeline.hpp"
 
+#include "core/gpu/pipeline_cache.hpp"
 #include "core/gpu/vk_check.hpp"
 
 namespace vitrine {
@@ -13,15 +14,20 @@ VkShaderModule createShaderModule(VkDevice device, const CompiledShader& shader)
     return module;
 }
 
-VkPipeline createComputePipeline(VkDevice device, const CompiledShader& shader, VkPipelineLayout layout) {
+VkPipeline createComputePipeline(Context& ctx, const CompiledShader& shader, VkPipelineLayout layout) {
+    VkDevice device = ctx.device();
     VkShaderModule module = createShaderModule(device, shader);
+    VkPipelineCreationFeedback feedback;
+    const VkPipelineCreationFeedbackCreateInfo feedbackInfo = PipelineCache::feedbackInfo(&feedback, nullptr);
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    ci.pNext = &feedbackInfo;
     ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_COMPUTE_BIT, module, "main", nullptr};
     ci.layout = layout;
     VkPipeline pipeline = VK_NULL_HANDLE;
-    VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline);
+    VkResult result = vkCreateComputePipelines(device, ctx.pipelineCache().handle(), 1, &ci, nullptr, &pipeline);
     vkDestroyShaderModule(device, module, nullptr);
     VK_CHECK(result);
+    ctx.pipelineCache().created(feedback);
     return pipeline;
 }
 

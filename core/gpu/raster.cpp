@@ -2,6 +2,7 @@
 
 #include "core/gpu/context.hpp"
 #include "core/gpu/pipeline.hpp"
+#include "core/gpu/pipeline_cache.hpp"
 #include "core/gpu/vk_check.hpp"
 
 #include <utility>
@@ -70,8 +71,10 @@ RasterPipeline::RasterPipeline(Context& ctx, const RasterPipelineDesc& desc) : m
     rendering.pColorAttachmentFormats = desc.colorFormats.data();
     rendering.depthAttachmentFormat = desc.depthFormat;
 
+    VkPipelineCreationFeedback feedback;
+    const VkPipelineCreationFeedbackCreateInfo feedbackInfo = PipelineCache::feedbackInfo(&feedback, &rendering);
     VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    ci.pNext = &rendering;
+    ci.pNext = &feedbackInfo;
     ci.stageCount = static_cast<uint32_t>(stages.size());
     ci.pStages = stages.data();
     ci.pVertexInputState = &vi;
@@ -83,10 +86,11 @@ RasterPipeline::RasterPipeline(Context& ctx, const RasterPipelineDesc& desc) : m
     ci.pColorBlendState = &cb;
     ci.pDynamicState = &dy;
     ci.layout = mLayout;
-    VkResult result = vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &mPipeline);
+    VkResult result = vkCreateGraphicsPipelines(device, ctx.pipelineCache().handle(), 1, &ci, nullptr, &mPipeline);
     for (VkShaderModule m : modules) vkDestroyShaderModule(device, m, nullptr);
     if (result != VK_SUCCESS) release();
     VK_CHECK(result);
+    ctx.pipelineCache().created(feedback);
     ctx.setName(reinterpret_cast<uint64_t>(mPipeline), VK_OBJECT_TYPE_PIPELINE, desc.name);
 }
 

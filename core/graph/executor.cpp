@@ -485,7 +485,7 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
             pl.pPushConstantRanges = &range;
             VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &p->layout));
 
-            p->pipeline = createComputePipeline(device, shader, p->layout);
+            p->pipeline = createComputePipeline(mCtx, shader, p->layout);
             mCtx.setName(reinterpret_cast<uint64_t>(p->pipeline), VK_OBJECT_TYPE_PIPELINE, pass.id + ":" + request.shader);
         }
     }
@@ -508,7 +508,7 @@ void Executor::createNodeSetPipeline(Pipeline& p, std::span<const VkDescriptorSe
     pl.pushConstantRangeCount = range.size ? 1 : 0;
     pl.pPushConstantRanges = &range;
     VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &p.layout));
-    p.pipeline = createComputePipeline(device, p.compiled, p.layout);
+    p.pipeline = createComputePipeline(mCtx, p.compiled, p.layout);
     p.nodeLayouts.assign(layouts.begin(), layouts.end());
     mCtx.setName(reinterpret_cast<uint64_t>(p.pipeline), VK_OBJECT_TYPE_PIPELINE, passId + ":" + p.shader);
 }

@@ -1,6 +1,7 @@
 #include "core/image/color.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/paths.hpp"
 
 #include <OpenColorIO/OpenColorIO.h>
 
@@ -8,9 +9,6 @@
 #include <cstdlib>
 #include <regex>
 
-#ifndef VITRINE_DATA_DIR
-#error "VITRINE_DATA_DIR must be defined by the build (see core/image/CMakeLists.txt)"
-#endif
 
 namespace OCIO = OCIO_NAMESPACE;
 
@@ -100,7 +98,7 @@ const ColorConfig& ColorConfig::builtin() {
     static const ColorConfig config([] {
         const char* override = std::getenv("VITRINE_OCIO");
         if (override && *override) return std::filesystem::path(override);
-        return std::filesystem::path(VITRINE_DATA_DIR) / "ocio" / "config.ocio";
+        return dataDir() / "ocio" / "config.ocio";
     }());
     return config;
 }

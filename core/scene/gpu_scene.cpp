@@ -387,7 +387,7 @@ void GpuScene::buildToksvigMips(ShaderCompiler& shaders, VkCommandBuffer cmd, co
     pl.pSetLayouts = &setLayout;
     VkPipelineLayout layout;
     VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &layout));
-    VkPipeline pipeline = createComputePipeline(device, shader, layout);
+    VkPipeline pipeline = createComputePipeline(mCtx, shader, layout);
 
     uint32_t sets = 0;
     for (uint32_t t : normalMaps) sets += mTextures[t].desc().mipLevels;

@@ -1,6 +1,7 @@
 #include "core/shader/compiler.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/paths.hpp"
 #include "core/shader/reflection.hpp"
 
 #include <glslang/Public/ResourceLimits.h>
@@ -20,17 +21,9 @@ namespace vitrine {
 
 namespace fs = std::filesystem;
 
-fs::path defaultShaderDir() {
-    if (const char* env = std::getenv("VITRINE_SHADER_DIR")) return env;
-    return VITRINE_SHADER_DIR;
-}
+fs::path defaultShaderDir() { return shaderDir(); }
 
-fs::path defaultCacheDir() {
-    if (const char* env = std::getenv("VITRINE_CACHE_DIR")) return env;
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME")) return fs::path(xdg) / "vitrine";
-    if (const char* home = std::getenv("HOME")) return fs::path(home) / ".cache" / "vitrine";
-    return fs::temp_directory_path() / "vitrine-cache";
-}
+fs::path defaultCacheDir() { return cacheDir(); }
 
 VkShaderStageFlagBits stageFromPath(const std::string& path) {
     std::string ext = fs::path(path).extension().string();

@@ -36,7 +36,8 @@ struct CompiledShader {
 
 using ShaderDefines = std::vector<std::pair<std::string, std::string>>;
 
-// The directory shaders are found in: $VITRINE_SHADER_DIR, else the source tree's shaders/.
+// The directory shaders are found in: $VITRINE_SHADER_DIR, else an installed share/vitrine/shaders next to the
+// binary, else the source tree's shaders/ (core/base/paths.hpp).
 std::filesystem::path defaultShaderDir();
 // $VITRINE_CACHE_DIR, else $XDG_CACHE_HOME/vitrine, else ~/.cache/vitrine.
 std::filesystem::path defaultCacheDir();

@@ -4,6 +4,7 @@
 // data/lenses/ file. Its `state` port carries the result (nodes/camera/camera_state.hpp).
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
+#include "core/base/paths.hpp"
 #include "core/gpu/buffer_set.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/vk_check.hpp"
@@ -20,10 +21,6 @@
 #include <cstdio>
 #include <numbers>
 #include <optional>
-
-#ifndef VITRINE_DATA_DIR
-#error "VITRINE_DATA_DIR must be defined by the build (see nodes/CMakeLists.txt)"
-#endif
 
 namespace vitrine {
 namespace {
@@ -91,7 +88,7 @@ public:
         const Params& p = ctx.params();
         try {
             mLens = camera::loadLens(camera::findLens(p.getString("lens"), ctx.resolvePath(".").parent_path(),
-                                                      VITRINE_DATA_DIR));
+                                                      dataDir()));
         } catch (const UserError& e) {
             ctx.failParam("lens", e.what());
         }

@@ -1,6 +1,7 @@
 // color.grade: a colour grade through OpenColorIO (exposure/contrast, ASC CDL, a LUT file) on the GPU, from the
 // GLSL OCIO generates for it; the LUT's 3D textures are the node's own (set 1), uploaded on the first frame.
 #include "core/base/error.hpp"
+#include "core/base/paths.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/resources.hpp"
 #include "core/gpu/vk_check.hpp"
@@ -15,10 +16,6 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
-
-#ifndef VITRINE_DATA_DIR
-#error "VITRINE_DATA_DIR must be defined by the build (see nodes/CMakeLists.txt)"
-#endif
 
 namespace vitrine {
 namespace {
@@ -75,7 +72,7 @@ public:
         // the graph file.
         const std::string lut = p.getString("lut");
         if (!lut.empty())
-            g.lut = lut.find('/') == std::string::npos ? std::filesystem::path(VITRINE_DATA_DIR) / "luts" / lut
+            g.lut = lut.find('/') == std::string::npos ? dataDir() / "luts" / lut
                                                        : ctx.resolvePath(lut);
         g.lutTetrahedral = p.getString("lut_interpolation") == "tetrahedral";
         GradeShader shader;

@@ -2,10 +2,12 @@
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/version.hpp"
 
 #include <cstdio>
 #include <exception>
 #include <set>
+#include <string_view>
 
 namespace {
 
@@ -83,6 +85,7 @@ commands:
                                     files inside the bake cache folder. Cache folder: $VITRINE_CACHE_DIR,
                                     else $XDG_CACHE_HOME/vitrine, else ~/.cache/vitrine.
   devices                           List Vulkan devices.
+  --version                         The version and the git commit vitrine was built from.
 
 common options:
   --device INDEX|NAME   Vulkan device (default: best discrete GPU, else lavapipe)
@@ -98,6 +101,10 @@ stopped by Ctrl-C / SIGTERM after finishing (and writing) the frame it was rende
 
 int main(int argc, char** argv) {
     using namespace vitrine;
+    if (argc == 2 && (std::string_view(argv[1]) == "--version" || std::string_view(argv[1]) == "version")) {
+        std::printf("vitrine %s (commit %s)\n", versionNumber(), versionCommit());
+        return 0;
+    }
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",

@@ -2,6 +2,7 @@
 // (tools/vitrine/serve/).
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
+#include "core/base/paths.hpp"
 #include "tools/vitrine/cli.hpp"
 #include "tools/vitrine/render_output.hpp"
 #include "tools/vitrine/serve/api.hpp"
@@ -53,10 +54,11 @@ int serveCommand(const Args& args) {
     if (args.positional.size() > 1) throw UserError("serve: expected at most one DIR argument (default: .)");
     serve::ServeOptions options;
     options.dir = args.positional.empty() ? fs::path(".") : fs::path(args.positional[0]);
-    options.editorDist = args.get("editor", (fs::path(VITRINE_SOURCE_DIR) / "editor" / "dist").string());
+    // The bundle next to an installed binary (share/vitrine/editor/dist), else the source tree's editor/dist.
+    options.editorDist = args.get("editor", (resourceRoot() / "editor" / "dist").string());
     // A PUT never writes the editor's own files: its bundle, the sources around a bundle called dist/, and the
     // repository's editor/ (when DIR is the repository).
-    options.readOnlyDirs = {options.editorDist, fs::path(VITRINE_SOURCE_DIR) / "editor"};
+    options.readOnlyDirs = {options.editorDist, resourceRoot() / "editor"};
     fs::path dist = options.editorDist.lexically_normal();
     if (dist.filename().empty()) dist = dist.parent_path(); // "editor/dist/"
     if (dist.filename() == "dist") options.readOnlyDirs.push_back(dist.parent_path());
