@@ -21,8 +21,6 @@
 #include <optional>
 #include <string>
 
-#include <time.h>
-
 namespace vitrine {
 namespace {
 
@@ -623,12 +621,6 @@ private:
         std::snprintf(rate, sizeof rate, "; %.0f paths/s (%.0f paths per CPU-second of this process)",
                       paths / std::max(seconds, 1e-9), paths / std::max(cpuSeconds, 1e-9));
         logInfo(summaryLine(samples, seconds, relative) + rate);
-    }
-
-    static double processCpuSeconds() {
-        timespec t{};
-        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
     }
 
     std::shared_ptr<SceneObject> mScene;

@@ -39,6 +39,12 @@ void CpuAccumulation::reset(int w, int h) {
 
 bool cpuPathTracerAvailable() { return true; }
 
+double processCpuSeconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 namespace {
 
 constexpr float kInfinity = 3.4e38f;
@@ -661,12 +667,7 @@ CpuPathTracer::~CpuPathTracer() = default;
 CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
                                       const std::function<void(double)>& progress) {
     if (acc.width != s.width || acc.height != s.height) acc.reset(s.width, s.height);
-    auto cpuNow = [] {
-        timespec t{};
-        clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-    };
-    const double cpuStart = cpuNow();
+    const double cpuStart = processCpuSeconds();
     const auto wallStart = std::chrono::steady_clock::now();
     Env env;
     env.sky = &sky;
@@ -707,7 +708,7 @@ CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& s
     c.paths = static_cast<uint64_t>(s.width) * s.height * s.spp;
     c.rays = rays.load();
     c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
-    c.cpuSeconds = cpuNow() - cpuStart;
+    c.cpuSeconds = processCpuSeconds() - cpuStart;
     return c;
 }
 

@@ -73,6 +73,9 @@ private:
     std::unique_ptr<Impl> mImpl;
 };
 
+// CPU time of this process so far (all threads), in seconds: throughput figures that hold on a loaded machine.
+double processCpuSeconds();
+
 // Whether this build has the CPU tracer (Embree found at configure time).
 bool cpuPathTracerAvailable();
 
