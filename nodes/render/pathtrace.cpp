@@ -1,5 +1,6 @@
 // render.pathtrace: progressive path-traced reference of the scene camera (shaders/render/pathtrace.comp).
 #include "shaders/render/pathtrace.h"
+#include "nodes/render/converge.hpp"
 #include "nodes/render/pathtrace_cpu.hpp"
 #include "core/accel/gpu_bvh.hpp"
 #include "core/gpu/buffer_set.hpp"
@@ -139,32 +140,8 @@ NodeSchema schema() {
          "Where paths are traced: gpu (shaders/render/pathtrace.comp), cpu (nodes/render/pathtrace_cpu.cpp: the same "
          "estimator, materials and BRDF through Embree on every core, about 10x the paths per second of lavapipe), "
          "auto: cpu when the Vulkan device is a CPU (lavapipe), else gpu"},
-        {"target_noise",
-         ParamType::Float,
-         0.0,
-         0.0,
-         1.0,
-         {},
-         "Converge, then cache: > 0 traces batches of `spp` samples until the median over lit pixels of the standard "
-         "error of the mean luminance, relative to that mean (stats.w / stats.y), is at most this and min_spp is "
-         "reached (or max_seconds ran out); the converged result is stored in the bake cache under a key of "
-         "everything it depends on and loaded, not traced, by later runs. 0: `spp` samples a frame, no cache"},
-        {"min_spp",
-         ParamType::Int,
-         64,
-         1.0,
-         1e9,
-         {},
-         "With target_noise: at least this many samples per pixel (the noise estimate of a few samples is itself noisy)"},
-        {"max_seconds",
-         ParamType::Float,
-         0.0,
-         0.0,
-         1e7,
-         {},
-         "With target_noise: stop after this long even if the target is not reached (0: no limit); a result stopped "
-         "early is not cached"},
     };
+    appendConvergeParams(s.params);
     return s;
 }
 
@@ -255,23 +232,6 @@ private:
     // Bump when the CPU tracer's estimator changes (the GPU tracer's SPIR-V is hashed instead).
     static constexpr uint32_t kCpuTracerVersion = 1;
 
-    // The median (and 90th percentile) over pixels with light of the standard error of the mean luminance relative
-    // to that mean.
-    static double relativeNoise(const std::vector<glm::vec4>& stats, double* p90 = nullptr) {
-        std::vector<float> relative;
-        relative.reserve(stats.size());
-        for (const glm::vec4& st : stats)
-            if (st.y > 0.0f) relative.push_back(st.w / st.y);
-        if (relative.empty()) return 0.0;
-        auto at = [&](double q) {
-            auto it = relative.begin() + static_cast<std::ptrdiff_t>(q * double(relative.size() - 1));
-            std::nth_element(relative.begin(), it, relative.end());
-            return static_cast<double>(*it);
-        };
-        if (p90) *p90 = at(0.9);
-        return at(0.5);
-    }
-
     // Everything a converged result depends on: the scene's content and pose, the camera, the sky (its pixels),
     // the frame size, every param that changes the estimate, and the tracer (CPU version, or the GPU's SPIR-V
     // and device).
@@ -307,135 +267,50 @@ private:
         return BakeKey{"reference", h.result()};
     }
 
-    std::vector<uint8_t> serializeAccumulation() const {
-        const uint32_t header[4] = {0x52545056u /* "VPTR" */, static_cast<uint32_t>(mAccumulation.width),
-                                    static_cast<uint32_t>(mAccumulation.height), 1u};
-        const size_t n = mAccumulation.color.size() * sizeof(glm::vec4);
-        std::vector<uint8_t> bytes(sizeof header + 2 * n);
-        std::memcpy(bytes.data(), header, sizeof header);
-        std::memcpy(bytes.data() + sizeof header, mAccumulation.color.data(), n);
-        std::memcpy(bytes.data() + sizeof header + n, mAccumulation.stats.data(), n);
-        return bytes;
-    }
-
-    bool deserializeAccumulation(const std::vector<uint8_t>& bytes, const ImageDesc& out) {
-        uint32_t header[4];
-        const size_t n = static_cast<size_t>(out.width) * out.height * sizeof(glm::vec4);
-        if (bytes.size() != sizeof header + 2 * n) return false;
-        std::memcpy(header, bytes.data(), sizeof header);
-        if (header[0] != 0x52545056u || header[1] != out.width || header[2] != out.height || header[3] != 1u) return false;
-        mAccumulation.reset(static_cast<int>(out.width), static_cast<int>(out.height));
-        std::memcpy(mAccumulation.color.data(), bytes.data() + sizeof header, n);
-        std::memcpy(mAccumulation.stats.data(), bytes.data() + sizeof header + n, n);
-        return true;
-    }
-
     void executeConverge(ExecuteContext& ctx, bool cpu) {
-        const Params& p = ctx.params();
         const ImageDesc& out = ctx.output("color").desc();
         ctx.splitSubmission(); // the sky of this frame is computed before it is read back and hashed
-        const CpuSky sky = readSky(ctx);
+        const CpuSky sky = readCpuSky(ctx);
         const BakeKey key = referenceKey(ctx, cpu, sky, out);
         if (!mConvergedKey || *mConvergedKey != key.hash) {
-            const BakeCache cache(defaultCacheDir());
-            const auto loadStart = std::chrono::steady_clock::now();
-            std::optional<std::vector<uint8_t>> bytes = cache.get(key);
-            if (bytes && deserializeAccumulation(*bytes, out)) {
-                double p90 = 0.0;
-                const double noise = relativeNoise(mAccumulation.stats, &p90);
-                char line[240];
-                std::snprintf(line, sizeof line,
-                              "render.pathtrace: converged reference loaded from the bake cache in %.0f ms (%.0f spp, "
-                              "standard error %.2f %% of the pixel's mean (median), %.2f %% (p90))",
-                              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - loadStart).count(),
-                              static_cast<double>(mAccumulation.stats.empty() ? 0.0f : mAccumulation.stats[0].x),
-                              noise * 100.0, p90 * 100.0);
-                logInfo(line);
-            } else if (converge(ctx, cpu, sky, out)) {
-                if (!cache.put(key, serializeAccumulation()))
-                    logWarning("render.pathtrace: could not write the converged reference to the bake cache under " +
-                               cache.dir().string());
-            }
+            const int w = static_cast<int>(out.width), h = static_cast<int>(out.height);
+            if (!loadConverged(key, "render.pathtrace", w, h, mAccumulation) && converge(ctx, cpu, sky, out))
+                storeConverged(key, "render.pathtrace", mAccumulation);
             mConvergedKey = key.hash;
         }
-        storeAccumulation(ctx, out);
-        (void)p;
+        mUpload.upload(ctx, mStorePipeline, mAccumulation);
     }
 
     // Traces batches of `spp` samples into mAccumulation until the target and min_spp hold (true) or max_seconds
     // ran out (false).
     bool converge(ExecuteContext& ctx, bool cpu, const CpuSky& sky, const ImageDesc& out) {
         const Params& p = ctx.params();
-        const double target = p.getFloat("target_noise"), maxSeconds = p.getFloat("max_seconds");
-        const double minSpp = static_cast<double>(p.getInt("min_spp"));
-        const uint32_t batch = static_cast<uint32_t>(p.getInt("spp"));
-        const bool report = p.getBool("report");
-        const auto start = std::chrono::steady_clock::now();
-        auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-
-        mAccumulation.reset(static_cast<int>(out.width), static_cast<int>(out.height));
-        std::unique_ptr<Progress> bar;
-        if (report) {
-            char label[160];
-            std::snprintf(label, sizeof label, "path tracing %ux%u to %.2f %% noise on the %s", out.width, out.height,
-                          target * 100.0, cpu ? "CPU" : "GPU");
-            bar = std::make_unique<Progress>(label, 1000);
-        }
-        size_t shown = 0;
-        double samples = 0.0, noise = 1.0, p90 = 0.0;
-        bool announced = false, converged = false;
-        for (uint32_t b = 0;; ++b) {
-            const uint32_t seed = (static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu) ^ (b * 0x9E3779B9u);
+        ConvergeRun run;
+        run.node = "render.pathtrace";
+        run.what = "path tracing";
+        run.where = cpu ? "CPU" : "GPU";
+        run.width = static_cast<int>(out.width);
+        run.height = static_cast<int>(out.height);
+        run.target = p.getFloat("target_noise");
+        run.maxSeconds = p.getFloat("max_seconds");
+        run.minSpp = static_cast<double>(p.getInt("min_spp"));
+        run.batch = static_cast<uint32_t>(p.getInt("spp"));
+        run.seed = static_cast<uint32_t>(p.getInt("seed"));
+        run.report = p.getBool("report");
+        const bool converged = convergeAccumulation(run, mAccumulation, [&](uint32_t spp, uint32_t seed, uint32_t b) {
             if (cpu) {
-                traceCpuBatch(ctx, sky, out, batch, seed);
+                traceCpuBatch(ctx, sky, out, spp, seed);
             } else {
-                recordGpuSamples(ctx, batch, b * 1024u, b > 0, true, seed);
+                recordGpuSamples(ctx, spp, b * 1024u, b > 0, true, seed);
                 ctx.splitSubmission();
                 const Image stats = readImage(ctx.gpu(), ctx.output("stats"), VK_IMAGE_LAYOUT_GENERAL);
                 std::memcpy(mAccumulation.stats.data(), stats.pixels.data(), stats.pixels.size() * sizeof(float));
             }
-            samples += batch;
-            noise = relativeNoise(mAccumulation.stats, &p90);
-            const double t = elapsed();
-            // Noise falls as 1 / sqrt(samples): the samples the target needs, and the time that takes.
-            const double needed = std::max(minSpp, samples * (noise / target) * (noise / target));
-            if (report && !announced) {
-                char line[240];
-                std::snprintf(line, sizeof line,
-                              "render.pathtrace: %.0f spp in %.1f s, standard error %.1f %% (median); the target %.2f %% "
-                              "needs about %.0f spp: about %.0f s on this machine",
-                              samples, t, noise * 100.0, target * 100.0, needed, t / samples * needed);
-                std::fprintf(stderr, "\n");
-                logInfo(line);
-                announced = true;
-            }
-            if (bar) {
-                const size_t now = static_cast<size_t>(std::min(0.999, samples / needed) * 1000.0);
-                if (now > shown) bar->advance(now - shown);
-                shown = std::max(shown, now);
-            }
-            if (samples >= minSpp && noise <= target) {
-                converged = true;
-                break;
-            }
-            if (maxSeconds > 0.0 && t >= maxSeconds) break;
-        }
-        if (bar) {
-            bar->advance(1000 - shown);
-            bar.reset();
-        }
+        });
         if (!cpu) {
             const Image color = readImage(ctx.gpu(), ctx.output("color"), VK_IMAGE_LAYOUT_GENERAL);
             std::memcpy(mAccumulation.color.data(), color.pixels.data(), color.pixels.size() * sizeof(float));
         }
-        char line[240];
-        std::snprintf(line, sizeof line,
-                      "render.pathtrace: %s after %.0f spp in %.1f s: standard error %.2f %% of the pixel's mean "
-                      "(median), %.2f %% (p90)%s",
-                      converged ? "converged" : "stopped at max_seconds", samples, elapsed(), noise * 100.0, p90 * 100.0,
-                      converged ? "; stored in the bake cache" : ", above the target: not cached");
-        if (converged) logInfo(line);
-        else logWarning(line);
         return converged;
     }
 
@@ -472,42 +347,6 @@ private:
         recordNodeFigure("render.pathtrace cpu paths per CPU-second", mLastPathsPerCpuSecond);
     }
 
-    // mAccumulation into the outputs, through a host-visible buffer and a copy shader (the outputs stay storage
-    // images, written by the GPU tracer's dispatches otherwise).
-    void storeAccumulation(ExecuteContext& ctx, const ImageDesc& out) {
-        const size_t bytes = mAccumulation.color.size() * 2 * sizeof(glm::vec4);
-        if (!mStoreBuffer || mStoreBuffer.size() < bytes) {
-            mStoreSet = StorageBufferSet();
-            mStoreBuffer = GpuBuffer(ctx.gpu(), bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "pathtrace.cpu_result");
-            const VkBuffer buffers[1] = {mStoreBuffer.buffer()};
-            mStoreSet = StorageBufferSet(ctx.gpu(), buffers, VK_SHADER_STAGE_COMPUTE_BIT, "pathtrace.cpu_result");
-        }
-        auto* dst = static_cast<glm::vec4*>(mStoreBuffer.mapped());
-        for (size_t i = 0; i < mAccumulation.color.size(); ++i) {
-            dst[2 * i] = mAccumulation.color[i];
-            dst[2 * i + 1] = mAccumulation.stats[i];
-        }
-        const glm::uvec4 push(out.width, out.height, 0u, 0u);
-        std::array<VkDescriptorSetLayout, 1> layouts = {mStoreSet.layout()};
-        std::array<VkDescriptorSet, 1> sets = {mStoreSet.set()};
-        ctx.dispatchWithSets(mStorePipeline, &push, sizeof(push), out.width, out.height, layouts, sets);
-    }
-
-    // The sky nodes' outputs, read back for the CPU tracer (they were computed earlier in this frame).
-    CpuSky readSky(ExecuteContext& ctx) {
-        CpuSky sky;
-        const GpuImage& cube = ctx.input("sky");
-        sky.size = static_cast<int>(cube.desc().width);
-        for (uint32_t face = 0; face < 6; ++face)
-            sky.faces.push_back(readImage(ctx.gpu(), cube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
-        const Image sh = readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-        sky.sunIlluminance = glm::vec3(sh.at(9, 0)[0], sh.at(9, 0)[1], sh.at(9, 0)[2]);
-        sky.sunDirection = glm::vec3(sh.at(10, 0)[0], sh.at(10, 0)[1], sh.at(10, 0)[2]);
-        if (ctx.hasInput("env_cdf"))
-            sky.envCdf = readImage(ctx.gpu(), ctx.input("env_cdf"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-        return sky;
-    }
-
     void executeCpu(ExecuteContext& ctx) {
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
@@ -518,7 +357,7 @@ private:
         const auto start = std::chrono::steady_clock::now();
 
         ctx.splitSubmission(); // the sky nodes' work of this frame is done before it is read back
-        const CpuSky sky = readSky(ctx);
+        const CpuSky sky = readCpuSky(ctx);
         if (!posed) {
             mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld);
             mCpuPose = mScene->pose.instanceWorld;
@@ -565,7 +404,7 @@ private:
         mLastPathsPerCpuSecond = static_cast<double>(counters.paths) / std::max(counters.cpuSeconds, 1e-9);
         recordCpuFigures();
 
-        storeAccumulation(ctx, out);
+        mUpload.upload(ctx, mStorePipeline, mAccumulation);
 
         if (report) {
             std::vector<float> relative;
@@ -631,8 +470,7 @@ private:
     std::unique_ptr<CpuPathTracer> mCpu;
     std::vector<glm::mat4> mCpuPose;
     CpuAccumulation mAccumulation;
-    GpuBuffer mStoreBuffer;
-    StorageBufferSet mStoreSet;
+    CpuResultUpload mUpload;
     double mLastPathsPerSecond = 0.0, mLastRaysPerSecond = 0.0, mLastPathsPerCpuSecond = 0.0;
     std::optional<uint64_t> mConvergedKey; // the key of the converged result in mAccumulation
 };

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstring>
 #include <mutex>
 #include <thread>
 
@@ -367,11 +368,7 @@ struct TriangleRef {
     uint32_t instance, primitive, triangle, material;
 };
 
-struct PathSurface {
-    vec3 position, geometricNormal, normal, baseColor;
-    float metallic, roughness, cavity;
-    vec3 emissive;
-};
+using PathSurface = CpuSurface;
 
 vec3 offsetRay(vec3 p, vec3 ng, vec3 dir) {
     float scale = 1e-4f * (1.0f + std::max(std::max(std::abs(p.x), std::abs(p.y)), std::abs(p.z)));
@@ -468,7 +465,7 @@ struct CpuPathTracer::Impl {
         return true;
     }
 
-    bool occluded(vec3 o, vec3 d, uint64_t& rays) const {
+    bool occluded(vec3 o, vec3 d, uint64_t& rays, float tmax = kInfinity) const {
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
         RTCRay r{};
@@ -479,7 +476,7 @@ struct CpuPathTracer::Impl {
         r.dir_y = d.y;
         r.dir_z = d.z;
         r.tnear = 0.0f;
-        r.tfar = kInfinity;
+        r.tfar = tmax;
         r.mask = ~0u;
         rtcOccluded1(rtc, &context, &r);
         ++rays;
@@ -517,6 +514,7 @@ struct CpuPathTracer::Impl {
         const glm::mat3& normalM = normalMatrix[ref.instance];
 
         PathSurface s;
+        s.t = hit.t;
         s.position = origin + hit.t * direction;
         vec3 ng = glm::normalize(normalM * glm::cross(v1.position - v0.position, v2.position - v0.position));
         bool backFace = glm::dot(ng, direction) > 0.0f;
@@ -563,6 +561,13 @@ struct CpuPathTracer::Impl {
     // pathtrace.comp's tracePath, line for line.
     vec3 tracePath(vec3 origin, vec3 dir, uint32_t& rng, const CpuTraceSettings& st, const Env& env,
                    uint64_t& rays) const {
+        return continuePath(origin, dir, rng, st, env, rays, nullptr, true);
+    }
+
+    // tracePath, optionally from a first surface already found along dir (the ray-traced twins' queries); without
+    // firstEmission that surface's emission is left out.
+    vec3 continuePath(vec3 origin, vec3 dir, uint32_t& rng, const CpuTraceSettings& st, const Env& env,
+                      uint64_t& rays, const PathSurface* first, bool firstEmission) const {
         bool envSampling = st.envSampling && st.skyScale > 0.0f && env.total() > 0.0f;
         vec3 sunE = env.sky->sunIlluminance * st.sunScale;
         vec3 sunDir = glm::normalize(env.sky->sunDirection);
@@ -571,14 +576,20 @@ struct CpuPathTracer::Impl {
         vec3 radiance(0.0f), throughput(1.0f);
         float brdfPdfPrev = 0.0f;
         for (uint32_t bounce = 0;; ++bounce) {
-            Hit hit;
-            if (!traceVisible(origin, dir, hit, rays)) {
-                float w = bounce == 0u || !envSampling ? 1.0f : powerHeuristic(brdfPdfPrev, env.pdf(dir));
-                radiance += throughput * env.radiance(dir) * w;
-                break;
+            PathSurface s;
+            if (bounce == 0u && first) {
+                s = *first;
+                if (firstEmission) radiance += throughput * s.emissive * st.emissiveScale;
+            } else {
+                Hit hit;
+                if (!traceVisible(origin, dir, hit, rays)) {
+                    float w = bounce == 0u || !envSampling ? 1.0f : powerHeuristic(brdfPdfPrev, env.pdf(dir));
+                    radiance += throughput * env.radiance(dir) * w;
+                    break;
+                }
+                s = pathSurface(hit, origin, dir);
+                radiance += throughput * s.emissive * st.emissiveScale;
             }
-            PathSurface s = pathSurface(hit, origin, dir);
-            radiance += throughput * s.emissive * st.emissiveScale;
             if (bounce >= st.maxBounces) break;
 
             vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
@@ -621,21 +632,32 @@ struct CpuPathTracer::Impl {
         return radiance;
     }
 
+    static vec3 cameraDirection(const CpuTraceSettings& st, int x, int y, vec2 jitter) {
+        vec2 ndc = (vec2(static_cast<float>(x), static_cast<float>(y)) + jitter) /
+                       vec2(static_cast<float>(st.width), static_cast<float>(st.height)) * 2.0f -
+                   1.0f;
+        vec4 nearH = st.invViewProj * vec4(ndc, 1.0f, 1.0f);
+        vec4 farH = st.invViewProj * vec4(ndc, 0.5f, 1.0f);
+        return glm::normalize(vec3(farH) / farH.w - vec3(nearH) / nearH.w);
+    }
+
     // pathtrace.comp's main for one row: this batch's samples, merged into the accumulation (Chan et al.).
     void traceRow(int y, const CpuTraceSettings& st, const Env& env, CpuAccumulation& acc, uint64_t& rays) const {
+        estimateRow(y, st, acc, [&](int x, uint32_t& rng) {
+            vec2 jitter = st.antialias ? rngNext2(rng) : vec2(0.5f);
+            return tracePath(st.cameraPos, cameraDirection(st, x, y, jitter), rng, st, env, rays);
+        });
+    }
+
+    // One row of any per-pixel estimator `sample(x, rng)`, merged into the accumulation (Chan et al.).
+    template <class Sample>
+    void estimateRow(int y, const CpuTraceSettings& st, CpuAccumulation& acc, const Sample& sample) const {
         for (int x = 0; x < st.width; ++x) {
             vec3 sum(0.0f);
             float mean = 0.0f, m2 = 0.0f;
             for (uint32_t i = 0; i < st.spp; ++i) {
                 uint32_t rng = rngSeed(glm::uvec2(x, y), st.seed, i);
-                vec2 jitter = st.antialias ? rngNext2(rng) : vec2(0.5f);
-                vec2 ndc = (vec2(static_cast<float>(x), static_cast<float>(y)) + jitter) /
-                               vec2(static_cast<float>(st.width), static_cast<float>(st.height)) * 2.0f -
-                           1.0f;
-                vec4 nearH = st.invViewProj * vec4(ndc, 1.0f, 1.0f);
-                vec4 farH = st.invViewProj * vec4(ndc, 0.5f, 1.0f);
-                vec3 dir = glm::normalize(vec3(farH) / farH.w - vec3(nearH) / nearH.w);
-                vec3 L = tracePath(st.cameraPos, dir, rng, st, env, rays);
+                vec3 L = sample(x, rng);
                 if (!std::isfinite(L.x) || !std::isfinite(L.y) || !std::isfinite(L.z)) L = vec3(0.0f);
                 sum += L;
                 float yl = luminance(L), delta = yl - mean;
@@ -664,36 +686,23 @@ CpuPathTracer::CpuPathTracer(const scene::Scene& scene, const std::vector<glm::m
 
 CpuPathTracer::~CpuPathTracer() = default;
 
-CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
-                                      const std::function<void(double)>& progress) {
-    if (acc.width != s.width || acc.height != s.height) acc.reset(s.width, s.height);
+namespace {
+
+// Runs row(y, rays) for every row of the frame on every core; the calling thread reports progress.
+template <class Row>
+CpuTraceCounters forEachRow(const CpuTraceSettings& s, const Row& row, const std::function<void(double)>& progress) {
     const double cpuStart = processCpuSeconds();
     const auto wallStart = std::chrono::steady_clock::now();
-    Env env;
-    env.sky = &sky;
-    env.scale = s.skyScale;
     const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
     std::atomic<int> nextRow{0}, rowsDone{0};
     std::atomic<uint64_t> rays{0};
-    auto work = [&] {
+    auto work = [&](bool report) {
         uint64_t local = 0;
-        for (int y; (y = nextRow.fetch_add(1)) < s.height;) {
-            mImpl->traceRow(y, s, env, acc, local);
-            rowsDone.fetch_add(1);
-        }
-        rays.fetch_add(local);
-    };
-    std::vector<std::thread> pool;
-    for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
-    if (!progress) {
-        work();
-    } else {
-        // The calling thread reports progress and traces rows between reports.
         auto last = std::chrono::steady_clock::now();
-        uint64_t local = 0;
         for (int y; (y = nextRow.fetch_add(1)) < s.height;) {
-            mImpl->traceRow(y, s, env, acc, local);
+            row(y, local);
             rowsDone.fetch_add(1);
+            if (!report) continue;
             auto now = std::chrono::steady_clock::now();
             if (now - last > std::chrono::milliseconds(200)) {
                 progress(static_cast<double>(rowsDone.load()) / s.height);
@@ -701,7 +710,10 @@ CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& s
             }
         }
         rays.fetch_add(local);
-    }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work, false);
+    work(static_cast<bool>(progress));
     for (auto& t : pool) t.join();
     if (progress) progress(1.0);
     CpuTraceCounters c;
@@ -710,6 +722,119 @@ CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& s
     c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
     c.cpuSeconds = processCpuSeconds() - cpuStart;
     return c;
+}
+
+} // namespace
+
+CpuTraceCounters CpuPathTracer::trace(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
+                                      const std::function<void(double)>& progress) {
+    if (acc.width != s.width || acc.height != s.height) acc.reset(s.width, s.height);
+    Env env;
+    env.sky = &sky;
+    env.scale = s.skyScale;
+    return forEachRow(
+        s, [&](int y, uint64_t& rays) { mImpl->traceRow(y, s, env, acc, rays); }, progress);
+}
+
+CpuTraceCounters CpuPathTracer::estimate(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
+                                         const CpuSampleFn& sample, const std::function<void(double)>& progress) {
+    if (acc.width != s.width || acc.height != s.height) acc.reset(s.width, s.height);
+    Env env;
+    env.sky = &sky;
+    env.scale = s.skyScale;
+    return forEachRow(
+        s,
+        [&](int y, uint64_t& rays) {
+            CpuRays q;
+            q.mImpl = mImpl.get();
+            q.mSettings = &s;
+            q.mEnv = &env;
+            mImpl->estimateRow(y, s, acc, [&](int x, uint32_t& rng) { return sample(q, x, y, rng); });
+            rays += q.mRays;
+        },
+        progress);
+}
+
+// --- CpuRays ---
+
+namespace {
+const CpuPathTracer::Impl& implOf(const void* p) { return *static_cast<const CpuPathTracer::Impl*>(p); }
+const Env& envOf(const void* p) { return *static_cast<const Env*>(p); }
+} // namespace
+
+bool CpuRays::intersect(vec3 o, vec3 d, float tmax, CpuSurface& hit) const {
+    CpuPathTracer::Impl::Hit h;
+    if (!implOf(mImpl).traceVisible(o, d, h, mRays) || h.t >= tmax) return false;
+    hit = implOf(mImpl).pathSurface(h, o, d);
+    return true;
+}
+
+bool CpuRays::occluded(vec3 o, vec3 d, float tmax) const { return implOf(mImpl).occluded(o, d, mRays, tmax); }
+
+vec3 CpuRays::radiance(vec3 o, vec3 d, uint32_t& rng) const {
+    return implOf(mImpl).tracePath(o, d, rng, *mSettings, envOf(mEnv), mRays);
+}
+
+vec3 CpuRays::radianceFrom(const CpuSurface& s, vec3 d, uint32_t& rng, bool emission) const {
+    return implOf(mImpl).continuePath(s.position - s.t * d, d, rng, *mSettings, envOf(mEnv), mRays, &s, emission);
+}
+
+vec3 CpuRays::sky(vec3 d) const { return envOf(mEnv).radiance(glm::normalize(d)); }
+vec3 CpuRays::sunIlluminance() const { return envOf(mEnv).sky->sunIlluminance * mSettings->sunScale; }
+vec3 CpuRays::sunDirection() const { return glm::normalize(envOf(mEnv).sky->sunDirection); }
+
+void CpuRays::cameraRay(int x, int y, vec2 jitter, vec3& origin, vec3& direction) const {
+    origin = mSettings->cameraPos;
+    direction = CpuPathTracer::Impl::cameraDirection(*mSettings, x, y, jitter);
+}
+
+vec3 CpuRays::offset(vec3 p, vec3 geometricNormal, vec3 dir) { return offsetRay(p, geometricNormal, dir); }
+float CpuRays::next(uint32_t& rng) { return rngNext(rng); }
+vec2 CpuRays::next2(uint32_t& rng) { return rngNext2(rng); }
+
+// --- CpuAccumulation ---
+
+std::vector<uint8_t> CpuAccumulation::serialize() const {
+    const uint32_t header[4] = {0x52545056u /* "VPTR" */, static_cast<uint32_t>(width), static_cast<uint32_t>(height),
+                                1u};
+    const size_t n = color.size() * sizeof(glm::vec4);
+    std::vector<uint8_t> bytes(sizeof header + 2 * n);
+    std::memcpy(bytes.data(), header, sizeof header);
+    std::memcpy(bytes.data() + sizeof header, color.data(), n);
+    std::memcpy(bytes.data() + sizeof header + n, stats.data(), n);
+    return bytes;
+}
+
+bool CpuAccumulation::deserialize(const std::vector<uint8_t>& bytes, int w, int h) {
+    uint32_t header[4];
+    const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h) * sizeof(glm::vec4);
+    if (w <= 0 || h <= 0 || bytes.size() != sizeof header + 2 * n) return false;
+    std::memcpy(header, bytes.data(), sizeof header);
+    if (header[0] != 0x52545056u || header[1] != static_cast<uint32_t>(w) || header[2] != static_cast<uint32_t>(h) ||
+        header[3] != 1u)
+        return false;
+    reset(w, h);
+    std::memcpy(color.data(), bytes.data() + sizeof header, n);
+    std::memcpy(stats.data(), bytes.data() + sizeof header + n, n);
+    return true;
+}
+
+double CpuAccumulation::relativeNoise(double* p90) const {
+    std::vector<float> relative;
+    relative.reserve(stats.size());
+    for (const glm::vec4& st : stats)
+        if (st.y > 0.0f) relative.push_back(st.w / st.y);
+    if (relative.empty()) {
+        if (p90) *p90 = 0.0;
+        return 0.0;
+    }
+    auto at = [&](double q) {
+        auto it = relative.begin() + static_cast<std::ptrdiff_t>(q * double(relative.size() - 1));
+        std::nth_element(relative.begin(), it, relative.end());
+        return static_cast<double>(*it);
+    };
+    if (p90) *p90 = at(0.9);
+    return at(0.5);
 }
 
 } // namespace vitrine

@@ -45,7 +45,67 @@ struct CpuAccumulation {
     int width = 0, height = 0;
     std::vector<glm::vec4> color, stats;
     void reset(int w, int h);
+    // For the bake cache: a small header (magic, size), then color and stats. deserialize() is false (and leaves
+    // this unchanged) for bytes of another size or format.
+    std::vector<uint8_t> serialize() const;
+    bool deserialize(const std::vector<uint8_t>& bytes, int w, int h);
+    // The median (and 90th percentile) over pixels with light of the standard error of the mean luminance relative
+    // to that mean (stats.w / stats.y): the noise figure target_noise is compared with.
+    double relativeNoise(double* p90 = nullptr) const;
 };
+
+// A surface found by a ray, as the path tracer shades it (shading normal facing the ray, the material evaluated
+// through the texel pool).
+struct CpuSurface {
+    glm::vec3 position{0.0f}, geometricNormal{0.0f}, normal{0.0f}, baseColor{0.0f};
+    float metallic = 0.0f, roughness = 1.0f, cavity = 1.0f;
+    glm::vec3 emissive{0.0f};
+    float t = 0.0f; // distance along the ray
+};
+
+class CpuPathTracer;
+
+// Ray queries on the tracer's scene for the ray-traced twins (nodes/reference/): the same Embree scene, back-face
+// rule and materials as the path tracer, and the path tracer's own estimator for the radiance along a ray. One per
+// thread (it counts the rays it traces); made by CpuPathTracer::estimate.
+class CpuRays {
+public:
+    // The first visible surface along o + t d, t in (0, tmax) (single-sided materials' backs are skipped, as the
+    // rasteriser culls them).
+    bool intersect(glm::vec3 o, glm::vec3 d, float tmax, CpuSurface& hit) const;
+    // Whether anything (either side of any opaque triangle) lies along o + t d, t in (0, tmax).
+    bool occluded(glm::vec3 o, glm::vec3 d, float tmax) const;
+    // render.pathtrace's estimate of the radiance arriving at o from direction -d (emission of the first surface,
+    // sun and sky NEE at every bounce, up to maxBounces surfaces), in cd/m^2 with the settings' scales.
+    glm::vec3 radiance(glm::vec3 o, glm::vec3 d, uint32_t& rng) const;
+    // Like radiance(), but the path starts at a known surface `s` seen along `d` from `o` (the first hit is not
+    // traced again). With emission false the surface's own emission is left out.
+    glm::vec3 radianceFrom(const CpuSurface& s, glm::vec3 d, uint32_t& rng, bool emission = true) const;
+    // The sky cube map's radiance along d (times sky_scale); the sun's illuminance (times sun_scale) and direction.
+    glm::vec3 sky(glm::vec3 d) const;
+    glm::vec3 sunIlluminance() const;
+    glm::vec3 sunDirection() const;
+    // The camera ray through pixel (x, y) at sub-pixel position `jitter` (0.5: the centre): origin and direction.
+    void cameraRay(int x, int y, glm::vec2 jitter, glm::vec3& origin, glm::vec3& direction) const;
+    // A point just off the surface on the side of `dir` (the tracer's self-intersection offset).
+    static glm::vec3 offset(glm::vec3 p, glm::vec3 geometricNormal, glm::vec3 dir);
+    // Uniform random numbers in [0, 1) from the tracer's PCG sequence.
+    static float next(uint32_t& rng);
+    static glm::vec2 next2(uint32_t& rng);
+
+    const CpuTraceSettings& settings() const { return *mSettings; }
+    uint64_t rays() const { return mRays; }
+
+private:
+    friend class CpuPathTracer;
+    const void* mImpl = nullptr; // CpuPathTracer::Impl
+    const CpuTraceSettings* mSettings = nullptr;
+    const void* mEnv = nullptr;
+    mutable uint64_t mRays = 0;
+};
+
+// One sample of a per-pixel estimate: rng is seeded per pixel, batch and sample as the path tracer's are.
+using CpuSampleFn = std::function<glm::vec3(const CpuRays& rays, int x, int y, uint32_t& rng)>;
 
 struct CpuTraceCounters {
     uint64_t paths = 0, rays = 0;
@@ -66,6 +126,11 @@ public:
     // in full, so a cancelled batch leaves some rows with fewer samples).
     CpuTraceCounters trace(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
                            const std::function<void(double)>& progress = {});
+
+    // Like trace(), but each sample is `sample` (a ray-traced twin's estimator) instead of a camera path; the
+    // accumulation and its stats are the same (the luminance of the returned value drives the noise estimate).
+    CpuTraceCounters estimate(const CpuTraceSettings& s, const CpuSky& sky, CpuAccumulation& acc,
+                              const CpuSampleFn& sample, const std::function<void(double)>& progress = {});
 
     struct Impl;
 

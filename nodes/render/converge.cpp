@@ -1,0 +1,162 @@
+// "Converge, then cache" (see converge.hpp).
+#include "nodes/render/converge.hpp"
+#include "core/base/log.hpp"
+#include "core/gpu/context.hpp"
+#include "core/gpu/transfer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+namespace vitrine {
+
+void appendConvergeParams(std::vector<ParamSpec>& params) {
+    params.push_back(
+        {"target_noise",
+         ParamType::Float,
+         0.0,
+         0.0,
+         1.0,
+         {},
+         "Converge, then cache: > 0 traces batches of `spp` samples until the median over lit pixels of the standard "
+         "error of the mean luminance, relative to that mean (stats.w / stats.y), is at most this and min_spp is "
+         "reached (or max_seconds ran out); the converged result is stored in the bake cache under a key of "
+         "everything it depends on and loaded, not traced, by later runs. 0: `spp` samples a frame, no cache"});
+    params.push_back(
+        {"min_spp",
+         ParamType::Int,
+         64,
+         1.0,
+         1e9,
+         {},
+         "With target_noise: at least this many samples per pixel (the noise estimate of a few samples is itself noisy)"});
+    params.push_back({"max_seconds",
+                      ParamType::Float,
+                      0.0,
+                      0.0,
+                      1e7,
+                      {},
+                      "With target_noise: stop after this long even if the target is not reached (0: no limit); a "
+                      "result stopped early is not cached"});
+}
+
+uint32_t convergeBatchSeed(uint32_t seed, uint32_t b) { return (seed * 0x85EBCA6Bu + 0x27D4EB2Fu) ^ (b * 0x9E3779B9u); }
+
+bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
+                          const std::function<void(uint32_t, uint32_t, uint32_t)>& traceBatch) {
+    const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    acc.reset(run.width, run.height);
+    std::unique_ptr<Progress> bar;
+    if (run.report) {
+        char label[200];
+        std::snprintf(label, sizeof label, "%s %dx%d to %.2f %% noise on the %s", run.what.c_str(), run.width,
+                      run.height, run.target * 100.0, run.where.c_str());
+        bar = std::make_unique<Progress>(label, 1000);
+    }
+    size_t shown = 0;
+    double samples = 0.0, noise = 1.0, p90 = 0.0;
+    bool announced = false, converged = false;
+    for (uint32_t b = 0;; ++b) {
+        traceBatch(run.batch, convergeBatchSeed(run.seed, b), b);
+        samples += run.batch;
+        noise = acc.relativeNoise(&p90);
+        const double t = elapsed();
+        // Noise falls as 1 / sqrt(samples): the samples the target needs, and the time that takes.
+        const double needed = std::max(run.minSpp, samples * (noise / run.target) * (noise / run.target));
+        if (run.report && !announced) {
+            char line[280];
+            std::snprintf(line, sizeof line,
+                          "%s: %.0f spp in %.1f s, standard error %.1f %% (median); the target %.2f %% needs about "
+                          "%.0f spp: about %.0f s on this machine",
+                          run.node.c_str(), samples, t, noise * 100.0, run.target * 100.0, needed, t / samples * needed);
+            std::fprintf(stderr, "\n");
+            logInfo(line);
+            announced = true;
+        }
+        if (bar) {
+            const size_t now = static_cast<size_t>(std::min(0.999, samples / needed) * 1000.0);
+            if (now > shown) bar->advance(now - shown);
+            shown = std::max(shown, now);
+        }
+        if (samples >= run.minSpp && noise <= run.target) {
+            converged = true;
+            break;
+        }
+        if (run.maxSeconds > 0.0 && t >= run.maxSeconds) break;
+    }
+    if (bar) {
+        bar->advance(1000 - shown);
+        bar.reset();
+    }
+    char line[280];
+    std::snprintf(line, sizeof line,
+                  "%s: %s after %.0f spp in %.1f s: standard error %.2f %% of the pixel's mean (median), %.2f %% "
+                  "(p90)%s",
+                  run.node.c_str(), converged ? "converged" : "stopped at max_seconds", samples, elapsed(),
+                  noise * 100.0, p90 * 100.0, converged ? "; stored in the bake cache" : ", above the target: not cached");
+    if (converged) logInfo(line);
+    else logWarning(line);
+    return converged;
+}
+
+bool loadConverged(const BakeKey& key, const std::string& node, int width, int height, CpuAccumulation& acc) {
+    const BakeCache cache(defaultCacheDir());
+    const auto loadStart = std::chrono::steady_clock::now();
+    std::optional<std::vector<uint8_t>> bytes = cache.get(key);
+    if (!bytes || !acc.deserialize(*bytes, width, height)) return false;
+    double p90 = 0.0;
+    const double noise = acc.relativeNoise(&p90);
+    char line[280];
+    std::snprintf(line, sizeof line,
+                  "%s: converged result loaded from the bake cache in %.0f ms (%.0f spp, standard error %.2f %% of the "
+                  "pixel's mean (median), %.2f %% (p90))",
+                  node.c_str(),
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - loadStart).count(),
+                  static_cast<double>(acc.stats.empty() ? 0.0f : acc.stats[0].x), noise * 100.0, p90 * 100.0);
+    logInfo(line);
+    return true;
+}
+
+void storeConverged(const BakeKey& key, const std::string& node, const CpuAccumulation& acc) {
+    const BakeCache cache(defaultCacheDir());
+    if (!cache.put(key, acc.serialize()))
+        logWarning(node + ": could not write the converged result to the bake cache under " + cache.dir().string());
+}
+
+CpuSky readCpuSky(ExecuteContext& ctx) {
+    CpuSky sky;
+    const GpuImage& cube = ctx.input("sky");
+    sky.size = static_cast<int>(cube.desc().width);
+    for (uint32_t face = 0; face < 6; ++face)
+        sky.faces.push_back(readImage(ctx.gpu(), cube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
+    const Image sh = readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    sky.sunIlluminance = glm::vec3(sh.at(9, 0)[0], sh.at(9, 0)[1], sh.at(9, 0)[2]);
+    sky.sunDirection = glm::vec3(sh.at(10, 0)[0], sh.at(10, 0)[1], sh.at(10, 0)[2]);
+    if (ctx.hasInput("env_cdf"))
+        sky.envCdf = readImage(ctx.gpu(), ctx.input("env_cdf"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    return sky;
+}
+
+void CpuResultUpload::upload(ExecuteContext& ctx, PipelineId storePipeline, const CpuAccumulation& acc) {
+    const size_t bytes = acc.color.size() * 2 * sizeof(glm::vec4);
+    if (!mBuffer || mBuffer.size() < bytes) {
+        mSet = StorageBufferSet();
+        mBuffer = GpuBuffer(ctx.gpu(), bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, "cpu_result");
+        const VkBuffer buffers[1] = {mBuffer.buffer()};
+        mSet = StorageBufferSet(ctx.gpu(), buffers, VK_SHADER_STAGE_COMPUTE_BIT, "cpu_result");
+    }
+    auto* dst = static_cast<glm::vec4*>(mBuffer.mapped());
+    for (size_t i = 0; i < acc.color.size(); ++i) {
+        dst[2 * i] = acc.color[i];
+        dst[2 * i + 1] = acc.stats[i];
+    }
+    const glm::uvec4 push(static_cast<uint32_t>(acc.width), static_cast<uint32_t>(acc.height), 0u, 0u);
+    std::array<VkDescriptorSetLayout, 1> layouts = {mSet.layout()};
+    std::array<VkDescriptorSet, 1> sets = {mSet.set()};
+    ctx.dispatchWithSets(storePipeline, &push, sizeof(push), push.x, push.y, layouts, sets);
+}
+
+} // namespace vitrine
