@@ -126,6 +126,20 @@ void storeConverged(const BakeKey& key, const std::string& node, const CpuAccumu
         logWarning(node + ": could not write the converged result to the bake cache under " + cache.dir().string());
 }
 
+void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFrame& cam, const CpuSky& sky, int width,
+                     int height) {
+    h.value(scene.scene().lightTransportHash());
+    h.array(scene.pose.instanceWorld);
+    h.value(cam.viewProjNoJitter);
+    h.value(cam.state.position);
+    for (const Image& face : sky.faces) h.array(face.pixels);
+    h.value(sky.sunIlluminance);
+    h.value(sky.sunDirection);
+    h.value(sky.envCdf.empty());
+    h.value(width);
+    h.value(height);
+}
+
 CpuSky readCpuSky(ExecuteContext& ctx) {
     CpuSky sky;
     const GpuImage& cube = ctx.input("sky");

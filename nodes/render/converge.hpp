@@ -8,6 +8,8 @@
 #include "core/graph/node.hpp"
 #include "core/gpu/buffer_set.hpp"
 #include "core/gpu/resources.hpp"
+#include "core/scene/gpu_scene.hpp"
+#include "core/scene/hash.hpp"
 #include "nodes/render/pathtrace_cpu.hpp"
 
 #include <functional>
@@ -42,6 +44,12 @@ bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
 bool loadConverged(const BakeKey& key, const std::string& node, int width, int height, CpuAccumulation& acc);
 // Stores a converged result (a warning if the cache cannot be written).
 void storeConverged(const BakeKey& key, const std::string& node, const CpuAccumulation& acc);
+
+// What every traced estimate of the camera's view depends on, into a cache key: the scene's light-transport content
+// and pose, the camera (unjittered view-projection and position), the sky's pixels and sun, the frame size. The
+// caller adds its node's name and version and every param that changes the estimate.
+void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFrame& camera, const CpuSky& sky,
+                     int width, int height);
 
 // The sky nodes' outputs read back for the CPU tracer: inputs `sky` (cube), `sky_sh` (sun texels 9 and 10) and the
 // optional `env_cdf`. They must be computed earlier in the frame (call ctx.splitSubmission() first) and declared

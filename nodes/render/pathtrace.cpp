@@ -240,16 +240,7 @@ private:
         const CameraFrame& cam = mCamera->current;
         scene::Hasher h;
         h.string("render.pathtrace converged reference v1");
-        h.value(mScene->scene().lightTransportHash());
-        h.array(mScene->pose.instanceWorld);
-        h.value(cam.viewProjNoJitter);
-        h.value(cam.state.position);
-        for (const Image& face : sky.faces) h.array(face.pixels);
-        h.value(sky.sunIlluminance);
-        h.value(sky.sunDirection);
-        h.value(sky.envCdf.empty());
-        h.value(out.width);
-        h.value(out.height);
+        hashTraceInputs(h, *mScene, cam, sky, static_cast<int>(out.width), static_cast<int>(out.height));
         for (const char* name : {"spp", "max_bounces", "seed", "min_spp"}) h.value(p.getInt(name));
         for (const char* name : {"sun_scale", "sky_scale", "emissive_scale", "target_noise"}) h.value(p.getFloat(name));
         h.value(p.getBool("antialias"));
