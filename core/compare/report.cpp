@@ -193,6 +193,22 @@ nlohmann::json metricsJson(const ReportInput& input) {
         doc["noiseFloor"] = std::move(floor);
     }
 
+    doc["regions"] = nullptr;
+    if (input.regions) {
+        nlohmann::json pairs = nlohmann::json::array();
+        for (const RegionTable::Pair& p : input.regions->pairs) {
+            nlohmann::json list = nlohmann::json::array();
+            for (const RegionRatio& r : p.regions)
+                list.push_back({{"name", r.name},
+                                {"pixels", r.pixels},
+                                {"test", finiteOrNull(r.test)},
+                                {"reference", finiteOrNull(r.reference)},
+                                {"ratio", finiteOrNull(r.ratio)}});
+            pairs.push_back({{"test", p.test}, {"reference", p.reference}, {"regions", list}});
+        }
+        doc["regions"] = {{"source", input.regions->source}, {"pairs", pairs}};
+    }
+
     doc["temporal"] = nlohmann::json::array();
     for (const TemporalMetrics& t : input.temporal) {
         nlohmann::json values = nlohmann::json::array();

@@ -2,6 +2,7 @@
 
 #include "core/compare/blocks.hpp"
 #include "core/compare/metrics.hpp"
+#include "core/compare/regions.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -101,6 +102,18 @@ struct GraphChange {
 // elements are compared index by index: an insertion shows as changes of the following elements.
 std::vector<GraphChange> diffGraphs(const nlohmann::json& a, const nlohmann::json& b);
 
+// compare --regions: the mean luminance ratio of each named region, for each pair (test / reference).
+struct RegionTable {
+    std::string source;      // the regions file
+    std::string description; // its description
+    struct Pair {
+        std::string test, reference;
+        std::vector<RegionRatio> regions;
+    };
+    std::vector<Pair> pairs;
+    std::optional<ReportImage> overlay; // regionOverlay() of the reference (or B) as PNG
+};
+
 struct ReportInput {
     std::string title = "vitrine compare";
     ReportImage a;
@@ -113,6 +126,7 @@ struct ReportInput {
     std::vector<PairMetrics> metrics;         // A vs B, A vs R, B vs R …
     std::optional<NoiseFloor> noiseFloor;     // set whenever there is a reference
     std::vector<TemporalMetrics> temporal;
+    std::optional<RegionTable> regions;
     nlohmann::json graphA; // graph documents for "what differs"; null when not known
     nlohmann::json graphB;
 };

@@ -175,6 +175,35 @@ std::string noiseBadge(const PairMetrics& m) {
                                    : "<span class=\"noise beyond\">beyond reference noise</span>";
 }
 
+// compare --regions: one row per region, one column per pair (mean luminance test / reference).
+std::string regionsSection(const RegionTable& t) {
+    std::string html = "<h3>Regions</h3>\n<p class=\"dim\">Mean luminance ratio per region (test / reference), from " +
+                       escapeHtml(t.source) + (t.description.empty() ? "" : ": " + escapeHtml(t.description)) +
+                       "</p>\n<div class=\"table-scroll\"><table><tr><th>region</th><th>pixels</th>";
+    for (const RegionTable::Pair& p : t.pairs)
+        html += "<th>" + escapeHtml(p.test) + " / " + escapeHtml(p.reference) + "</th>";
+    html += "</tr>\n";
+    const size_t rows = t.pairs.empty() ? 0 : t.pairs.front().regions.size();
+    for (size_t r = 0; r < rows; ++r) {
+        html += "<tr><td>" + escapeHtml(t.pairs.front().regions[r].name) + "</td><td>" +
+                std::to_string(t.pairs.front().regions[r].pixels) + "</td>";
+        for (const RegionTable::Pair& p : t.pairs) {
+            char cell[32];
+            const double v = p.regions[r].ratio;
+            if (std::isfinite(v)) std::snprintf(cell, sizeof cell, "%.3f", v);
+            else std::snprintf(cell, sizeof cell, "–");
+            html += std::string("<td>") + cell + "</td>";
+        }
+        html += "</tr>\n";
+    }
+    html += "</table></div>\n";
+    if (t.overlay) {
+        requirePng(*t.overlay, "regions overlay");
+        html += "<div class=\"row\">" + card(*t.overlay, "img-regions") + "</div>\n";
+    }
+    return html;
+}
+
 std::string noiseFloorSection(const NoiseFloor& n) {
     std::string html = "<p id=\"noise-floor\">Noise floor: ";
     if (n.status == NoiseFloor::Status::Measured && n.pair) {
@@ -365,6 +394,7 @@ std::string renderReportHtml(const ReportInput& input) {
                                   : "<div class=\"table-scroll\">" + metricsTable(input.metrics) + "</div>\n";
     if (input.noiseFloor) html += noiseFloorSection(*input.noiseFloor);
     if (!input.temporal.empty()) html += "<h3>Temporal</h3>\n" + temporalTable(input.temporal);
+    if (input.regions) html += regionsSection(*input.regions);
     html += "</section>\n";
 
     html += changesSection(input);

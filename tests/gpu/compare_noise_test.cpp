@@ -227,5 +227,56 @@ TEST_F(CompareNoise, ImageReferenceNeedsItsHalfGiven) {
     EXPECT_NE(alone.output.find("--reference R"), std::string::npos) << alone.output;
 }
 
+
+// --regions: the mean luminance ratio of each named region per pair, in the terminal, metrics.json and the report,
+// with regions.png; --output NAME picks that layer of a multi-layer EXR (what `vitrine run` writes); a wrong regions
+// file is refused with its JSON pointer before anything is compared.
+TEST_F(CompareNoise, RegionsReportEachRegionsRatioOnTheChosenExrLayer) {
+    const std::filesystem::path dir = freshDir("compare_regions");
+    const int w = 40, h = 20;
+    Image reference(w, h), test(w, h), display(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 4; ++c) {
+                const float base = c == 3 ? 1.0f : 1.0f + 0.1f * static_cast<float>((x * 7 + y * 3 + c) % 5);
+                reference.at(x, y)[c] = base;
+                test.at(x, y)[c] = c == 3 ? 1.0f : base * (x < w / 2 ? 0.8f : 1.5f);
+                display.at(x, y)[c] = 0.5f; // the other layer: identical in both files
+            }
+    writeExr(dir / "test.exr", {ExrLayer{"final", &display}, ExrLayer{"radiance", &test}}, ExrPixelType::Float);
+    writeExr(dir / "reference.exr", {ExrLayer{"final", &display}, ExrLayer{"radiance", &reference}},
+             ExrPixelType::Float);
+    std::ofstream(dir / "halves.regions.json") << R"({"format": "vitrine-regions/1", "regions": [
+        {"name": "left half", "polygons": [[[0, 0], [0.5, 0], [0.5, 1], [0, 1]]]},
+        {"name": "right half", "polygons": [[[0.5, 0], [1, 0], [1, 1], [0.5, 1]]]}]})";
+    const std::string t = quote((dir / "test.exr").string()), r = quote((dir / "reference.exr").string());
+    const CliResult res = vitrine("compare " + t + " " + r + " --output radiance --hdr --regions " +
+                                  quote((dir / "halves.regions.json").string()) + " --quiet --out " +
+                                  quote((dir / "out").string()));
+    ASSERT_EQ(res.status, 0) << res.output;
+    const json m = json::parse(readFile(dir / "out" / "metrics.json"));
+    const json& regions = m.at("regions").at("pairs").at(0).at("regions");
+    ASSERT_EQ(regions.size(), 2u) << m.dump(2);
+    EXPECT_EQ(regions[0]["name"], "left half");
+    EXPECT_EQ(regions[0]["pixels"], w * h / 2);
+    EXPECT_NEAR(regions[0]["ratio"].get<double>(), 0.8, 1e-5);
+    EXPECT_NEAR(regions[1]["ratio"].get<double>(), 1.5, 1e-5);
+    EXPECT_NE(res.output.find("left half"), std::string::npos) << res.output;
+    EXPECT_NE(res.output.find("1.500"), std::string::npos) << res.output;
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out" / "regions.png"));
+    EXPECT_NE(readFile(dir / "out" / "report.html").find("<h3>Regions</h3>"), std::string::npos);
+    // The "final" layers are identical: without --output that is not what was compared... with it, it is.
+    const CliResult fin = vitrine("compare " + t + " " + r + " --output final --quiet --out " +
+                                  quote((dir / "final").string()));
+    ASSERT_EQ(fin.status, 0) << fin.output;
+    EXPECT_TRUE(json::parse(readFile(dir / "final" / "metrics.json"))["pairs"][0]["psnr"].is_null()); // identical
+    // A wrong file: its path and JSON pointer, exit 1.
+    std::ofstream(dir / "bad.regions.json") << R"({"format": "vitrine-regions/1", "regions": [{"name": "x"}]})";
+    const CliResult bad = vitrine("compare " + t + " " + r + " --regions " + quote((dir / "bad.regions.json").string()) +
+                                  " --quiet --out " + quote((dir / "bad").string()));
+    EXPECT_EQ(bad.status, 1) << bad.output;
+    EXPECT_NE(bad.output.find("bad.regions.json: /regions/0/polygons: missing"), std::string::npos) << bad.output;
+}
+
 } // namespace
 } // namespace vitrine::test

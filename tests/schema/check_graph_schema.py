@@ -54,8 +54,9 @@ def errors(doc):
 count = 0
 for root, _, files in os.walk(graphs):
     for name in sorted(files):
-        # *.sweep.json: `vitrine sweep` files (graphs/sweeps/), not graphs; tests/unit/sweep checks them.
-        if not name.endswith(".json") or name.endswith(".schema.json") or name.endswith(".sweep.json"):
+        # *.sweep.json: `vitrine sweep` files (graphs/sweeps/), not graphs; tests/unit/sweep checks them. *.regions.json:
+        # `compare --regions` files (tests/unit/compare checks them).
+        if not name.endswith(".json") or name.endswith(".schema.json") or name.endswith(".sweep.json") or name.endswith(".regions.json"):
             continue
         path = os.path.join(root, name)
         rel = os.path.relpath(path, source)

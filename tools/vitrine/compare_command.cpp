@@ -207,6 +207,9 @@ int compareCommand(const Args& args) {
     for (const Input* in : rendered)
         if (in->graph) graphFrames = std::max(graphFrames, in->graph->frame.frames);
     const FrameRange range = frameRange(args, graphFrames);
+    // --regions: read (and so refused, when wrong) before anything renders.
+    std::optional<compare::RegionSet> regions;
+    if (args.has("regions")) regions = compare::loadRegions(args.get("regions"));
     const bool hdr = args.has("hdr");
     double ppd = compare::kDefaultPixelsPerDegree;
     if (args.has("ppd")) {
@@ -233,6 +236,7 @@ int compareCommand(const Args& args) {
                                    "flip_a_reference.png", "flip_a_reference.exr", "flip_b_reference.png",
                                    "flip_b_reference.exr", "blocks_a_reference.png", "blocks_b_reference.png"});
     names.push_back("blocks_a_b.png");
+    if (regions) names.push_back("regions.png");
     if (half)
         names.insert(names.end(), {"reference_half.png", "reference_half.exr", "flip_reference_half.png",
                                    "flip_reference_half.exr", "blocks_reference_half.png"});
@@ -266,7 +270,10 @@ int compareCommand(const Args& args) {
             for (uint32_t f : wanted)
                 in->frames.push_back(std::move(frames.at(f)));
         } else {
-            Image image = loadImage(in->path);
+            // --output NAME picks that layer of a multi-layer EXR (what `vitrine run` writes: one layer per output).
+            Image image = args.has("output") && lower(in->path.extension().string()) == ".exr"
+                              ? loadExrLayer(in->path, args.get("output"))
+                              : loadImage(in->path);
             in->frames.assign(wanted.size(), image);
         }
         in->still = in->frames[range.still - range.first];
@@ -339,6 +346,20 @@ int compareCommand(const Args& args) {
     }
     report.noiseFloor = noiseFloor;
 
+    if (regions) {
+        compare::RegionTable table;
+        table.source = regions->source;
+        table.description = regions->description;
+        const Input& base = reference ? *reference : b;
+        table.overlay = writeImage(out, "regions", "regions of " + regions->source + " over " + base.role,
+                                   compare::regionOverlay(*regions, base.still), false);
+        for (const PairJob& job : jobs)
+            if (!(half && job.test == &*half))
+                table.pairs.push_back({job.test->role, job.ref->role,
+                                       compare::regionLuminanceRatios(*regions, job.test->still, job.ref->still)});
+        report.regions = std::move(table);
+    }
+
     if (range.temporal) {
         for (const Input* in : inputs) {
             compare::TemporalMetrics t;
@@ -365,6 +386,17 @@ int compareCommand(const Args& args) {
                     !m.withinReferenceNoise   ? ""
                     : *m.withinReferenceNoise ? "   within reference noise"
                                               : "   beyond reference noise");
+    if (report.regions) {
+        std::printf("%-22s %8s", "region", "pixels");
+        for (const auto& p : report.regions->pairs)
+            std::printf("  %14s", (p.test + "/" + (p.reference == "reference" ? "R" : p.reference)).c_str());
+        std::printf("   (mean luminance ratio)\n");
+        for (size_t r = 0; r < regions->regions.size(); ++r) {
+            std::printf("%-22s %8d", regions->regions[r].name.c_str(), report.regions->pairs.front().regions[r].pixels);
+            for (const auto& p : report.regions->pairs) std::printf("  %14.3f", p.regions[r].ratio);
+            std::printf("\n");
+        }
+    }
     if (noiseFloor) {
         if (noiseFloor->status == compare::NoiseFloor::Status::Measured)
             std::printf("noise floor: FLIP mean %.4f between the reference and its other half (%s); blocks within 15%% "
