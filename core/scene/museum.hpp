@@ -16,6 +16,9 @@
 #include "core/scene/scene.hpp"
 
 #include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
 
 namespace vitrine::scene {
 
@@ -25,7 +28,17 @@ struct MuseumOptions {
     // Edge of every procedural texture in texels (power of two, 16..4096). 1024 matches the demo's
     // assets; tests use less where texture detail does not matter.
     uint32_t textureSize = 1024;
+    // Optional store for the procedural textures, about 90 % of the build time: `key` hashes everything they
+    // depend on (the seed's texture streams, the size, and the generator's source files: museumTextureSourceHash());
+    // loadTextures returns the images stored under it, in order (or nothing: they are generated), storeTextures
+    // keeps freshly generated ones. scene.museum wires both to the bake cache; without them nothing is stored.
+    std::function<std::optional<std::vector<TextureImage>>(uint64_t key)> loadTextures;
+    std::function<void(uint64_t key, const std::vector<TextureImage>&)> storeTextures;
 };
+
+// A hash of the source files that generate the museum's textures (computed at build time): part of the texture
+// cache key, so an edit to the generator never loads textures the old code made.
+uint64_t museumTextureSourceHash();
 
 // The daylight the museum is lit by: graphs/museum.json's sky.procedural turbidity (Preetham). The scene's sun takes
 // its colour and illuminance from the same model (shading::PreethamSky::sunIlluminance()), so the KHR_lights_punctual

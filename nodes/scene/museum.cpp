@@ -1,8 +1,14 @@
 // scene.museum: the built-in procedural museum (core/scene/museum), no asset files needed.
+#include "core/bake/cache.hpp"
+#include "core/base/log.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/museum.hpp"
+#include "core/shader/compiler.hpp"
 #include "nodes/scene/scene_node.hpp"
 
+#include <chrono>
+#include <cstdio>
+#include <cstring>
 #include <map>
 #include <mutex>
 
@@ -26,6 +32,55 @@ NodeSchema schema() {
     return s;
 }
 
+// The procedural textures in the bake cache (kind "museum_textures"): a header (magic, count), then per image its
+// name length, name, width, height and RGBA8 pixels. A payload that does not parse is ignored (they are generated).
+constexpr uint32_t kTexturesMagic = 0x5854554du; // "MUTX"
+
+std::vector<uint8_t> serializeTextures(const std::vector<scene::TextureImage>& images) {
+    std::vector<uint8_t> out;
+    auto put32 = [&](uint32_t v) {
+        const auto* p = reinterpret_cast<const uint8_t*>(&v);
+        out.insert(out.end(), p, p + 4);
+    };
+    put32(kTexturesMagic);
+    put32(static_cast<uint32_t>(images.size()));
+    for (const scene::TextureImage& image : images) {
+        put32(static_cast<uint32_t>(image.name.size()));
+        out.insert(out.end(), image.name.begin(), image.name.end());
+        put32(image.width);
+        put32(image.height);
+        out.insert(out.end(), image.pixels.begin(), image.pixels.end());
+    }
+    return out;
+}
+
+std::optional<std::vector<scene::TextureImage>> deserializeTextures(const std::vector<uint8_t>& bytes) {
+    size_t at = 0;
+    auto get32 = [&](uint32_t& v) {
+        if (bytes.size() - at < 4) return false;
+        std::memcpy(&v, bytes.data() + at, 4);
+        at += 4;
+        return true;
+    };
+    uint32_t magic = 0, count = 0;
+    if (!get32(magic) || magic != kTexturesMagic || !get32(count) || count > 1024) return std::nullopt;
+    std::vector<scene::TextureImage> images(count);
+    for (scene::TextureImage& image : images) {
+        uint32_t length = 0;
+        if (!get32(length) || bytes.size() - at < length) return std::nullopt;
+        image.name.assign(reinterpret_cast<const char*>(bytes.data() + at), length);
+        at += length;
+        if (!get32(image.width) || !get32(image.height) || image.width > 16384 || image.height > 16384)
+            return std::nullopt;
+        const size_t n = static_cast<size_t>(image.width) * image.height * 4;
+        if (bytes.size() - at < n) return std::nullopt;
+        image.pixels.assign(bytes.begin() + static_cast<std::ptrdiff_t>(at), bytes.begin() + static_cast<std::ptrdiff_t>(at + n));
+        at += n;
+    }
+    if (at != bytes.size()) return std::nullopt;
+    return images;
+}
+
 // Museums already built in this process (tests and the editor compile the same graph many times).
 std::shared_ptr<const scene::Scene> museum(uint64_t seed, uint32_t size) {
     static std::mutex mutex;
@@ -33,7 +88,29 @@ std::shared_ptr<const scene::Scene> museum(uint64_t seed, uint32_t size) {
     std::lock_guard lock(mutex);
     auto& slot = cache[{seed, size}];
     if (auto s = slot.lock()) return s;
-    auto s = std::make_shared<const scene::Scene>(scene::buildMuseum({seed, size}));
+    scene::MuseumOptions options{seed, size, {}, {}};
+    // The textures (about 90 % of the build) come from the bake cache when an earlier run made them.
+    const BakeCache bake(defaultCacheDir());
+    const auto start = std::chrono::steady_clock::now();
+    auto ms = [&] { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count(); };
+    bool loaded = false;
+    options.loadTextures = [&](uint64_t key) -> std::optional<std::vector<scene::TextureImage>> {
+        std::optional<std::vector<uint8_t>> bytes = bake.get(BakeKey{"museum_textures", key});
+        if (!bytes) return std::nullopt;
+        auto images = deserializeTextures(*bytes);
+        loaded = images.has_value();
+        return images;
+    };
+    options.storeTextures = [&](uint64_t key, const std::vector<scene::TextureImage>& images) {
+        if (!bake.put(BakeKey{"museum_textures", key}, serializeTextures(images)))
+            logWarning("scene 'museum': could not store the procedural textures in the bake cache under " +
+                       bake.dir().string());
+    };
+    auto s = std::make_shared<const scene::Scene>(scene::buildMuseum(options));
+    char line[160];
+    std::snprintf(line, sizeof line, "scene 'museum': built in %.0f ms (procedural textures %s)", ms(),
+                  loaded ? "loaded from the bake cache" : "generated and stored in the bake cache");
+    logDebug(line);
     slot = s;
     return s;
 }

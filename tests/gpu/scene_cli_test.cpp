@@ -131,5 +131,39 @@ TEST_F(SceneCli, GltfWarningsArePrintedAndStrictRefuses) {
     EXPECT_FALSE(fs::exists(dir / "b.glb"));
 }
 
+
+// scene.museum's procedural textures go into the bake cache (kind museum_textures): the second build of the same
+// museum loads them instead of generating them (what makes a second `run` start quickly), and a damaged entry is
+// generated again without a word to the user beyond the debug log.
+TEST_F(SceneCli, MuseumTexturesComeFromTheBakeCacheOnTheSecondBuild) {
+    const fs::path cache = fs::path(VITRINE_TEST_OUT) / "museum_texture_cache";
+    fs::remove_all(cache);
+    const std::string env = "VITRINE_CACHE_DIR=" + quote(cache.string());
+    // A texture size no other test uses, so the process-wide museum of another test cannot answer instead.
+    const std::string args = "validate " + quote(kSource + "/graphs/museum.json") +
+                             " --set scene.params.texture_size=32 --set scene.params.seed=7 --verbose";
+    const CliResult first = vitrine(args, env);
+    ASSERT_EQ(first.status, 0) << first.output;
+    EXPECT_NE(first.output.find("procedural textures generated and stored in the bake cache"), std::string::npos)
+        << first.output;
+    const fs::path dir = cache / "bake" / "museum_textures";
+    ASSERT_TRUE(fs::is_directory(dir)) << first.output;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
+    ASSERT_EQ(files.size(), 1u);
+    const CliResult second = vitrine(args, env);
+    ASSERT_EQ(second.status, 0) << second.output;
+    EXPECT_NE(second.output.find("procedural textures loaded from the bake cache"), std::string::npos)
+        << second.output;
+    // Damaged (truncated): generated again, stored again, no failure.
+    fs::resize_file(files[0], fs::file_size(files[0]) / 2);
+    const CliResult third = vitrine(args, env);
+    ASSERT_EQ(third.status, 0) << third.output;
+    EXPECT_NE(third.output.find("procedural textures generated and stored"), std::string::npos) << third.output;
+    const CliResult fourth = vitrine(args, env);
+    EXPECT_NE(fourth.output.find("procedural textures loaded from the bake cache"), std::string::npos)
+        << fourth.output;
+}
+
 } // namespace
 } // namespace vitrine::test

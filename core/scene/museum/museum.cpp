@@ -288,7 +288,7 @@ Scene buildMuseum(const MuseumOptions& options) {
     Scene scene;
     scene.name = "museum";
     Museum m{scene, {}, {}, Rng(options.seed), 0};
-    m.tex = makeTextures(scene, size, m.rng);
+    m.tex = makeTextures(scene, size, m.rng, options);
     m.mat = makeMaterials(scene, m.tex);
     scene.nodes.push_back(Node{"museum"});
     scene.roots = {0};

@@ -1,4 +1,8 @@
 #include "core/scene/museum/textures.hpp"
+#include "core/scene/hash.hpp"
+
+#include <array>
+#include <optional>
 
 #include "core/scene/museum/texture_util.hpp"
 
@@ -209,30 +213,75 @@ int32_t add(Scene& scene, TextureImage&& image, TextureUsage usage, Sampler samp
 
 } // namespace
 
-MuseumTextures makeTextures(Scene& scene, uint32_t size, Rng& rng) {
-    MuseumTextures t;
-    Family m = marble(size, rng.fork(1));
-    t.marbleAlbedo = add(scene, std::move(m.albedo), TextureUsage::Color);
-    t.marbleData = add(scene, std::move(m.data), TextureUsage::Data);
-    t.marbleNormal = add(scene, std::move(m.normal), TextureUsage::Normal);
-    Family s = stone(size, rng.fork(2));
-    t.stoneAlbedo = add(scene, std::move(s.albedo), TextureUsage::Color);
-    t.stoneData = add(scene, std::move(s.data), TextureUsage::Data);
-    t.stoneNormal = add(scene, std::move(s.normal), TextureUsage::Normal);
-    Family w = wood(size, rng.fork(3));
-    t.woodAlbedo = add(scene, std::move(w.albedo), TextureUsage::Color);
-    t.woodData = add(scene, std::move(w.data), TextureUsage::Data);
-    t.woodNormal = add(scene, std::move(w.normal), TextureUsage::Normal);
-    t.dirt = add(scene, dirt(size, rng.fork(4)), TextureUsage::Data);
-    t.brushedNormal = add(scene, brushed(size, rng.fork(5)), TextureUsage::Normal);
+MuseumTextures makeTextures(Scene& scene, uint32_t size, Rng& rng, const MuseumOptions& options) {
+    // Every family draws from its own fork, taken in this order whether the images are generated or loaded.
+    std::array<Rng, 8> forks{Rng(0), Rng(0), Rng(0), Rng(0), Rng(0), Rng(0), Rng(0), Rng(0)};
+    Rng probe = rng;
+    const uint64_t stream = probe.next();
+    for (uint64_t k = 0; k < forks.size(); ++k) forks[k] = rng.fork(k + 1);
+
     Sampler clamp;
     clamp.wrapU = clamp.wrapV = Wrap::ClampToEdge;
-    t.fineNormal = add(scene, engraving(size), TextureUsage::Normal, clamp);
-    Family c = cloth(size, rng.fork(6));
-    t.clothAlbedo = add(scene, std::move(c.albedo), TextureUsage::Color);
-    t.clothNormal = add(scene, std::move(c.normal), TextureUsage::Normal);
-    t.plasterNormal = add(scene, plaster(size, rng.fork(7)), TextureUsage::Normal);
-    t.paintings = add(scene, paintingAtlas(size, rng.fork(8)), TextureUsage::Color, clamp);
+    // The textures in Scene::textures order, with how each is sampled.
+    struct Slot {
+        int32_t MuseumTextures::*index;
+        TextureUsage usage;
+        Sampler sampler;
+    };
+    const std::array<Slot, 16> slots = {{
+        {&MuseumTextures::marbleAlbedo, TextureUsage::Color, {}},  {&MuseumTextures::marbleData, TextureUsage::Data, {}},
+        {&MuseumTextures::marbleNormal, TextureUsage::Normal, {}}, {&MuseumTextures::stoneAlbedo, TextureUsage::Color, {}},
+        {&MuseumTextures::stoneData, TextureUsage::Data, {}},      {&MuseumTextures::stoneNormal, TextureUsage::Normal, {}},
+        {&MuseumTextures::woodAlbedo, TextureUsage::Color, {}},    {&MuseumTextures::woodData, TextureUsage::Data, {}},
+        {&MuseumTextures::woodNormal, TextureUsage::Normal, {}},   {&MuseumTextures::dirt, TextureUsage::Data, {}},
+        {&MuseumTextures::brushedNormal, TextureUsage::Normal, {}}, {&MuseumTextures::fineNormal, TextureUsage::Normal, clamp},
+        {&MuseumTextures::clothAlbedo, TextureUsage::Color, {}},   {&MuseumTextures::clothNormal, TextureUsage::Normal, {}},
+        {&MuseumTextures::plasterNormal, TextureUsage::Normal, {}}, {&MuseumTextures::paintings, TextureUsage::Color, clamp},
+    }};
+
+    Hasher h;
+    h.string("museum textures v1");
+    h.value(stream);
+    h.value(size);
+    h.value(museumTextureSourceHash());
+    const uint64_t key = h.result();
+
+    std::vector<TextureImage> images;
+    if (options.loadTextures) {
+        if (std::optional<std::vector<TextureImage>> loaded = options.loadTextures(key)) {
+            bool ok = loaded->size() == slots.size();
+            for (const TextureImage& image : ok ? *loaded : std::vector<TextureImage>{})
+                ok = ok && image.width > 0 && image.height > 0 &&
+                     image.pixels.size() == static_cast<size_t>(image.width) * image.height * 4;
+            if (ok) images = std::move(*loaded);
+        }
+    }
+    if (images.empty()) {
+        Family m = marble(size, forks[0]);
+        Family s = stone(size, forks[1]);
+        Family w = wood(size, forks[2]);
+        images.push_back(std::move(m.albedo));
+        images.push_back(std::move(m.data));
+        images.push_back(std::move(m.normal));
+        images.push_back(std::move(s.albedo));
+        images.push_back(std::move(s.data));
+        images.push_back(std::move(s.normal));
+        images.push_back(std::move(w.albedo));
+        images.push_back(std::move(w.data));
+        images.push_back(std::move(w.normal));
+        images.push_back(dirt(size, forks[3]));
+        images.push_back(brushed(size, forks[4]));
+        images.push_back(engraving(size));
+        Family c = cloth(size, forks[5]);
+        images.push_back(std::move(c.albedo));
+        images.push_back(std::move(c.normal));
+        images.push_back(plaster(size, forks[6]));
+        images.push_back(paintingAtlas(size, forks[7]));
+        if (options.storeTextures) options.storeTextures(key, images);
+    }
+    MuseumTextures t;
+    for (size_t i = 0; i < slots.size(); ++i)
+        t.*(slots[i].index) = add(scene, std::move(images[i]), slots[i].usage, slots[i].sampler);
     return t;
 }
 

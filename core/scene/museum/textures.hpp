@@ -5,6 +5,7 @@
 // several scalar channels; the channel assignments below are what the museum's materials read.
 
 #include "core/scene/museum/noise.hpp"
+#include "core/scene/museum.hpp"
 #include "core/scene/scene.hpp"
 
 #include <cstdint>
@@ -30,6 +31,8 @@ struct MuseumTextures {
     int32_t paintings = -1; // four paintings in the quadrants of one image
 };
 
-MuseumTextures makeTextures(Scene& scene, uint32_t size, Rng& rng);
+// Generates the textures into `scene` (or loads them through options.loadTextures, storing fresh ones through
+// storeTextures). `rng` advances the same way either way.
+MuseumTextures makeTextures(Scene& scene, uint32_t size, Rng& rng, const MuseumOptions& options = {});
 
 } // namespace vitrine::scene::museum

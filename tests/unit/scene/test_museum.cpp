@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <set>
 
@@ -29,6 +30,54 @@ TEST_F(Museum, IsDeterministicFromTheSeed) {
     MuseumOptions other;
     other.seed = 2;
     EXPECT_NE(buildMuseum(other).contentHash(), museum().contentHash());
+}
+
+// The texture store (what scene.museum wires to the bake cache): the first build stores its textures under a key,
+// a build that loads them is the same scene (every other random draw unchanged), a payload that does not fit is
+// ignored (generated and stored again), and the key follows the seed and the size.
+TEST_F(Museum, TexturesLoadedFromTheStoreBuildTheSameScene) {
+    std::map<uint64_t, std::vector<TextureImage>> store;
+    int loads = 0, hits = 0, stores = 0;
+    auto withStore = [&](uint64_t seed, uint32_t size, bool corrupt = false) {
+        MuseumOptions o;
+        o.seed = seed;
+        o.textureSize = size;
+        o.loadTextures = [&, corrupt](uint64_t key) -> std::optional<std::vector<TextureImage>> {
+            ++loads;
+            auto it = store.find(key);
+            if (it == store.end()) return std::nullopt;
+            ++hits;
+            std::vector<TextureImage> images = it->second;
+            if (corrupt) images.pop_back();
+            return images;
+        };
+        o.storeTextures = [&](uint64_t key, const std::vector<TextureImage>& images) {
+            ++stores;
+            store[key] = images;
+        };
+        return buildMuseum(o);
+    };
+    MuseumOptions plain;
+    plain.textureSize = 32;
+    const uint64_t expected = buildMuseum(plain).contentHash();
+    EXPECT_EQ(withStore(1, 32).contentHash(), expected);
+    EXPECT_EQ(stores, 1);
+    EXPECT_EQ(hits, 0);
+    ASSERT_EQ(store.size(), 1u);
+    EXPECT_EQ(store.begin()->second.size(), buildMuseum(plain).images.size());
+    // Loaded: no store, the same content (textures, and every placement drawn after them).
+    EXPECT_EQ(withStore(1, 32).contentHash(), expected);
+    EXPECT_EQ(hits, 1);
+    EXPECT_EQ(stores, 1);
+    // Loaded images that are not what the museum needs (one missing): generated and stored again.
+    EXPECT_EQ(withStore(1, 32, true).contentHash(), expected);
+    EXPECT_EQ(stores, 2);
+    // Another seed or size: another key.
+    withStore(2, 32);
+    withStore(1, 16);
+    EXPECT_EQ(store.size(), 3u);
+    EXPECT_EQ(loads, 5);
+    EXPECT_NE(museumTextureSourceHash(), 0u);
 }
 
 TEST_F(Museum, RejectsBadOptions) {
