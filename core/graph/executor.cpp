@@ -13,9 +13,13 @@
 #include "core/shader/compiler.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
+#include <exception>
+#include <mutex>
 #include <set>
+#include <thread>
 
 namespace vitrine {
 
@@ -421,6 +425,12 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
     auto start = Clock::now();
     VkDevice device = mCtx.device();
     mPipelines.resize(mGraph.passes.size());
+    struct PipelineJob {
+        Pipeline* pipeline;
+        CompiledShader shader;
+        std::string name;
+    };
+    std::vector<PipelineJob> jobs;
     for (size_t pi = 0; pi < mGraph.passes.size(); ++pi) {
         const CompiledPass& pass = mGraph.passes[pi];
         for (const auto& request : pass.pipelines) {
@@ -485,10 +495,33 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
             pl.pPushConstantRanges = &range;
             VK_CHECK(vkCreatePipelineLayout(device, &pl, nullptr, &p->layout));
 
-            p->pipeline = createComputePipeline(mCtx, shader, p->layout);
-            mCtx.setName(reinterpret_cast<uint64_t>(p->pipeline), VK_OBJECT_TYPE_PIPELINE, pass.id + ":" + request.shader);
+            jobs.push_back({p, std::move(shader), pass.id + ":" + request.shader});
         }
     }
+    // The pipelines themselves on every core: a driver that compiles at creation (lavapipe's LLVM, or a GPU driver
+    // without a cache hit) spends nearly all of the start there, and vkCreateComputePipelines may be called from
+    // several threads at once (the pipeline cache is internally synchronised).
+    std::atomic<size_t> next{0};
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    auto work = [&] {
+        for (size_t i; (i = next.fetch_add(1)) < jobs.size();) {
+            try {
+                jobs[i].pipeline->pipeline = createComputePipeline(mCtx, jobs[i].shader, jobs[i].pipeline->layout);
+            } catch (...) {
+                std::lock_guard lock(failureMutex);
+                if (!failure) failure = std::current_exception();
+            }
+        }
+    };
+    const size_t threads = std::min<size_t>(jobs.size(), std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    for (const PipelineJob& job : jobs)
+        mCtx.setName(reinterpret_cast<uint64_t>(job.pipeline->pipeline), VK_OBJECT_TYPE_PIPELINE, job.name);
     mPipelineMs = msSince(start);
 }
 
