@@ -1,8 +1,9 @@
 // ibl.localized against CPU references. Scenes are built in code (floor, wall), loaded through scene.gltf with
 // probes added by test.gltf_probes; ibl.capture's outputs are replaced by test.probe_cubes (known radiance per
-// probe, or each face's texel coordinates) and test.brdf_lut (a LUT linear in NoV and roughness). The CPU casts
-// the same camera rays against the analytic geometry and evaluates the probes' volumes, fade weights, priorities,
-// blend, parallax-corrected directions and the split-sum product independently of the shaders.
+// probe, each face's texel coordinates, or a mip chain whose mip m holds m) and test.brdf_lut (a LUT linear in NoV
+// and roughness). The CPU casts the same camera rays against the analytic geometry and evaluates the probes'
+// volumes, fade weights, priorities, blend, parallax-corrected directions, the split-sum product and the prefiltered
+// mip by roughness independently of the shaders.
 #include "tests/gpu/lighting_scene.hpp"
 #include "tests/gpu/test_nodes.hpp"
 
@@ -485,6 +486,54 @@ TEST_F(IblLocalized, ResolveAppliesTheSplitSumLutAndDiffuseAlbedo) {
             EXPECT_LT(relErr(rgb(texels.at("diffuse"), x, y), faceCentre * albedo), 0.01) << x << "," << y;
         }
     EXPECT_GT(centred, W * H / 5);
+}
+
+// The prefiltered mip: ibl.capture's mip m is GGX roughness m / (mips - 1) (ibl_common.glsl), so a surface of roughness
+// r reads lod r (mips - 1). One box probe around a floor of roughness 0.25 and a wall of roughness 0.7, its cubes
+// (16², 5 mips) holding m on every texel of mip m (test.probe_cubes "levels"): the blended radiance (ibl.radiance's
+// rgb over its weight) is the lod itself, trilinear between the two mips around it. Against r (mips - 1) from the
+// roughness the G-buffer stored, within 0.05 of a mip.
+TEST_F(IblLocalized, SpecularReadsThePrefilteredMipOfItsRoughness) {
+    const int W = 96, H = 64, mips = 5;
+    Room room;
+    SceneBuilder b("ibl_mips");
+    std::vector<Tri> floorTris, wallTris;
+    const float h = static_cast<float>(room.floorHalf), z = static_cast<float>(room.wallZ);
+    addQuad(floorTris, {0, 0, 0}, {h, 0, 0}, {0, 0, h}, {0, 1, 0});
+    addQuad(wallTris, {0, h, z}, {h, 0, 0}, {0, h, 0}, {0, 0, 1});
+    b.node("floor", static_cast<int32_t>(b.mesh("floor", floorTris, b.material("floor", glm::vec3(0.8f), 1.0f, 0.75f))));
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", wallTris, b.material("wall", glm::vec3(0.8f), 1.0f, 0.3f))));
+    b.camera({0.0f, 4.0f, 9.0f}, {0.0f, 0.5f, -2.0f}, 0.9f);
+    b.sun({0.3f, 1.0f, 0.2f});
+    const auto glb = b.write();
+    Probe probe;
+    probe.center = {0.0, 4.0, 0.0};
+    probe.half = {11.0, 5.0, 11.0};
+    probe.fade = 0.1;
+    auto out = runGraph(graph(iblNodes(glb, {probe}, {{"ibl", {{"blend", "b"}, {"parallax", false}}}}, "levels"),
+                              {{"radiance", "ibl.radiance"}, {"normal", "gbuffer.normal"}}, W, H));
+    Pinhole cam(b.s, W, H);
+    int checked[2] = {0, 0};
+    double worst = 0.0, mean[2] = {0.0, 0.0};
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            auto p = room.hit(cam.position, cam.ray(x, y));
+            if (!p || probe.border(*p) < 0.2) continue;
+            const float* rad = out.at("radiance").at(x, y);
+            ASSERT_GT(rad[3], 0.0f) << x << "," << y;
+            const double lod = rad[0] / rad[3];
+            const double expected = (1.0 - value(out.at("normal"), x, y, 3)) * (mips - 1);
+            const int wall = std::abs(p->y) < 1e-6 ? 0 : 1;
+            ++checked[wall];
+            mean[wall] += lod;
+            worst = std::max(worst, std::abs(lod - expected));
+            EXPECT_NEAR(lod, expected, 0.05) << "pixel " << x << "," << y << (wall ? " (wall)" : " (floor)");
+        }
+    std::printf("prefiltered mip: floor (roughness 0.25) read at lod %.3f, wall (0.7) at %.3f on average; largest "
+                "error %.4f of a mip over %d + %d pixels\n",
+                mean[0] / std::max(checked[0], 1), mean[1] / std::max(checked[1], 1), worst, checked[0], checked[1]);
+    EXPECT_GT(checked[0], W * H / 5);
+    EXPECT_GT(checked[1], W * H / 10);
 }
 
 // lighting.deferred with ibl_specular: its specular_indirect is the IBL input (vertex AO and cavity are 1 here)

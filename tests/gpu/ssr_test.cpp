@@ -2,7 +2,9 @@
 // level's level-0 footprint (odd sizes included); color.pyramid's means likewise; ssr.hiz on a mirror floor
 // against the analytic mirror image (a colour image that holds each pixel's own coordinates makes the reflected
 // texel readable), its confidence against the same factors evaluated at the analytic hit, the back-face test on a
-// plate seen from below, the tap limit; ssr.composite against the CPU blend with Karis' environment BRDF.
+// plate seen from below, the tap limit; ssr.composite against the CPU blend with Karis' environment BRDF; the cone
+// footprint's pyramid level (test.ssr_levels: each level holds its own index) against the lobe's footprint at each
+// hit, and the roughness cut-off's fade against the same rays without it (issue 26).
 #include "tests/gpu/lighting_scene.hpp"
 
 #include "core/compare/metrics.hpp"
@@ -10,6 +12,7 @@
 #include "core/graph/registry.hpp"
 #include "core/shading/brdf.hpp"
 #include "core/shading/octahedral.hpp"
+#include "nodes/depth/mip_atlas.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -143,6 +146,54 @@ NodeSchema overrideNormalsSchema() {
     return s;
 }
 const NodeRegistration kNormals(overrideNormalsSchema(), [] { return std::make_unique<OverrideNormals>(); });
+
+// test.ssr_levels: a colour pyramid (the mip atlas color.pyramid writes, sized like it) whose every texel of level k
+// holds (k, its centre in level-0 pixels): ssr.hiz's trilinear read at lod L returns L in r (between levels k and
+// k + 1 with weight L - k) and the level-0 position it read in g, b.
+const char* kLevelsSource = R"(#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common/mip_atlas.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_result;
+layout(push_constant) uniform Push { ivec2 size0; int levels; } pc;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(out_result)))) return;
+    vec4 v = vec4(-1.0);
+    for (int k = 0; k < pc.levels; ++k) {
+        ivec2 c = p - mipOffset(pc.size0, k);
+        if (all(greaterThanEqual(c, ivec2(0))) && all(lessThan(c, mipSize(pc.size0, k)))) {
+            v = vec4(float(k), (vec2(c) + 0.5) * float(1 << k), 1.0);
+            break;
+        }
+    }
+    imageStore(out_result, p, v);
+}
+)";
+
+class LevelsSource final : public Node {
+public:
+    void setup(SetupContext& ctx) override {
+        mWidth = ctx.frame().width;
+        mHeight = ctx.frame().height;
+        sizeMipAtlas(ctx.output("result"), mWidth, mHeight);
+        mPipeline = ctx.computePipelineSource("test/ssr_levels", kLevelsSource);
+    }
+    void execute(ExecuteContext& ctx) override {
+        struct {
+            glm::ivec2 size0;
+            int32_t levels;
+        } push{{static_cast<int>(mWidth), static_cast<int>(mHeight)},
+               static_cast<int32_t>(mipAtlasLevels(mWidth, mHeight))};
+        const ImageDesc& out = ctx.output("result").desc();
+        ctx.dispatch(mPipeline, &push, sizeof(push), out.width, out.height);
+    }
+
+private:
+    uint32_t mWidth = 0, mHeight = 0;
+    PipelineId mPipeline = 0;
+};
+const NodeRegistration kLevels(frameSourceSchema("test.ssr_levels"), [] { return std::make_unique<LevelsSource>(); });
 
 // --- CPU mip atlas (written from the layout's description, not from the shader) --------------------------------
 
@@ -1011,6 +1062,146 @@ TEST_F(Ssr, RaysMeetingABackFaceWithinItsSlabStopThere) {
                 confident);
     EXPECT_GT(intoBack, 150);
     EXPECT_LE(confident, intoBack / 20);
+}
+
+// A glossy floor in front of a large wall, ssr.hiz reading test.ssr_levels (each pyramid level holds its own index, so
+// r is the lod the march read at, g, b where it read). Cone tracing [Uludag14]: the lod is log2 of the footprint in
+// pixels of a cone of half-angle tan 1.29 alpha / sqrt(rays) (alpha = roughness², one ray below roughness 0.2, two up
+// to 0.4) at the hit: 2 x hit distance x tan over the pixel size at the hit's view depth. Recomputed here for every
+// floor pixel whose rays all met the wall, from the hit the ray read (g, b) cast back onto the wall and the floor point
+// under the pixel; with two rays r and g, b are their means, and the lod at the mean hit differs from the mean lod by
+// far less than the tolerance (the footprint changes slowly along the wall).
+json levelNodes(const std::filesystem::path& glb, json params) {
+    json nodes = ssrNodes(glb, params);
+    nodes.erase("coords");
+    nodes["pyramid"] = {{"type", "test.ssr_levels"}};
+    nodes["ssr"]["in"]["color"] = "pyramid.result";
+    return nodes;
+}
+
+struct GlossyWall {
+    static constexpr int W = 128, H = 96;
+    static constexpr double wallZ = -5.0;
+    std::filesystem::path glb;
+    std::optional<Pinhole> cam;
+    explicit GlossyWall(float roughness) {
+        SceneBuilder b("ssr_cone_" + std::to_string(int(roughness * 100.0f + 0.5f)));
+        std::vector<Tri> floorTris, wallTris;
+        addQuad(floorTris, {0.0f, 0.0f, 0.0f}, {8.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 5.0f}, {0, 1, 0});
+        addQuad(wallTris, {0.0f, 5.0f, -5.0f}, {8.0f, 0.0f, 0.0f}, {0.0f, 5.0f, 0.0f}, {0, 0, 1});
+        b.node("floor", static_cast<int32_t>(b.mesh("floor", floorTris, b.material("gloss", glm::vec3(0.9f), 1.0f,
+                                                                                     1.0f - roughness))));
+        b.node("wall", static_cast<int32_t>(b.mesh("wall", wallTris, b.material("matte", glm::vec3(0.5f), 0.0f, 0.5f))));
+        b.camera({0.0f, 1.2f, 4.0f}, {0.0f, 0.9f, -1.0f}, 1.0f);
+        b.sun({0.3f, 1.0f, 0.6f});
+        glb = b.write();
+        cam.emplace(b.s, W, H);
+    }
+    // The camera ray through continuous pixel position px (pixel centres at +0.5).
+    glm::dvec3 rayAt(glm::dvec2 px) const {
+        const double tanHalf = std::tan(0.5 * cam->yfov), aspect = double(W) / H;
+        glm::dvec2 ndc = px / glm::dvec2(W, H) * 2.0 - 1.0;
+        return glm::normalize(cam->orientation * glm::dvec3(ndc.x * aspect * tanHalf, -ndc.y * tanHalf, -1.0));
+    }
+};
+
+TEST_F(Ssr, ConeFootprintMatchesTheLobeAtTheHit) {
+    const int W = GlossyWall::W, H = GlossyWall::H;
+    const int levels = static_cast<int>(mipAtlasLevels(W, H));
+    for (float roughness : {0.15f, 0.3f}) {
+        GlossyWall scene(roughness);
+        const Pinhole& cam = *scene.cam;
+        json params = {{"resolution_scale", 1.0}, {"max_taps", 64},      {"thickness", 0.2},
+                       {"max_distance", 30.0},    {"edge_fade", 0.05},   {"max_roughness", 1.0}};
+        auto out = runGraph(graph(levelNodes(scene.glb, params), {{"ssr", "ssr.reflection"}, {"normal", "gbuffer.normal"}},
+                                  W, H));
+        const Image& ssr = out.at("ssr");
+        const glm::dvec3 forward = cam.orientation * glm::dvec3(0, 0, -1);
+        const double focal = 0.5 * H / std::tan(0.5 * cam.yfov); // pixels per unit of tan at unit depth
+        int checked = 0, wrong = 0;
+        double worst = 0.0, meanLod = 0.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const float* got = ssr.at(x, y);
+                const glm::dvec3 d = cam.ray(x, y);
+                if (d.y >= 0.0 || got[3] < 0.9f) continue; // every ray hit, away from the fades
+                const glm::dvec3 p = cam.position + (-cam.position.y / d.y) * d;
+                if (std::abs(p.x) > 6.0 || p.z > 3.0) continue;
+                const glm::dvec3 e = scene.rayAt({got[1], got[2]});
+                if (e.z >= 0.0) continue;
+                const glm::dvec3 hit = cam.position + e * ((GlossyWall::wallZ - cam.position.z) / e.z);
+                if (hit.y < 0.2 || std::abs(hit.x) > 7.0) continue; // on the wall, clear of the floor
+                const double r = 1.0 - out.at("normal").at(x, y)[3]; // the roughness the G-buffer stored
+                const int rays = std::clamp(int(std::ceil(r * 5.0)), 1, 4);
+                const double alpha = std::max(r * r, double(shading::kMinGgxAlpha));
+                const double coneTan = 1.29 * alpha / std::sqrt(double(rays));
+                const double hitDepth = glm::dot(hit - cam.position, forward);
+                const double pixels = 2.0 * glm::length(hit - p) * coneTan * focal / hitDepth;
+                const double expected = std::clamp(std::log2(std::max(pixels, 1.0)), 0.0, double(levels - 1));
+                const double err = std::abs(got[0] - expected);
+                ++checked;
+                meanLod += expected;
+                if (err > 0.15) {
+                    if (++wrong <= 5)
+                        std::printf("  pixel %d,%d: lod %.3f, expected %.3f (%d rays, hit %.1f m away)\n", x, y, got[0],
+                                    expected, rays, glm::length(hit - p));
+                } else {
+                    worst = std::max(worst, err);
+                }
+            }
+        meanLod /= std::max(checked, 1);
+        std::printf("cone, roughness %.2f: %d floor pixels, mean expected lod %.2f, %d off by over 0.15; of the others "
+                    "the largest error %.3f\n",
+                    roughness, checked, meanLod, wrong, worst);
+        EXPECT_GT(checked, 1500) << "roughness " << roughness;
+        EXPECT_GT(meanLod, 1.0) << "the footprints must be wider than a pixel for the lod to show";
+        EXPECT_LE(wrong, checked / 50) << "roughness " << roughness;
+    }
+}
+
+// The roughness cut-off: max_roughness m fades the confidence linearly from 1 at 0.75 m to 0 at m. The same floor
+// (roughness 0.3) with m = 0.35 and with m = 1 (no fade) marches the same rays (the seed is the pixel's), so their
+// confidences differ by the fade alone: (m - r) / (m / 4) = 4/7 here. With m = 0.25 the floor has no reflection.
+TEST_F(Ssr, RoughnessCutOffFadesTheConfidence) {
+    const int W = GlossyWall::W, H = GlossyWall::H;
+    GlossyWall scene(0.3f);
+    json nodes = levelNodes(scene.glb, {{"resolution_scale", 1.0}, {"max_taps", 64}, {"thickness", 0.2},
+                                        {"max_distance", 30.0}, {"edge_fade", 0.05}, {"max_roughness", 1.0}});
+    nodes["ssr_cut"] = nodes["ssr"];
+    nodes["ssr_cut"]["params"]["max_roughness"] = 0.35;
+    nodes["ssr_off"] = nodes["ssr"];
+    nodes["ssr_off"]["params"]["max_roughness"] = 0.25;
+    auto out = runGraph(graph(nodes,
+                              {{"full", "ssr.reflection"},
+                               {"cut", "ssr_cut.reflection"},
+                               {"off", "ssr_off.reflection"},
+                               {"normal", "gbuffer.normal"}},
+                              W, H));
+    int checked = 0, lit = 0;
+    double worst = 0.0, worstOff = 0.0, meanFade = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float* g0 = out.at("normal").at(x, y);
+            if (g0[2] <= 0.0f || g0[3] > 0.8f) continue; // the floor (the wall is rougher than every cut-off)
+            const double r = 1.0 - g0[3];
+            if (std::abs(r - 0.3) > 0.01) continue;
+            const double full = out.at("full").at(x, y)[3], cut = out.at("cut").at(x, y)[3];
+            const double fade = std::clamp((0.35 - r) / (0.25 * 0.35), 0.0, 1.0);
+            ++checked;
+            meanFade += fade;
+            if (full > 0.5) ++lit;
+            worst = std::max(worst, std::abs(cut - full * fade));
+            worstOff = std::max(worstOff, double(out.at("off").at(x, y)[3]));
+        }
+    meanFade /= std::max(checked, 1);
+    std::printf("roughness cut-off: %d floor pixels (%d with confidence > 0.5 uncut), fade %.3f, largest |cut - full x "
+                "fade| %.2e, largest confidence beyond the cut-off %.2e\n",
+                checked, lit, meanFade, worst, worstOff);
+    EXPECT_GT(checked, 2000);
+    EXPECT_GT(lit, 1000);
+    EXPECT_NEAR(meanFade, 4.0 / 7.0, 0.05);
+    EXPECT_LT(worst, 2e-3);
+    EXPECT_EQ(worstOff, 0.0);
 }
 
 } // namespace

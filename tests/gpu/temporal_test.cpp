@@ -1,7 +1,8 @@
 // temporal.accumulate and gbuffer.temporal_filter (MUSEUM_SPEC §5) against independent expectations: the running mean
 // of per-pixel noise recomputed on the CPU, one blend step with velocity / depth / luminance rejection written out from
 // the node's documented formulas, the ghost trail of a moving object (scene.gltf + gbuffer.layered, full and half
-// resolution input), the restart of the sample count where the background is disoccluded; the normal filter's running
+// resolution input), the restart of the sample count where the background is disoccluded, the history of a bilinear
+// footprint partly rejected by depth renormalised over the taps kept; the normal filter's running
 // blend and Toksvig shininess against core/shading, and on the Museum's dolly shot shininess never increases.
 #include "tests/gpu/lighting_scene.hpp"
 
@@ -243,6 +244,77 @@ TEST_F(Temporal, OneStepWeightsMatchTheirFormulas) {
         EXPECT_LT(worst, 2e-3) << k.name;
         EXPECT_LT(worstN, 2e-3) << k.name;
     }
+}
+
+// A partial disocclusion inside the history's bilinear footprint: per-pixel noise as colour and as view depth (both
+// frames differ everywhere), a uniform velocity of (0.5, 0.25) px so that every pixel's history is a 2x2 bilinear
+// fetch with weights (0.5 x 0.25 .. 0.5 x 0.75), and a depth tolerance of 30 % that rejects some of the four taps at
+// most pixels. The history is then the mean of the accepted taps' last outputs with their bilinear weights, divided
+// by the sum of those weights (renormalised), recomputed here from the same hash; the output is its running blend
+// with this frame, n = 1: mix(current, history, 1/2); all four taps rejected: current alone.
+TEST_F(Temporal, PartlyRejectedBilinearHistoryIsRenormalised) {
+    const int w = 32, h = 24;
+    const double tolerance = 0.3;
+    const glm::vec2 velocity(0.5f, 0.25f);
+    json nodes = {{"src", {{"type", "test.frames"}, {"params", {{"noise", true}}}}},
+                  {"depth", {{"type", "test.frames"}, {"params", {{"noise", true}}}}},
+                  {"vel", framesNode(glm::vec4(velocity, 0.0f, 0.0f), glm::vec4(velocity, 0.0f, 0.0f))},
+                  {"acc",
+                   accumulateNode({{"velocity_weight", 0.0}, {"luminance_weight", 0.0}, {"depth_tolerance", tolerance}},
+                                  {{"color", "src.color"},
+                                   {"velocity", "vel.color"},
+                                   {"depth", "depth.color"},
+                                   {"history_depth", "depth.color@prev"}})}};
+    json g = graph(nodes, {{"out", "acc.color"}, {"samples", "acc.samples"}}, w, h);
+    g["frame"]["frames"] = 2;
+    auto out = runGraph(g);
+    int partial = 0, all = 0, none = 0, ambiguous = 0;
+    double worst = 0.0;
+    for (int y = 1; y < h - 1; ++y)
+        for (int x = 1; x < w - 1; ++x) {
+            const double here = noiseValue(x, y, 1, 2);
+            // The reprojected point (x + 0.5, y + 0.5) - velocity lies between texels x-1, x and y-1, y.
+            const double fx = 1.0 - velocity.x, fy = 1.0 - velocity.y; // its offset from texel (x-1, y-1): 0.5, 0.75
+            glm::dvec4 sum(0.0);
+            double total = 0.0;
+            int accepted = 0;
+            bool nearThreshold = false;
+            for (int j = 0; j < 2; ++j)
+                for (int i = 0; i < 2; ++i) {
+                    const int qx = x - 1 + i, qy = y - 1 + j;
+                    const double before = noiseValue(qx, qy, 0, 2);
+                    const double rel = std::fabs(before - here) / std::max(before, here);
+                    nearThreshold = nearThreshold || std::fabs(rel - tolerance) < 1e-3;
+                    if (rel > tolerance) continue;
+                    const double wt = (i == 0 ? 1.0 - fx : fx) * (j == 0 ? 1.0 - fy : fy);
+                    for (int c = 0; c < 4; ++c) sum[c] += wt * noiseValue(qx, qy, 0, c);
+                    total += wt;
+                    ++accepted;
+                }
+            if (nearThreshold) {
+                ++ambiguous;
+                continue;
+            }
+            glm::dvec4 current;
+            for (int c = 0; c < 4; ++c) current[c] = noiseValue(x, y, 1, c);
+            const glm::dvec4 expected = accepted > 0 ? glm::mix(current, sum / total, 0.5) : current;
+            const double expectedSamples = accepted > 0 ? 2.0 : 1.0;
+            if (accepted == 4) ++all;
+            else if (accepted == 0) ++none;
+            else ++partial;
+            for (int c = 0; c < 4; ++c) {
+                const double err = std::fabs(out.at("out").at(x, y)[c] - expected[c]);
+                worst = std::max(worst, err);
+                EXPECT_LT(err, 2e-3) << "pixel " << x << "," << y << " channel " << c << ", " << accepted
+                                     << " taps accepted";
+            }
+            EXPECT_EQ(out.at("samples").at(x, y)[0], float(expectedSamples)) << "pixel " << x << "," << y;
+        }
+    std::printf("partial rejection: %d pixels with 1-3 of 4 taps accepted, %d with all, %d with none (%d near the "
+                "tolerance skipped); worst |output - CPU| %.2e\n",
+                partial, all, none, ambiguous, worst);
+    EXPECT_GT(partial, 200);
+    EXPECT_GT(none, 10);
 }
 
 // A bright square sliding over a dark wall at ~4 px per frame, accumulated from the G-buffer's base colour (full

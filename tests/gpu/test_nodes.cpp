@@ -1,5 +1,7 @@
 #include "tests/gpu/test_nodes.hpp"
 
+#include "core/gpu/context.hpp"
+#include "core/gpu/descriptors.hpp"
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "core/scene/gltf.hpp"
@@ -10,6 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 
 #include <string>
 
@@ -176,7 +180,8 @@ namespace {
 
 // A cube-map array (RGBA16F, one mip, 6 layers per probe, at least 2 probes' worth so the view is always a cube
 // array) whose probe i holds `values[i]` everywhere ("constant"), or on face f texel (x, y) the colour
-// (f, x + 0.5, y + 0.5) ("texels": bilinear lookups inside a face read back the continuous texel coordinate).
+// (f, x + 0.5, y + 0.5) ("texels": bilinear lookups inside a face read back the continuous texel coordinate), or
+// ("levels") a full mip chain holding m on every texel of mip m.
 const char* kProbeCubesSource = R"(#version 460
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) writeonly uniform imageCubeArray out_cubes;
@@ -191,6 +196,18 @@ void main() {
 }
 )";
 
+// "levels": a full mip chain whose every texel of mip m is (m, m, m): trilinear lookups at lod L read L back.
+const char* kProbeCubeLevelsSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 1, binding = 0, rgba16f) uniform writeonly image2DArray target;
+layout(push_constant) uniform Push { int size; int mip; int layers; } pc;
+void main() {
+    ivec2 g = ivec2(gl_GlobalInvocationID.xy);
+    if (g.x >= pc.size || g.y >= pc.size * pc.layers) return;
+    imageStore(target, ivec3(g.x, g.y % pc.size, g.y / pc.size), vec4(vec3(float(pc.mip)), 1.0));
+}
+)";
+
 class ProbeCubes final : public Node {
 public:
     void setup(SetupContext& ctx) override {
@@ -198,6 +215,11 @@ public:
         ImageDesc& out = ctx.output("cubes");
         uint32_t size = static_cast<uint32_t>(p.getInt("size"));
         out.width = out.height = size;
+        mLevels = p.getString("mode") == "levels";
+        if (mLevels) {
+            out.mipLevels = static_cast<uint32_t>(std::bit_width(size));
+            mLevelsPipeline = ctx.computePipelineSource("test/probe_cube_levels", kProbeCubeLevelsSource, 1);
+        }
         auto values = nlohmann::json::parse(p.getString("values"));
         mUniforms.mode = {p.getString("mode") == "texels" ? 1 : 0, 0, 0, 0};
         for (size_t i = 0; i < values.size() && i < 64; ++i)
@@ -209,11 +231,36 @@ public:
     }
     void execute(ExecuteContext& ctx) override {
         const ImageDesc& out = ctx.output("cubes").desc();
-        ctx.setUniforms(mUniforms);
-        ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height, out.layers);
+        if (!mLevels) {
+            ctx.setUniforms(mUniforms);
+            ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height, out.layers);
+            return;
+        }
+        if (!mSets) {
+            const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT,
+                                                       nullptr};
+            mSets = DescriptorSets(ctx.gpu(), std::span(&binding, 1), 16, {}, "test.probe_cubes");
+        }
+        mSets.reset();
+        const std::array<VkDescriptorSetLayout, 1> layouts = {mSets.layout()};
+        for (uint32_t m = 0; m < out.mipLevels; ++m) {
+            const VkDescriptorSet set = mSets.allocate();
+            DescriptorWrites(set)
+                .image(0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {VK_NULL_HANDLE, ctx.output("cubes").mipView(m), VK_IMAGE_LAYOUT_GENERAL})
+                .update(ctx.gpu().device());
+            struct {
+                int32_t size, mip, layers;
+            } push{static_cast<int32_t>(std::max(out.width >> m, 1u)), static_cast<int32_t>(m),
+                   static_cast<int32_t>(out.layers)};
+            ctx.dispatchWithSets(mLevelsPipeline, &push, sizeof(push), push.size, push.size * out.layers, layouts,
+                                 std::array<VkDescriptorSet, 1>{set});
+        }
     }
 
 private:
+    bool mLevels = false;
+    PipelineId mLevelsPipeline = 0;
+    DescriptorSets mSets;
     struct Uniforms {
         glm::vec4 values[64];
         glm::ivec4 mode;
@@ -247,7 +294,8 @@ NodeSchema probeCubesSchema() {
     out.doc = "cube-map array, 6 layers per probe";
     s.outputs = {out};
     s.params = {{"size", ParamType::Int, 16, 1.0, 1024.0, {}, "face size"},
-                {"mode", ParamType::Enum, "constant", {}, {}, {"constant", "texels"}, "content"},
+                {"mode", ParamType::Enum, "constant", {}, {}, {"constant", "texels", "levels"},
+                 "content (levels: a full mip chain, mip m holding m)"},
                 {"values", ParamType::String, "[[1,1,1]]", {}, {}, {}, "JSON array of RGB, one per probe"}};
     return s;
 }
