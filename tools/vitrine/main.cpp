@@ -34,8 +34,11 @@ commands:
       and rays/s of primary (one per pixel) and incoherent (bounce) rays.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
   compare A B [--reference R [--reference-half H | --no-noise-floor]] [--frame N | --frames A:B]
-          [--set K=V]... [--output NAME] [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
-      A, B, R: graphs (variants too) or images (EXR/PNG), same size. Writes the images, |A-B|,
+          [--set K=V]... [--output NAME] [--output-a NAME] [--output-b NAME] [--output-reference NAME]
+          [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
+      A, B, R: graphs (variants too) or images (EXR/PNG), same size. --output NAME: the graphs' output
+      compared (default "final"); --output-a/-b/-reference NAME: that side's (e.g. one term of the frame,
+      terms/specular_indirect, against its ray-traced twin's). Writes the images, |A-B|,
       FLIP error maps, metrics.json (PSNR, SSIM, FLIP; flicker and error per frame with
       --frames) and a self-contained report.html to DIR (default out/compare/A_vs_B).
       Files vitrine did not write there are not replaced without --force.
@@ -108,7 +111,7 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "reference-half", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
+                                     "output", "output-a", "output-b", "output-reference", "ppd", "diff-scale", "reference-half", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
                                      "jobs", "point", "collect", "devices", "from", "keep", "goldens", "class",
                                      "partition", "time", "gpus-per-task", "sbatch-arg"},
                                     {{"nodes", {"json"}}});
