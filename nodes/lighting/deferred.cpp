@@ -51,7 +51,12 @@ NodeSchema schema() {
     OutputPort spec = color;
     spec.name = "specular_indirect";
     spec.doc = "The indirect specular term alone (included in color; SSR replaces it where it hits)";
-    s.outputs = {color, spec};
+    OutputPort diffuse = color;
+    diffuse.name = "diffuse_indirect";
+    diffuse.doc = "The indirect diffuse term alone (included in color): the lightmap's baked diffuse (with the "
+                  "surface's own emission, baked together), else the irradiance volume's, ibl.localized's or the sky's "
+                  "diffuse, x vertex AO x cavity, x the ao tint; what reference.diffuse_indirect estimates by tracing";
+    s.outputs = {color, spec, diffuse};
     s.params = {
         {"sky_ambient", ParamType::Float, 0.15, 0.0, 1.0, {},
          "Fraction of the open sky's ambient that reaches surfaces with neither a lightmap nor the irradiance volume "

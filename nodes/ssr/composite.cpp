@@ -31,7 +31,13 @@ NodeSchema schema() {
     color.formatFrom = "color";
     color.size = SizeRule::ofInput("color");
     color.doc = "HDR colour with SSR in place of the environment where it is confident";
-    s.outputs = {color};
+    OutputPort specular;
+    specular.name = "specular_indirect";
+    specular.formatFrom = "specular_indirect";
+    specular.size = SizeRule::ofInput("color");
+    specular.doc = "The indirect specular term now inside color, mix(I, E L_ssr vertexAO cavity, c) (0 where nothing "
+                   "is drawn): what reference.reflections estimates by tracing";
+    s.outputs = {color, specular};
     return s;
 }
 

@@ -31,6 +31,7 @@ layout(binding = 11) uniform sampler2D in_volume;
 layout(binding = 12) uniform sampler2D in_ao;
 layout(binding = 13) uniform sampler2D in_ibl_specular;
 layout(binding = 14) uniform sampler2D in_ibl_diffuse;
+layout(binding = 15) writeonly uniform image2D out_diffuse_indirect;
 #define VITRINE_LIGHTS u.lights
 #define VITRINE_SHADOW u.shadow
 #include "lighting/sun_shadow.glsl"
@@ -52,6 +53,7 @@ void main() {
         vec3 sky = textureLod(in_sky, -v, 0.0).rgb;
         imageStore(out_color, p, vec4(min(sky, vec3(kHalfMax)), 1.0));
         imageStore(out_specular_indirect, p, vec4(0.0));
+        imageStore(out_diffuse_indirect, p, vec4(0.0));
         return;
     }
 
@@ -108,4 +110,8 @@ void main() {
     vec3 color = direct + diffuse + specular + emissive * (lightmapped ? 1.0 : u.params.w);
     imageStore(out_color, p, vec4(min(color, vec3(kHalfMax)), 1.0));
     imageStore(out_specular_indirect, p, vec4(min(specular, vec3(kHalfMax)), 1.0));
+    // The indirect diffuse alone (the twin of reference.diffuse_indirect): a lightmapped pixel's is its emissive
+    // channel, baked diffuse and the surface's own emission together.
+    vec3 diffuseIndirect = diffuse + (lightmapped ? emissive : vec3(0.0));
+    imageStore(out_diffuse_indirect, p, vec4(min(diffuseIndirect, vec3(kHalfMax)), 1.0));
 }

@@ -10,6 +10,7 @@
 // reflected radiance L_ssr with a confidence c. The same BRDF factor weighs it, with the surface's own
 // micro-occlusion (vertex AO, cavity; not the sky stand-in's, SSR sees the real surroundings):
 //   S = E L_ssr vertexAo cavity,   final = color - I + mix(I, S, c).
+// The term that replaced I, mix(I, S, c), is written alone too (specular_indirect: the twin of reference.reflections).
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_color;
 layout(binding = 1) uniform sampler2D in_specular_indirect;
@@ -20,6 +21,7 @@ layout(binding = 5) uniform sampler2D in_material;
 layout(binding = 6) uniform sampler2D in_depth;
 layout(binding = 7) writeonly uniform image2D out_color;
 layout(binding = 8) uniform Uniforms { SsrCompositeUniforms u; };
+layout(binding = 9) writeonly uniform image2D out_specular_indirect;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -29,6 +31,7 @@ void main() {
     float z = texelFetch(in_depth, p, 0).r;
     if (z <= 0.0) {
         imageStore(out_color, p, color);
+        imageStore(out_specular_indirect, p, vec4(0.0));
         return;
     }
     vec2 uv = (vec2(p) + 0.5) / vec2(size);
@@ -46,5 +49,7 @@ void main() {
     vec3 indirect = texelFetch(in_specular_indirect, p, 0).rgb;
     vec3 reflected = brdf * ssr.rgb * (g2.z * g2.w);
     vec3 final = color.rgb - indirect + mix(indirect, reflected, clamp(ssr.a, 0.0, 1.0));
+    vec3 specular = mix(indirect, reflected, clamp(ssr.a, 0.0, 1.0)); // the term alone
+    imageStore(out_specular_indirect, p, vec4(min(max(specular, vec3(0.0)), vec3(kHalfMax)), 1.0));
     imageStore(out_color, p, vec4(min(max(final, vec3(0.0)), vec3(kHalfMax)), color.a));
 }

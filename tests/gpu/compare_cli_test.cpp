@@ -98,6 +98,42 @@ TEST(CompareCli, FramesRangeAddsTemporalMetrics) {
     EXPECT_GT(metrics["temporal"][0]["errorPerFrame"]["values"][0].get<double>(), 0.0);
 }
 
+// --output-a / --output-b pick each side's output (one term of a frame against its twin's): a graph with two flat
+// outputs (checkers whose two colours are equal) compared with itself, A from `dark` and B from `bright`. a.exr and
+// b.exr hold those values, the mean luminance line gives their ratio, and a name the graph lacks exits 1 naming it.
+TEST(CompareCli, OutputPerSidePicksEachSidesOutput) {
+    const fs::path out = freshDir("compare_output_per_side");
+    auto flatChecker = [](double v) {
+        return json{{"type", "pattern.checker"},
+                    {"params", {{"color_a", {v, v, v, 1.0}}, {"color_b", {v, v, v, 1.0}}}}};
+    };
+    const json graph = {{"format", "vitrine-graph/1"},
+                        {"frame", {{"width", 32}, {"height", 16}}},
+                        {"nodes", {{"dark", flatChecker(0.25)}, {"bright", flatChecker(0.5)}}},
+                        {"outputs", {{"final", "bright.color"}, {"terms/dark", "dark.color"}, {"terms/bright", "bright.color"}}}};
+    const fs::path file = out / "two_outputs.json";
+    std::ofstream(file) << graph.dump(2);
+    const CliResult r = vitrine("compare " + quote(file.string()) + " " + quote(file.string()) +
+                                " --output-a terms/dark --output-b terms/bright --hdr --quiet --out " +
+                                quote((out / "report").string()));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const Image a = loadImage(out / "report" / "a.exr"), b = loadImage(out / "report" / "b.exr");
+    ASSERT_EQ(a.width, 32);
+    EXPECT_NEAR(a.at(5, 5)[1], 0.25f, 1e-3f);
+    EXPECT_NEAR(b.at(5, 5)[1], 0.5f, 1e-3f);
+    EXPECT_NE(r.output.find("A / B 0.5000"), std::string::npos) << r.output;
+    // Without --output-b, B falls back to --output (here: none, so "final", the bright checker).
+    const CliResult fallback = vitrine("compare " + quote(file.string()) + " " + quote(file.string()) +
+                                       " --output-a terms/dark --hdr --quiet --out " +
+                                       quote((out / "fallback").string()));
+    ASSERT_EQ(fallback.status, 0) << fallback.output;
+    EXPECT_NEAR(loadImage(out / "fallback" / "b.exr").at(5, 5)[1], 0.5f, 1e-3f);
+    const CliResult missing = vitrine("compare " + quote(file.string()) + " " + quote(file.string()) +
+                                      " --output-b terms/nothing --quiet --out " + quote((out / "missing").string()));
+    EXPECT_EQ(missing.status, 1) << missing.output;
+    EXPECT_NE(missing.output.find("terms/nothing"), std::string::npos) << missing.output;
+}
+
 TEST(CompareCli, ImagesOfDifferentSizesAreAUserError) {
     const fs::path dir = freshDir("compare_sizes");
     writeExr(dir / "small.exr", flat(16, 9, 0.5f), ExrPixelType::Float);

@@ -574,7 +574,8 @@ TEST_F(Ssr, TapLimitBoundsTheMarch) {
 
 // ssr.composite on a lit glossy floor (roughness 0.15, cavity 0.8, vertex AO 0.5..1) with SSR at half
 // resolution: every pixel against the blend evaluated on the CPU from the read-back inputs, with Karis' environment
-// BRDF from core/shading and the half-resolution reflection upsampled bilinearly (clamped at the edges).
+// BRDF from core/shading and the half-resolution reflection upsampled bilinearly (clamped at the edges); its
+// specular_indirect output against the blended term alone.
 TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
     MirrorScene m(0.85f, 0.8f, true);
     const int W = MirrorScene::W, H = MirrorScene::H;
@@ -606,7 +607,8 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
                                {"normal", "gbuffer.normal"},
                                {"base", "gbuffer.base_color"},
                                {"material", "gbuffer.material"},
-                               {"final", "composite.color"}},
+                               {"final", "composite.color"},
+                               {"final_specular", "composite.specular_indirect"}},
                               W, H));
     const Image& ssr = out.at("ssr");
     ASSERT_EQ(ssr.width, W / 2);
@@ -637,6 +639,11 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
             glm::dvec3 reflected = e * glm::dvec3(r) * double(g2[2] * g2[3]);
             double c = std::clamp(r.w, 0.0, 1.0);
             glm::dvec3 expected = glm::max(color - spec + spec * (1.0 - c) + reflected * c, glm::dvec3(0.0));
+            // Its specular_indirect output: the blended term alone (what reference.reflections is compared with).
+            const glm::dvec3 term = spec * (1.0 - c) + reflected * c, gotTerm = rgb(out.at("final_specular"), x, y);
+            for (int k = 0; k < 3; ++k)
+                EXPECT_LT(std::abs(gotTerm[k] - term[k]), 4e-3 * std::abs(term[k]) + 1e-3 * std::abs(color[k]) + 1e-6)
+                    << "specular_indirect, pixel " << x << "," << y << " channel " << k;
             if (c > 0.05 && c < 0.95) ++blended;
             if (c >= 0.95) ++full;
             for (int k = 0; k < 3; ++k) {

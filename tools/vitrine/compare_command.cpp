@@ -58,7 +58,9 @@ Input openInput(const std::string& role, const std::string& key, const fs::path&
     const std::string ext = lower(path.extension().string());
     if (ext == ".json") {
         in.graph = loadGraph(path, setsWithFrames(args, frames, false, path.string()));
-        in.output = pickOutput(*in.graph, args.get("output"));
+        // --output-a/-b/-reference pick one side's output (one term of the frame against its twin's), else --output.
+        const std::string side = key == "reference_half" ? "reference" : key;
+        in.output = pickOutput(*in.graph, args.get("output-" + side, args.get("output")));
     } else if (!isImageFile(path)) {
         throw UserError(path.string() + ": compare " + role + ": " + expected + ", got a '" + ext + "' file");
     }
@@ -151,7 +153,10 @@ std::optional<Input> referenceHalf(const Input& reference, const Args& args, uin
     half.key = "reference_half";
     std::string changed;
     for (NodeDecl& node : half.graph->nodes) {
-        if (!node.schema || node.schema->type != "render.pathtrace") continue;
+        // render.pathtrace and the ray-traced twins (reference.*, but for reference.substitute, which has no seed).
+        if (!node.schema || !(node.schema->type == "render.pathtrace" ||
+                              (node.schema->type.starts_with("reference.") && node.params.contains("seed"))))
+            continue;
         const int64_t seed = node.params.value("seed", int64_t(0));
         const int64_t next = seed >= 2147483647 ? 0 : seed + 1; // the param's range is [0, 2^31 - 1]
         node.params["seed"] = next;
@@ -160,12 +165,23 @@ std::optional<Input> referenceHalf(const Input& reference, const Args& args, uin
                    std::to_string(next);
     }
     if (changed.empty()) {
-        floor.reason = "the reference graph has no render.pathtrace node to re-seed; pass --reference-half FILE, an "
-                       "independent render of it";
+        floor.reason = "the reference graph has no render.pathtrace or reference.* node to re-seed; pass "
+                       "--reference-half FILE, an independent render of it";
         return std::nullopt;
     }
     floor.reason = "the reference graph with " + changed;
     return half;
+}
+
+// Mean Rec. 709 luminance of an image's linear values (what a.exr holds).
+double meanLuminance(const Image& image) {
+    double sum = 0.0;
+    const size_t pixels = static_cast<size_t>(image.width) * image.height;
+    for (size_t i = 0; i < pixels; ++i) {
+        const float* p = image.pixels.data() + i * 4;
+        sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+    }
+    return pixels > 0 ? sum / static_cast<double>(pixels) : 0.0;
 }
 
 std::string formatPsnr(double psnr) {
@@ -270,9 +286,12 @@ int compareCommand(const Args& args) {
             for (uint32_t f : wanted)
                 in->frames.push_back(std::move(frames.at(f)));
         } else {
-            // --output NAME picks that layer of a multi-layer EXR (what `vitrine run` writes: one layer per output).
-            Image image = args.has("output") && lower(in->path.extension().string()) == ".exr"
-                              ? loadExrLayer(in->path, args.get("output"))
+            // --output(-a/-b/-reference) NAME picks that layer of a multi-layer EXR (what `vitrine run` writes: one
+            // layer per output).
+            const std::string side = in->key == "reference_half" ? "reference" : in->key;
+            const std::string layer = args.get("output-" + side, args.get("output"));
+            Image image = !layer.empty() && lower(in->path.extension().string()) == ".exr"
+                              ? loadExrLayer(in->path, layer)
                               : loadImage(in->path);
             in->frames.assign(wanted.size(), image);
         }
@@ -397,6 +416,17 @@ int compareCommand(const Args& args) {
             std::printf("\n");
         }
     }
+    // Whole-frame brightness: which side is darker, and by how much (one term against its twin, a frame against R).
+    std::printf("mean luminance: A %.6g, B %.6g", meanLuminance(a.still), meanLuminance(b.still));
+    if (reference) std::printf(", reference %.6g", meanLuminance(reference->still));
+    const double lumB = meanLuminance(b.still);
+    std::printf("; A / B %.4f", lumB > 0.0 ? meanLuminance(a.still) / lumB : 0.0);
+    if (reference) {
+        const double lumR = meanLuminance(reference->still);
+        std::printf(", A / reference %.4f, B / reference %.4f", lumR > 0.0 ? meanLuminance(a.still) / lumR : 0.0,
+                    lumR > 0.0 ? lumB / lumR : 0.0);
+    }
+    std::printf("\n");
     if (noiseFloor) {
         if (noiseFloor->status == compare::NoiseFloor::Status::Measured)
             std::printf("noise floor: FLIP mean %.4f between the reference and its other half (%s); blocks within 15%% "

@@ -34,8 +34,11 @@ commands:
       and rays/s of primary (one per pixel) and incoherent (bounce) rays.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
   compare A B [--reference R [--reference-half H | --no-noise-floor]] [--frame N | --frames A:B] [--regions F]
-          [--set K=V]... [--output NAME] [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
-      A, B, R: graphs (variants too) or images (EXR/PNG), same size. Writes the images, |A-B|,
+          [--set K=V]... [--output NAME] [--output-a NAME] [--output-b NAME] [--output-reference NAME]
+          [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
+      A, B, R: graphs (variants too) or images (EXR/PNG), same size. --output NAME: the graphs' output
+      compared (default "final"), or that layer of an EXR; --output-a/-b/-reference NAME: that side's (e.g.
+      one term of the frame, terms/specular_indirect, against its ray-traced twin's). Writes the images, |A-B|,
       FLIP error maps, metrics.json (PSNR, SSIM, FLIP; flicker and error per frame with
       --frames) and a self-contained report.html to DIR (default out/compare/A_vs_B).
       Files vitrine did not write there are not replaced without --force.
@@ -44,7 +47,7 @@ commands:
       reference noise". --no-noise-floor: no second half. Every pair also gets the luminance ratio of
       16 px blocks (share within 15 %, mean |log2|) and its heat map (blocks_*.png). --regions F: the
       mean luminance ratio of each named region of F (e.g. graphs/regions/museum.regions.json) per pair,
-      and regions.png showing them. --output NAME: that output of a graph, or that layer of an EXR.
+      and regions.png showing them.
   golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]... [--from DIR]
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
       `accept` (re)writes the golden EXRs, `check` compares with FLIP, per-pixel and block
@@ -110,7 +113,7 @@ int main(int argc, char** argv) {
     try {
         cli::Args args = cli::parse(argc, argv,
                                     {"set", "out", "frames", "device", "json", "warmup", "exr", "reference", "frame",
-                                     "output", "ppd", "diff-scale", "reference-half", "regions", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
+                                     "output", "output-a", "output-b", "output-reference", "ppd", "diff-scale", "reference-half", "regions", "manifest", "seed", "texture-size", "scene", "port", "host", "token", "editor", "max-body", "warm", "max-queue",
                                      "jobs", "point", "collect", "devices", "from", "keep", "goldens", "class",
                                      "partition", "time", "gpus-per-task", "sbatch-arg"},
                                     {{"nodes", {"json"}}});

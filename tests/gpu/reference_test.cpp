@@ -1,0 +1,328 @@
+// The ray-traced twins (nodes/reference/) against closed forms, and against the real-time terms they are twins of
+// where the approximation is exact or nearly so. Scenes are built in code, written as .glb and loaded through
+// scene.gltf; skies are uniform (sky.hdri of a constant image: no sun, radiance C everywhere).
+//
+// Closed forms, with the shared BRDF (core/shading: Lambert + GGX/Smith/Schlick, F0 = 0.04 for dielectrics, the
+// base colour for metals):
+//   - reference.reflections on a mirror plane (shininess 1, GGX alpha 0.002) under a uniform sky C with nothing
+//     above it: every reflected ray sees the sky, and the lobe's weight F G2 / G1 is Schlick's F(NoV) (G2 / G1
+//     differs from 1 by < 1e-5 at the angles used): S = C F(NoV);
+//   - on a glossy plane (roughness 0.5): S = C times the specular lobe's directional albedo at NoV, the integral of
+//     brdfCosine (diffuse 0) over the hemisphere by a 256 x 256 midpoint rule in (cos theta, phi);
+//   - reference.diffuse_indirect on a plane under a uniform sky: E = pi C, radiance = albedo C;
+//   - under a black square of half size a at height h (an unlit, double-sided occluder): E = pi C (1 - F), F the
+//     form factor from the floor point to the parallel rectangle (superposition of the corner-rectangle formula).
+#include "tests/gpu/lighting_scene.hpp"
+
+#include "core/image/io.hpp"
+#include "core/shading/brdf.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace vitrine::test {
+namespace {
+
+using nlohmann::json;
+using namespace lighting;
+
+class Reference : public GpuTest {};
+
+// A uniform sky of radiance c (no sun in it) as sky.hdri over an equirect .exr written next to glb.
+json uniformSky(const std::filesystem::path& glb, double c) {
+    Image sky(32, 16);
+    for (float& v : sky.pixels)
+        v = 1.0f;
+    const auto file = glb.parent_path() / (glb.stem().string() + "_sky.exr");
+    writeExr(file, sky, ExrPixelType::Float);
+    return {{"type", "sky.hdri"}, {"params", {{"path", file.string()}, {"intensity", c}, {"size", 16}}}};
+}
+
+json twinNode(const char* type, json params) {
+    return {{"type", type},
+            {"in",
+             {{"scene", "scene.scene"},
+              {"camera", "scene.camera"},
+              {"sky", "sky.cubemap"},
+              {"sky_sh", "sky.sh"},
+              {"env_cdf", "env_cdf.cdf"}}},
+            {"params", params}};
+}
+
+json twinNodes(const std::filesystem::path& glb, double C) {
+    return {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}}}}},
+            {"sky", uniformSky(glb, C)},
+            {"env_cdf", {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}}}};
+}
+
+double schlick(double f0, double cosine) {
+    return f0 + (1.0 - f0) * std::pow(1.0 - cosine, 5.0);
+}
+
+// The specular lobe's directional albedo at NoV (core/shading's brdfCosineF0 with no diffuse), midpoint rule.
+double specularAlbedo(double NoV, glm::vec3 f0, float roughness) {
+    const int nu = 256, nphi = 256;
+    const glm::vec3 n(0, 0, 1), v(static_cast<float>(std::sqrt(1.0 - NoV * NoV)), 0.0f, static_cast<float>(NoV));
+    double sum = 0.0;
+    for (int i = 0; i < nu; ++i) {
+        double u = (i + 0.5) / nu, r = std::sqrt(1.0 - u * u);
+        for (int j = 0; j < nphi; ++j) {
+            double phi = 2.0 * kPi * (j + 0.5) / nphi;
+            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                        static_cast<float>(u));
+            sum += shading::brdfCosineF0(n, v, l, glm::vec3(0.0f), f0, roughness).g;
+        }
+    }
+    return sum * (1.0 / nu) * (2.0 * kPi / nphi);
+}
+
+// Form factor from a floor point to a parallel rectangle at height h with one corner straight above it and sides
+// a, b (signed: the formula is odd in each).
+double cornerFormFactor(double a, double b, double h) {
+    const double x = a / h, y = b / h;
+    const double sx = std::sqrt(1.0 + x * x), sy = std::sqrt(1.0 + y * y);
+    return (x / sx * std::atan(y / sx) + y / sy * std::atan(x / sy)) / (2.0 * kPi);
+}
+
+// A 20 x 20 plane at y = 0 facing up.
+std::vector<Tri> floorQuad() {
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(20, 0, 0), glm::vec3(0, 0, 20), glm::vec3(0, 1, 0));
+    return quad;
+}
+
+struct PlaneStats {
+    int n = 0, within2 = 0;
+    double sumRatio = 0.0, worst = 0.0;
+    void add(double got, double expected, double se) {
+        const double ratio = got / expected;
+        sumRatio += ratio;
+        worst = std::max(worst, std::abs(ratio - 1.0));
+        within2 += std::abs(got - expected) <= 2.0 * se + 1e-4 * expected ? 1 : 0;
+        ++n;
+    }
+    double mean() const { return sumRatio / std::max(n, 1); }
+    double share() const { return double(within2) / std::max(n, 1); }
+};
+
+// reference.reflections on a mirror plane and a glossy plane (dielectric and metal) under a uniform sky, against
+// C F(NoV) and C times the lobe's directional albedo (times the material's cavity, 0.6 on one mirror). Bounds: the mean over the plane's pixels within 1 %, each pixel
+// within 3 % on mirrors (every sample is nearly the same) and 50 % on the glossy planes (64 samples: the worst of
+// 1,360 pixels measured 36 %), and at least
+// 85 % of pixels within two of their estimated standard errors.
+TEST_F(Reference, ReflectionsOfAUniformSkyOnMirrorAndGlossyPlanes) {
+    const int W = 48, H = 32;
+    const double C = 100.0;
+    struct Case {
+        const char* name;
+        glm::vec3 base;
+        float metallic, shininess, cavity;
+    };
+    for (const Case& c : {Case{"mirror_dielectric", glm::vec3(0.5f), 0.0f, 1.0f, 1.0f},
+                          Case{"mirror_metal", glm::vec3(0.9f, 0.6f, 0.3f), 1.0f, 1.0f, 1.0f},
+                          Case{"mirror_metal_cavity", glm::vec3(0.9f, 0.6f, 0.3f), 1.0f, 1.0f, 0.6f},
+                          Case{"glossy_dielectric", glm::vec3(0.5f), 0.0f, 0.5f, 1.0f},
+                          Case{"glossy_metal", glm::vec3(0.9f, 0.6f, 0.3f), 1.0f, 0.5f, 1.0f}}) {
+        SCOPED_TRACE(c.name);
+        SceneBuilder b(std::string("twin_reflections_") + c.name);
+        const uint32_t material = b.material(c.name, c.base, c.metallic, c.shininess);
+        b.s.materials[material].layers[0].cavity = {c.cavity, 0.0f}; // the cavity darkens what the surface reflects
+        b.node("plane", static_cast<int32_t>(b.mesh("plane", floorQuad(), material)));
+        b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+        auto glb = b.write();
+        json nodes = twinNodes(glb, C);
+        nodes["twin"] = twinNode("reference.reflections", {{"spp", 64}});
+        auto out = runGraph(graph(nodes, {{"color", "twin.color"}, {"stats", "twin.stats"}}, W, H));
+        const Image& img = out.at("color");
+        const glm::vec3 f0 = shading::specularF0(c.base, c.metallic);
+        const float roughness = 1.0f - c.shininess;
+        // The glossy lobe's albedo (green channel) at 65 values of NoV in [0.1, 1], interpolated linearly.
+        std::vector<double> albedo;
+        if (c.shininess < 1.0f)
+            for (int i = 0; i <= 64; ++i)
+                albedo.push_back(specularAlbedo(0.1 + 0.9 * i / 64.0, f0, roughness));
+        Pinhole cam(b.s, W, H);
+        PlaneStats st;
+        double background = 0.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                if (d.y > -0.1) {
+                    if (d.y > 0.05) background = std::max(background, rgb(img, x, y).g);
+                    continue;
+                }
+                const double NoV = -d.y;
+                double expected = C * schlick(f0.g, NoV);
+                if (c.shininess < 1.0f) {
+                    double f = std::clamp((NoV - 0.1) / 0.9 * 64.0, 0.0, 63.999);
+                    int i = static_cast<int>(f);
+                    expected = C * (albedo[i] + (albedo[i + 1] - albedo[i]) * (f - i));
+                }
+                st.add(rgb(img, x, y).g, c.cavity * expected, out.at("stats").at(x, y)[3]);
+            }
+        std::printf("reflections %s: %d pixels, mean ratio %.5f, worst pixel %.4f, within 2 standard errors %.3f\n",
+                    c.name, st.n, st.mean(), st.worst, st.share());
+        ASSERT_GT(st.n, 300);
+        EXPECT_LT(std::abs(st.mean() - 1.0), 0.01);
+        EXPECT_LT(st.worst, c.shininess < 1.0f ? 0.5 : 0.03);
+        EXPECT_GT(st.share(), 0.85);
+        EXPECT_EQ(background, 0.0) << "pixels without a surface have no specular term";
+    }
+}
+
+// reference.diffuse_indirect on a plane (base 0.5) under a uniform sky C: E = pi C and radiance 0.5 C at every
+// pixel, and every sample is exact (each cosine-weighted ray sees the sky), so the bound is 1e-3.
+TEST_F(Reference, DiffuseIndirectOfAUniformSkyIsPiL) {
+    const int W = 32, H = 24;
+    const double C = 100.0, albedo = 0.5;
+    SceneBuilder b("twin_diffuse_plane");
+    b.node("plane", static_cast<int32_t>(b.mesh(
+                        "plane", floorQuad(), b.material("plane", glm::vec3(static_cast<float>(albedo)), 0.0f, 0.5f))));
+    b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+    auto glb = b.write();
+    json nodes = twinNodes(glb, C);
+    nodes["radiance"] = twinNode("reference.diffuse_indirect", {{"spp", 8}});
+    nodes["irradiance"] = twinNode("reference.diffuse_indirect", {{"spp", 8}, {"output", "irradiance"}});
+    auto out = runGraph(graph(nodes, {{"radiance", "radiance.color"}, {"irradiance", "irradiance.color"}}, W, H));
+    Pinhole cam(b.s, W, H);
+    int n = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            if (cam.ray(x, y).y > -0.1) continue;
+            EXPECT_LT(relErr(rgb(out.at("radiance"), x, y), glm::dvec3(albedo * C)), 1e-3) << x << "," << y;
+            EXPECT_LT(relErr(rgb(out.at("irradiance"), x, y), glm::dvec3(kPi * C)), 1e-3) << x << "," << y;
+            ++n;
+        }
+    EXPECT_GT(n, 200);
+}
+
+// Under a black square (unlit, double sided: it emits and reflects nothing) of half size 1 at height 1, the floor's
+// irradiance is E = pi C (1 - F), F the form factor to the square. Bounds: the mean ratio over floor pixels within
+// 2 m of the square's centre within 1.5 %, at least 85 % of them within two estimated standard errors.
+TEST_F(Reference, DiffuseIndirectUnderASquareOccluderMatchesTheFormFactor) {
+    const int W = 64, H = 48;
+    const double C = 100.0, a = 1.0, h = 1.0;
+    SceneBuilder b("twin_diffuse_occluder");
+    b.node("plane", static_cast<int32_t>(b.mesh("plane", floorQuad(), b.material("floor", glm::vec3(0.5f), 0.0f, 0.5f))));
+    std::vector<Tri> square;
+    addQuad(square, glm::vec3(0.0f, static_cast<float>(h), 0.0f), glm::vec3(static_cast<float>(a), 0, 0),
+            glm::vec3(0, 0, static_cast<float>(a)), glm::vec3(0, -1, 0)); // centre +- u +- v
+    uint32_t black = b.material("black", glm::vec3(0.0f), 0.0f, 0.5f);
+    b.s.materials[black].unlit = true;
+    b.s.materials[black].doubleSided = true;
+    b.node("square", static_cast<int32_t>(b.mesh("square", square, black)));
+    b.camera({0.0f, 0.6f, 3.5f}, {0.0f, 0.0f, 0.0f}, 0.9f);
+    auto glb = b.write();
+    json nodes = twinNodes(glb, C);
+    nodes["twin"] = twinNode("reference.diffuse_indirect", {{"spp", 64}, {"output", "irradiance"}});
+    auto out = runGraph(graph(nodes, {{"color", "twin.color"}, {"stats", "twin.stats"}}, W, H));
+    Pinhole cam(b.s, W, H);
+    PlaneStats st;
+    double minExpected = 1e30;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y > -0.05) continue;
+            glm::dvec3 p = cam.position + (-cam.position.y / d.y) * d;
+            if (std::abs(p.x) > 2.0 || std::abs(p.z) > 2.0) continue;
+            double F = cornerFormFactor(a - p.x, a - p.z, h) - cornerFormFactor(-a - p.x, a - p.z, h) -
+                       cornerFormFactor(a - p.x, -a - p.z, h) + cornerFormFactor(-a - p.x, -a - p.z, h);
+            double expected = kPi * C * (1.0 - F);
+            minExpected = std::min(minExpected, expected);
+            st.add(rgb(out.at("color"), x, y).g, expected, out.at("stats").at(x, y)[3]);
+        }
+    std::printf("occluder: %d pixels, mean ratio %.5f, worst pixel %.3f, within 2 standard errors %.3f, darkest "
+                "expected E / (pi C) %.3f\n",
+                st.n, st.mean(), st.worst, st.share(), minExpected / (kPi * C));
+    ASSERT_GT(st.n, 300);
+    EXPECT_LT(minExpected / (kPi * C), 0.5) << "the square must shade some of the pixels measured";
+    EXPECT_LT(std::abs(st.mean() - 1.0), 0.015);
+    EXPECT_GT(st.share(), 0.85);
+}
+
+// Where the real-time approximation is exact or nearly so, the technique's term and its twin agree: a plane alone
+// under a uniform sky C, lit by lighting.deferred's open-sky stand-ins at sky_ambient 1 (nothing occludes the sky).
+// Diffuse: the sky's SH irradiance of a constant sky is pi C exactly, so lighting.deferred's diffuse_indirect and
+// reference.diffuse_indirect are both diffuseAlbedo C (the G-buffer's base colour is UNORM8: 0.4 % at 0.5); bound
+// 1.5 % on the mean. Specular on a mirror metal (F0 = base colour 0.9): the sky along the mirror direction times
+// Karis' split-sum fit E(F0, 0, NoV) against the traced C F(NoV); the fit's own error for this F0 at the angles seen
+// measured -2.5 % on the mean (lavapipe; a deterministic gap, the mirror's samples barely vary), so the bound is
+// 3.5 %. (On a dielectric mirror, F0 0.04, the fit is +9 % on the mean and +23 % at NoV 0.78: printed, not
+// bounded, as the measure of that approximation.) reference.substitute of the diffuse
+// term gives lit - diffuse_indirect + twin at every pixel.
+TEST_F(Reference, TwinsMatchLightingDeferredUnderAnOpenUniformSky) {
+    const int W = 48, H = 32;
+    const double C = 100.0;
+    struct Case {
+        const char* name;
+        glm::vec3 base;
+        float metallic, shininess;
+    };
+    for (const Case& c : {Case{"metal_mirror", glm::vec3(0.9f), 1.0f, 1.0f},
+                          Case{"dielectric_mirror", glm::vec3(0.5f), 0.0f, 1.0f}}) {
+        SCOPED_TRACE(c.name);
+        SceneBuilder b(std::string("twin_vs_deferred_") + c.name);
+        b.node("plane", static_cast<int32_t>(b.mesh("plane", floorQuad(), b.material(c.name, c.base, c.metallic,
+                                                                                     c.shininess))));
+        b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+        auto glb = b.write();
+        json nodes = twinNodes(glb, C);
+        nodes["gbuffer"] = {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}};
+        nodes["lighting"] = lightingNode({{"sky_ambient", 1.0}}, false);
+        nodes["reflections"] = twinNode("reference.reflections", {{"spp", 16}});
+        nodes["diffuse"] = twinNode("reference.diffuse_indirect", {{"spp", 8}});
+        nodes["swap"] = {{"type", "reference.substitute"},
+                         {"in",
+                          {{"color", "lighting.color"},
+                           {"technique", "lighting.diffuse_indirect"},
+                           {"twin", "diffuse.color"}}}};
+        auto out = runGraph(graph(nodes,
+                                  {{"lit", "lighting.color"},
+                                   {"swapped", "swap.color"},
+                                   {"specular", "lighting.specular_indirect"},
+                                   {"diffuse", "lighting.diffuse_indirect"},
+                                   {"specular_traced", "reflections.color"},
+                                   {"diffuse_traced", "diffuse.color"}},
+                                  W, H));
+        Pinhole cam(b.s, W, H);
+        double specRatio = 0.0, diffRatio = 0.0, specNormal = 0.0, maxNoV = 0.0;
+        int n = 0, nd = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                if (d.y > -0.15) continue;
+                const glm::dvec3 s = rgb(out.at("specular"), x, y), st = rgb(out.at("specular_traced"), x, y);
+                // reference.substitute: lit - technique + twin (the diffuse term here).
+                const glm::dvec3 swapped = glm::max(rgb(out.at("lit"), x, y) - rgb(out.at("diffuse"), x, y) +
+                                                        rgb(out.at("diffuse_traced"), x, y),
+                                                    glm::dvec3(0.0));
+                EXPECT_LT(relErr(rgb(out.at("swapped"), x, y), swapped), 2e-3) << x << "," << y;
+                specRatio += s.g / st.g;
+                if (-d.y > maxNoV) {
+                    maxNoV = -d.y;
+                    specNormal = s.g / st.g;
+                }
+                ++n;
+                if (c.metallic < 0.5f) {
+                    diffRatio += rgb(out.at("diffuse"), x, y).g / rgb(out.at("diffuse_traced"), x, y).g;
+                    ++nd;
+                }
+            }
+        ASSERT_GT(n, 300);
+        specRatio /= n;
+        std::printf("%s: specular_indirect / reflections twin %.4f (mean), %.4f at the largest NoV (%.2f)", c.name,
+                    specRatio, specNormal, maxNoV);
+        if (nd > 0) std::printf("; diffuse_indirect / twin %.4f", diffRatio / nd);
+        std::printf("\n");
+        if (c.metallic > 0.5f) {
+            EXPECT_NEAR(specRatio, 1.0, 0.035);
+        }
+        if (nd > 0) {
+            EXPECT_NEAR(diffRatio / nd, 1.0, 0.015);
+        }
+    }
+}
+
+} // namespace
+} // namespace vitrine::test
