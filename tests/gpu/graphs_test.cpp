@@ -38,7 +38,9 @@ TEST_P(ShippedGraph, ValidatesAndRunsAtPreviewSize) {
             for (const char* p : {".params.samples=2", ".params.texels_per_meter=1", ".params.probe_spacing=10"})
                 sets.push_back(id + p);
         // A few samples, not converged and cached (museum_reference converges for minutes).
-        if (node.value("type", "") == "render.pathtrace")
+        // The ray-traced twins (reference.*) likewise.
+        const std::string type = node.value("type", "");
+        if (type == "render.pathtrace" || type.starts_with("reference."))
             for (const char* p : {".params.target_noise=0", ".params.spp=4"}) sets.push_back(id + p);
     }
     const auto outputs = runGraphFile(file.string(), sets);
