@@ -34,8 +34,8 @@ NodeSchema schema() {
     color.format = VK_FORMAT_R32G32B32A32_SFLOAT;
     color.size = SizeRule::frame();
     color.usage = Usage::StorageReadWrite;
-    color.doc = "Ambient visibility A = max(0, 1 - intensity O)^contrast in r (g and b the same; a = 1), ao.alchemy's "
-                "`ao` layout: 1 unoccluded, 0 fully occluded, 1 where no surface was hit";
+    color.doc = "Ambient visibility A = max(0, 1 - intensity O)^contrast in r (g = b = 0, a = 1: ao.alchemy's `ao` "
+                "as its consumers read it): 1 unoccluded, 0 fully occluded, 1 where no surface was hit";
     OutputPort stats = color;
     stats.name = "stats";
     stats.doc = "Of the samples of 1 - intensity x occluded (before the clamp and the contrast): x samples per pixel, "
@@ -101,7 +101,7 @@ public:
         mResult = acc;
         for (glm::vec4& c : mResult.color) {
             const float a = std::pow(std::max(0.0f, c.r), contrast);
-            c = glm::vec4(a, a, a, 1.0f);
+            c = glm::vec4(a, 0.0f, 0.0f, 1.0f);
         }
         mUpload.upload(ctx, mStorePipeline, mResult);
     }

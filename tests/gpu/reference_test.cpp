@@ -164,7 +164,7 @@ TEST_F(Reference, AoCornerMatchesCosineWeightedQuadrature) {
             const double o = cornerObscurance(p, face, radius);
             const double expected = 1.0 - o, got = ao.at(x, y)[0];
             for (int ch = 0; ch < 3; ++ch) expectedImage.at(x, y)[ch] = static_cast<float>(expected);
-            EXPECT_EQ(ao.at(x, y)[0], ao.at(x, y)[2]) << "r = g = b";
+            EXPECT_EQ(ao.at(x, y)[1], 0.0f) << "ao.alchemy's layout: the value in r";
             EXPECT_EQ(out.at("stats").at(x, y)[0], float(spp));
             const double variance = std::max(o * (1.0 - o), 1.0 / spp) / spp;
             const double z = std::abs(got - expected) / (std::sqrt(variance) + 2e-3);
@@ -245,10 +245,10 @@ TEST_F(Reference, AlchemyAgreesWithTwinInCorner) {
                 "mean |difference| %.4f, worst row mean difference %.4f\n",
                 intensity, sumA / n, sumT / n, ratio, sumAbs / n, worstRow);
     EXPECT_GT(sumT / n, 0.02); // the twin sees the corner
-    EXPECT_GT(ratio, 0.5);
-    EXPECT_LT(ratio, 2.0);
-    EXPECT_LT(sumAbs / n, 0.1);
-    EXPECT_LT(worstRow, 0.2);
+    EXPECT_GT(ratio, 1.4); // measured 1.576: Alchemy's estimate obscures more than the rays find
+    EXPECT_LT(ratio, 1.75);
+    EXPECT_LT(sumAbs / n, 0.07); // measured 0.0547
+    EXPECT_LT(worstRow, 0.2);    // measured 0.150
 }
 
 // ---------------------------------------------------------------------------------------------
