@@ -378,7 +378,7 @@ TEST_F(Reference, FogSlabMatchesClosedForm) {
     const double edgeSigma = 0.5 / steps / std::sqrt(double(spp));
     for (const auto& [name, m] : {std::pair{"flat", flat}, std::pair{"thin", thin}}) {
         const Image& got = out.at(name);
-        look(got, std::string("fog_slab_twin_") + name, 1.0 / (sunE.g * 0.02));
+        look(got, std::string("fog_slab_twin_") + name, 1.0 / (sunE.g * 0.12));
         int lit = 0, shade = 0, edge = 0, skyRays = 0;
         double worstPlain = 0.0, worstEdge = 0.0, worstT = 0.0, sumEdge = 0.0;
         for (int y = 0; y < H; ++y)
@@ -465,8 +465,8 @@ TEST_F(Reference, VolumetricAgreesWithTwinInSlab) {
     auto out = runGraph(graph(nodes, {{"fog", "fog.scatter"}, {"twin", "twin.color"}, {"sh", "sky.sh"}}, W, H));
     const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
     const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
-    look(out.at("fog"), "fog_slab_volumetric", 1.0 / (sunE.g * 0.02));
-    look(out.at("twin"), "fog_slab_twin", 1.0 / (sunE.g * 0.02));
+    look(out.at("fog"), "fog_slab_volumetric", 1.0 / (sunE.g * 0.12));
+    look(out.at("twin"), "fog_slab_twin", 1.0 / (sunE.g * 0.12));
     Pinhole cam(slab.s, W, H);
     int lit = 0, edge = 0;
     double worstLit = 0.0, worstEdge = 0.0, sumEdge = 0.0, worstT = 0.0, sumF = 0.0, sumT = 0.0;
