@@ -206,6 +206,18 @@ MaterialLayer readMetallicRoughness(LoadContext& ctx, const Json& m, const std::
     layer.name = "base";
     float roughness = 1.0f, metallic = 1.0f;
     const Json* pbr = object(ctx, m, "pbrMetallicRoughness", e);
+    if (pbr && specGloss) {
+        // The fallback for viewers without the extension: its textures count as used (no "no material uses it"
+        // warning) and go with the conversion's sources unless another material samples them.
+        std::string pe = e + ".pbrMetallicRoughness";
+        if (const Json* t = member(*pbr, "baseColorTexture"))
+            ctx.specGlossSources.insert(
+                readTextureInfo(ctx, *t, TextureUsage::Color, pe + ".baseColorTexture").texture);
+        if (const Json* t = member(*pbr, "metallicRoughnessTexture")) {
+            ctx.specGlossSources.insert(
+                readTextureInfo(ctx, *t, TextureUsage::Data, pe + ".metallicRoughnessTexture").texture);
+        }
+    }
     if (pbr && !specGloss) {
         std::string pe = e + ".pbrMetallicRoughness";
         layer.albedo.factor = numbers(ctx, *pbr, "baseColorFactor", 4, glm::vec4(1.0f), pe);

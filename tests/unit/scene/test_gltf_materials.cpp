@@ -135,6 +135,25 @@ TEST(GltfMaterials, SpecularGlossinessSourceSharedWithAnotherMaterialIsKept) {
     EXPECT_EQ(s.images[s.textures[converted.texture].image].name, "diffuse base colour (from specular-glossiness)");
 }
 
+// Files converted from specular-glossiness often keep a pbrMetallicRoughness fallback for viewers without the
+// extension: it is not drawn, its textures raise no "unused" warning and are dropped with the conversion's sources.
+TEST(GltfMaterials, SpecularGlossinessFallbackTexturesAreNeitherWarnedNorKept) {
+    test::Json doc = test::readJson(corpus("spec_gloss.gltf"));
+    doc["textures"].push_back({{"source", 0}}); // a texture only the fallback names
+    doc["materials"][3]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 2}}},
+                                                   {"metallicRoughnessTexture", {{"index", 1}}}};
+    doc["materials"][1]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.1, 0.2, 0.3, 1.0}}, {"metallicFactor", 0.0}};
+    auto file = test::scratchDir() / "fallback.gltf";
+    test::writeText(file, doc.dump());
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(file, warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    EXPECT_EQ(s.textures.size(), 2u);
+    EXPECT_EQ(s.images.size(), 2u);
+    // The extension wins over the fallback's factors.
+    EXPECT_EQ(byName(s, "gold").layers.at(0), byName(loadGltf(corpus("spec_gloss.gltf")), "gold").layers.at(0));
+}
+
 TEST(GltfMaterials, EmissiveStrengthMultipliesTheEmissiveFactor) {
     Scene s = loadGltf(corpus("emissive_strength.gltf"));
     const Material& strong = byName(s, "strong");
