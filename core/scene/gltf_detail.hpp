@@ -74,6 +74,7 @@ struct LoadContext {
     // into the file's variants once loadMaterials() has found it (-1: none asked for).
     std::string materialVariant;
     int32_t variantIndex = -1;
+    size_t variantCount = 0; // the file's variants
     // Scene textures made by converting KHR_materials_pbrSpecularGlossiness textures (base colour, metallic-roughness),
     // by a key of their sources and factors, so that materials sharing them share the result.
     std::map<std::string, std::pair<int32_t, int32_t>> specGlossTextures;

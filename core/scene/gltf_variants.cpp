@@ -30,6 +30,7 @@ std::vector<std::string> variantNames(const LoadContext& ctx) {
 
 void readVariants(LoadContext& ctx) {
     std::vector<std::string> names = variantNames(ctx);
+    ctx.variantCount = names.size();
     if (ctx.materialVariant.empty()) return;
     if (names.empty()) {
         throw UnknownMaterialVariant(ctx.message(kVariants, "material_variant '" + ctx.materialVariant +
@@ -60,22 +61,26 @@ int variantMaterial(const LoadContext& ctx, const Json& primitive, int material,
     const Json* mappings = member(*ours, "mappings");
     if (!mappings || !mappings->is_array())
         ctx.fail(e, "expected an array of {\"material\": ..., \"variants\": [...]}");
+    // Every mapping is checked, not only up to the one that applies.
+    int chosen = material;
     for (size_t i = 0; i < mappings->size(); ++i) {
         std::string me = e + "[" + std::to_string(i) + "]";
         const Json& mapping = (*mappings)[i];
         if (!mapping.is_object()) ctx.fail(me, "expected a JSON object");
         const Json* variants = member(mapping, "variants");
         if (!variants || !variants->is_array()) ctx.fail(me + ".variants", "expected an array of variant indices");
+        const Json* m = member(mapping, "material");
+        if (!m) ctx.fail(me + ".material", "missing; expected an index into materials");
+        int mapped = static_cast<int>(checkIndex(ctx, *m, me + ".material", "materials"));
         for (const Json& v : *variants) {
-            if (!v.is_number_integer() || v.get<int64_t>() < 0)
-                ctx.fail(me + ".variants", v.dump() + "; expected an index into the file's variants");
-            if (v.get<int64_t>() != ctx.variantIndex) continue;
-            const Json* m = member(mapping, "material");
-            if (!m) ctx.fail(me + ".material", "missing; expected an index into materials");
-            return static_cast<int>(checkIndex(ctx, *m, me + ".material", "materials"));
+            if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<uint64_t>() >= ctx.variantCount) {
+                ctx.fail(me + ".variants", v.dump() + "; expected an index into the file's " +
+                                               std::to_string(ctx.variantCount) + " variants");
+            }
+            if (v.get<int64_t>() == ctx.variantIndex) chosen = mapped;
         }
     }
-    return material;
+    return chosen;
 }
 
 } // namespace vitrine::scene::gltf

@@ -42,6 +42,13 @@ TEST(GltfMaterials, SpecularGlossinessFactorsConvertToMetallicRoughness) {
     std::vector<std::string> warnings;
     Scene s = loadGltf(corpus("spec_gloss.gltf"), warnings);
     EXPECT_TRUE(warnings.empty()) << warnings[0];
+    // Supported, so a file may require it.
+    test::Json doc = test::readJson(corpus("spec_gloss.gltf"));
+    doc["extensionsRequired"] = {"KHR_materials_pbrSpecularGlossiness"};
+    auto required = test::scratchDir() / "required.gltf";
+    test::writeText(required, doc.dump());
+    EXPECT_EQ(loadGltf(required, warnings).materials, s.materials);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
     test::Json want = expected("spec_gloss.gltf");
     const char* names[] = {"grey_dielectric", "gold", "grey_half_metal"};
     const float diffuse[] = {0.5f, 0.0f, 0.3f};
@@ -191,6 +198,17 @@ TEST(GltfMaterials, MaterialVariantSelectsEachPrimitivesMapping) {
                           {"material_variant 'red'", "the file defines no material variants"});
     // Its own type, so that scene.gltf blames its param material_variant rather than the file.
     EXPECT_THROW(loadGltf(corpus("variants.gltf"), warnings, "green"), UnknownMaterialVariant);
+
+    // A mapping naming a variant the file lacks is an error at its JSON pointer (the validator's error too).
+    test::Json doc = test::readJson(corpus("variants.gltf"));
+    doc["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][1]["variants"] = {2};
+    auto bad = test::scratchDir() / "bad_mapping.gltf";
+    test::writeText(bad, doc.dump());
+    test::expectUserError(
+        [&] { loadGltf(bad, warnings, "red"); },
+        {"meshes[0].primitives[0].extensions.KHR_materials_variants.mappings[1].variants: 2; expected "
+         "an index into the file's 2 variants",
+         "(at /meshes/0/primitives/0/extensions/KHR_materials_variants/mappings/1/variants)"});
 }
 
 // Each material extension vitrine does not draw gets one warning naming it, what is lost and the materials using it;
