@@ -11,13 +11,17 @@
 // animations (objects and cameras), KHR_texture_transform, KHR_materials_emissive_strength,
 // KHR_lights_punctual (the first directional light becomes the sun; point and spot lights are kept with their
 // nodes), KHR_materials_unlit, KHR_materials_transmission (the factor; its texture is ignored with a warning),
-// KHR_materials_ior, KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's
-// reflection probes in VITRINE_reflection_probes (VITRINE_reflection_probes.md), morph targets (POSITION, NORMAL,
-// TANGENT displacements; mesh or node `weights` make the rest pose, animated weights are an animation channel). Any
-// other extension in extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning.
-// Skins (JOINTS_0/WEIGHTS_0, inverse bind matrices): the rest pose is skinned at load, animated joints re-skin on the
-// CPU every frame (GpuScene::update). Point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus
-// their sparse substitutions), as glTF says, indices included. Data URIs may be base64 or percent-encoded (RFC 2397). Embedded (data: URI, GLB) and external buffers and images both work.
+// KHR_materials_ior, KHR_materials_pbrSpecularGlossiness (converted to metallic-roughness at load: factors, and
+// textures texel by texel into new textures; gltf_specgloss.cpp), KHR_materials_variants (one variant chosen by name at
+// load), KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's reflection probes
+// in VITRINE_reflection_probes (VITRINE_reflection_probes.md), morph targets (POSITION, NORMAL, TANGENT displacements;
+// mesh or node `weights` make the rest pose, animated weights are an animation channel). Any other extension in
+// extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning
+// (KHR_materials_clearcoat, _sheen, _specular, _iridescence, _volume: one each, naming what of which materials is
+// lost). Skins (JOINTS_0/WEIGHTS_0, inverse bind matrices): the rest pose is skinned at load, animated joints re-skin
+// on the CPU every frame (GpuScene::update). Point/line primitives are ignored with a warning. Accessors without a
+// bufferView are zeros (plus their sparse substitutions), as glTF says, indices included. Data URIs may be base64 or
+// percent-encoded (RFC 2397). Embedded (data: URI, GLB) and external buffers and images both work.
 //
 // How glTF maps onto the scene model:
 // - A metallic-roughness material is a one-layer stack: shininess = 1 − roughnessFactor × texel.g,
@@ -28,6 +32,7 @@
 //   at 30 Hz over its animations otherwise. Paths written by exportGlb() come back exactly.
 // - Node matrices are decomposed into translation/rotation/scale (shear is lost).
 
+#include "core/base/error.hpp"
 #include "core/scene/scene.hpp"
 
 #include <filesystem>
@@ -39,21 +44,31 @@ namespace vitrine::scene {
 inline constexpr const char* kLayersExtension = "VITRINE_material_layers";
 inline constexpr const char* kProbesExtension = "VITRINE_reflection_probes";
 
+// What the loaders throw when their materialVariant is not a KHR_materials_variants variant of the file (the message
+// lists the file's variants), so that a caller can point at where the name came from.
+class UnknownMaterialVariant : public UserError {
+public:
+    using UserError::UserError;
+};
+
 // Loads a .gltf (JSON, external or data: URI buffers) or a .glb (recognised by its magic, whatever the
 // file is called). The result is finalized and valid (Scene::validate() passes).
 Scene loadGltf(const std::filesystem::path& file);
-// Same, and collects what was ignored (unsupported features, extra attributes) into warnings.
-Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings);
+// Same, and collects what was ignored (unsupported features, extra attributes) into warnings. materialVariant: the
+// KHR_materials_variants variant whose materials the primitives get ("" = their default materials); a name the file
+// does not define is a UserError listing the file's variants.
+Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings,
+               const std::string& materialVariant = "");
 // The bytes of a file already read, as if loaded from `file` (its name for messages and the GLB check, its
 // folder for external files). For the fuzzer and for callers that hold the file in memory.
 Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesystem::path& file,
-                         std::vector<std::string>& warnings);
+                         std::vector<std::string>& warnings, const std::string& materialVariant = "");
 
 // Loads for a user, as the scene.gltf node and `vitrine export-scene` do: each distinct warning (an unsupported
 // extension in extensionsUsed, point and line primitives, unused attributes, tinygltf's own warnings, ...) is printed once
 // on stderr through logWarning(), as "warning: FILE: ELEMENT: WHAT (at /json/pointer)". strict: warnings are errors;
 // a UserError lists them all and nothing is printed.
-Scene loadGltfReporting(const std::filesystem::path& file, bool strict);
+Scene loadGltfReporting(const std::filesystem::path& file, bool strict, const std::string& materialVariant = "");
 
 // Writes the scene as one self-contained .glb that the Khronos glTF-Validator reports without errors or warnings:
 // geometry (one interleaved vertex buffer view; TANGENT only where the material has a normal map, TEXCOORD_0 only

@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -28,6 +30,25 @@ inline constexpr const char* kMeshQuantization = "KHR_mesh_quantization";
 inline constexpr const char* kUnlit = "KHR_materials_unlit";
 inline constexpr const char* kTransmission = "KHR_materials_transmission";
 inline constexpr const char* kIor = "KHR_materials_ior";
+inline constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
+inline constexpr const char* kVariants = "KHR_materials_variants";
+
+// Material extensions vitrine reads no part of, and what of the material each one's absence leaves out: the loader
+// warns once per extension (naming the materials that use it) rather than with the generic extensionsUsed warning.
+struct IgnoredMaterialExtension {
+    const char* name;
+    const char* ignored;
+};
+inline constexpr IgnoredMaterialExtension kIgnoredMaterialExtensions[] = {
+    {"KHR_materials_clearcoat", "the clear coat layer (clearcoatFactor, clearcoatRoughnessFactor and their textures)"},
+    {"KHR_materials_sheen", "the sheen lobe (sheenColorFactor, sheenRoughnessFactor and their textures)"},
+    {"KHR_materials_specular",
+     "the specular strength and tint (specularFactor, specularColorFactor and their textures; the dielectric "
+     "reflectance stays the ior's, untinted)"},
+    {"KHR_materials_iridescence", "the thin-film iridescence (iridescenceFactor, its ior, thickness and textures)"},
+    {"KHR_materials_volume",
+     "the volume (thicknessFactor, attenuationColor, attenuationDistance; transmission stays thin-walled)"},
+};
 // Our key inside `extras` for what glTF has no place for (physical camera, rooms, camera paths).
 inline constexpr const char* kExtrasKey = "vitrine";
 
@@ -49,10 +70,20 @@ struct LoadContext {
     // Scene texture made for glTF texture i with usage u, or -1 (see resolveTexture()).
     std::vector<std::array<int32_t, 3>> textureByUsage;
     int32_t defaultMaterial = -1;
+    // The KHR_materials_variants variant the caller asked for ("" = the primitives' default materials), and its index
+    // into the file's variants once loadMaterials() has found it (-1: none asked for).
+    std::string materialVariant;
+    int32_t variantIndex = -1;
+    size_t variantCount = 0; // the file's variants
+    // Scene textures made by converting KHR_materials_pbrSpecularGlossiness textures (base colour, metallic-roughness),
+    // by a key of their sources and factors, so that materials sharing them share the result.
+    std::map<std::string, std::pair<int32_t, int32_t>> specGlossTextures;
+    std::set<int32_t> specGlossSources; // the scene textures those were converted from
 
     // "FILE: ELEMENT: WHAT", plus " (at /json/pointer)" when ELEMENT starts with a path into the glTF JSON
     // (`accessors[0].bufferView` → /accessors/0/bufferView). warn() keeps each distinct warning once.
     [[noreturn]] void fail(const std::string& element, const std::string& what) const;
+    std::string message(const std::string& element, const std::string& what) const; // the text fail() throws
     void warn(const std::string& element, const std::string& what) const;
 };
 
@@ -105,6 +136,27 @@ void loadImagesAndTextures(LoadContext& ctx);
 void loadMaterials(LoadContext& ctx);
 void loadMeshes(LoadContext& ctx);
 void loadNodesAndScene(LoadContext& ctx);
+
+// The primitive's material: its KHR_materials_variants mapping for ctx.variantIndex when it has one, else `material`
+// (its own, -1 when absent). Checks the mapping's indices.
+int variantMaterial(const LoadContext& ctx, const Json& primitive, int material, const std::string& element);
+// Reads the file's KHR_materials_variants list and finds ctx.materialVariant in it (UserError listing the variants
+// when absent). Called by loadMaterials().
+void readVariants(LoadContext& ctx);
+
+// KHR_materials_pbrSpecularGlossiness (the object under that name in material `element`) converted into the layer's
+// albedo, shininess and metallic; its textures become new scene textures converted texel by texel.
+void readSpecularGlossiness(LoadContext& ctx, const Json& ext, const std::string& element, MaterialLayer& layer);
+// Once every material is read: removes the scene textures (and their images) that only the conversions read, so that
+// neither the GPU nor an export carries them. Called by loadMaterials().
+void dropSpecGlossSources(LoadContext& ctx);
+// The conversion of one specular-glossiness sample (linear colours) into metallic-roughness. See gltf_specgloss.cpp.
+struct MetalRough {
+    glm::vec4 baseColor;
+    float metallic;
+    float roughness;
+};
+MetalRough specGlossToMetalRough(glm::vec4 diffuse, glm::vec3 specular, float glossiness);
 
 // A glTF textureInfo (with KHR_texture_transform) as a TextureRef of the given usage.
 TextureRef readTextureInfo(LoadContext& ctx, const Json& info, TextureUsage usage, const std::string& element);

@@ -590,12 +590,13 @@ void loadNodesAndScene(LoadContext& ctx) {
 namespace vitrine::scene {
 
 Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesystem::path& file,
-                         std::vector<std::string>& warnings) {
+                         std::vector<std::string>& warnings, const std::string& materialVariant) {
     using namespace gltf;
     LoadContext ctx;
     ctx.file = file.string();
     ctx.baseDir = file.parent_path();
     ctx.warnings = &warnings;
+    ctx.materialVariant = materialVariant;
     preflight(ctx, file, bytes);
 
     tinygltf::Model model;
@@ -631,15 +632,16 @@ Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesyste
     return scene;
 }
 
-Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings) {
+Scene loadGltf(const std::filesystem::path& file, std::vector<std::string>& warnings,
+               const std::string& materialVariant) {
     gltf::LoadContext ctx;
     ctx.file = file.string();
-    return loadGltfFromMemory(gltf::readGltfFile(ctx, file), file, warnings);
+    return loadGltfFromMemory(gltf::readGltfFile(ctx, file), file, warnings, materialVariant);
 }
 
-Scene loadGltfReporting(const std::filesystem::path& file, bool strict) {
+Scene loadGltfReporting(const std::filesystem::path& file, bool strict, const std::string& materialVariant) {
     std::vector<std::string> warnings; // distinct already (LoadContext::warn)
-    Scene scene = loadGltf(file, warnings);
+    Scene scene = loadGltf(file, warnings, materialVariant);
     if (strict && !warnings.empty()) {
         std::string list;
         for (const std::string& w : warnings)

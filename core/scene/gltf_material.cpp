@@ -199,12 +199,26 @@ MaterialLayer readLayer(LoadContext& ctx, const Json& layer, const std::string& 
     return out;
 }
 
-// The core metallic-roughness material as a one-layer stack (see gltf.hpp for the mapping).
-MaterialLayer readMetallicRoughness(LoadContext& ctx, const Json& m, const std::string& e) {
+// The core metallic-roughness material as a one-layer stack (see gltf.hpp for the mapping). specGloss: the material's
+// KHR_materials_pbrSpecularGlossiness, which replaces pbrMetallicRoughness (then only a fallback for other viewers).
+MaterialLayer readMetallicRoughness(LoadContext& ctx, const Json& m, const std::string& e, const Json* specGloss) {
     MaterialLayer layer;
     layer.name = "base";
     float roughness = 1.0f, metallic = 1.0f;
-    if (const Json* pbr = object(ctx, m, "pbrMetallicRoughness", e)) {
+    const Json* pbr = object(ctx, m, "pbrMetallicRoughness", e);
+    if (pbr && specGloss) {
+        // The fallback for viewers without the extension: its textures count as used (no "no material uses it"
+        // warning) and go with the conversion's sources unless another material samples them.
+        std::string pe = e + ".pbrMetallicRoughness";
+        if (const Json* t = member(*pbr, "baseColorTexture"))
+            ctx.specGlossSources.insert(
+                readTextureInfo(ctx, *t, TextureUsage::Color, pe + ".baseColorTexture").texture);
+        if (const Json* t = member(*pbr, "metallicRoughnessTexture")) {
+            ctx.specGlossSources.insert(
+                readTextureInfo(ctx, *t, TextureUsage::Data, pe + ".metallicRoughnessTexture").texture);
+        }
+    }
+    if (pbr && !specGloss) {
         std::string pe = e + ".pbrMetallicRoughness";
         layer.albedo.factor = numbers(ctx, *pbr, "baseColorFactor", 4, glm::vec4(1.0f), pe);
         if (const Json* t = member(*pbr, "baseColorTexture")) {
@@ -223,6 +237,7 @@ MaterialLayer readMetallicRoughness(LoadContext& ctx, const Json& m, const std::
     layer.shininess.factor = 1.0f - roughness;
     layer.shininess.atZero = 1.0f;
     layer.metallic.factor = metallic;
+    if (specGloss) readSpecularGlossiness(ctx, *specGloss, e, layer);
     if (const Json* n = object(ctx, m, "normalTexture", e)) {
         layer.normal.texture = readTextureInfo(ctx, *n, TextureUsage::Normal, e + ".normalTexture");
         layer.normal.scale = static_cast<float>(number(ctx, *n, "scale", 1.0, e + ".normalTexture"));
@@ -247,7 +262,8 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
         for (size_t i = 0; i < list->size(); ++i)
             out.layers.push_back(readLayer(ctx, (*list)[i], le + "[" + std::to_string(i) + "]"));
     } else {
-        out.layers.push_back(readMetallicRoughness(ctx, m, e));
+        const Json* specGloss = extensions ? object(ctx, *extensions, kSpecGloss, e + ".extensions") : nullptr;
+        out.layers.push_back(readMetallicRoughness(ctx, m, e, specGloss));
     }
     out.emissiveFactor = glm::vec3(numbers(ctx, m, "emissiveFactor", 3, glm::vec4(0.0f), e));
     if (const Json* t = member(m, "emissiveTexture")) {
@@ -287,6 +303,37 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
     out.alphaCutoff = static_cast<float>(number(ctx, m, "alphaCutoff", 0.5, e));
     out.doubleSided = boolean(ctx, m, "doubleSided", false, e);
     return out;
+}
+
+// One warning per material extension of kIgnoredMaterialExtensions the file uses, at its extensionsUsed entry (or at
+// the first material using it when extensionsUsed lacks it), naming what is not drawn and the materials concerned.
+void warnIgnoredMaterialExtensions(const LoadContext& ctx, const Json* materials) {
+    const Json* used = member(ctx.doc, "extensionsUsed");
+    for (const IgnoredMaterialExtension& ext : kIgnoredMaterialExtensions) {
+        std::string users, first;
+        size_t count = 0;
+        for (size_t i = 0; materials && i < materials->size(); ++i) {
+            const Json* extensions = member((*materials)[i], "extensions");
+            if (!extensions || !extensions->is_object() || !member(*extensions, ext.name)) continue;
+            std::string e = "materials[" + std::to_string(i) + "]";
+            if (first.empty()) first = e + ".extensions." + ext.name;
+            if (++count <= 8) users += (users.empty() ? "" : ", ") + e;
+        }
+        if (count > 8) users += " and " + std::to_string(count - 8) + " more";
+        std::string element = first;
+        for (size_t i = 0; used && used->is_array() && i < used->size(); ++i) {
+            if ((*used)[i] == ext.name) element = "extensionsUsed[" + std::to_string(i) + "]";
+        }
+        if (element.empty()) continue; // neither listed nor used
+        if (count == 0) {
+            ctx.warn(element, std::string("extension '") + ext.name +
+                                  "' is not supported by vitrine; no material uses it (vitrine would ignore " +
+                                  ext.ignored + ")");
+        } else {
+            ctx.warn(element, std::string("extension '") + ext.name + "' is not supported by vitrine: " + ext.ignored +
+                                  " of " + users + " is ignored; drawn with the rest of the material");
+        }
+    }
 }
 
 } // namespace
@@ -367,6 +414,7 @@ void loadImagesAndTextures(LoadContext& ctx) {
 }
 
 void loadMaterials(LoadContext& ctx) {
+    readVariants(ctx);
     const Json* materials = member(ctx.doc, "materials");
     if (materials && !materials->is_array()) ctx.fail("materials", "expected an array");
     for (size_t i = 0; materials && i < materials->size(); ++i) {
@@ -374,12 +422,14 @@ void loadMaterials(LoadContext& ctx) {
         if (!(*materials)[i].is_object()) ctx.fail(e, "expected a JSON object");
         ctx.scene->materials.push_back(readMaterial(ctx, (*materials)[i], e));
     }
+    warnIgnoredMaterialExtensions(ctx, materials);
     for (size_t i = 0; i < ctx.textureByUsage.size(); ++i) {
         const auto& u = ctx.textureByUsage[i];
         if (u[0] < 0 && u[1] < 0 && u[2] < 0) {
             ctx.warn("textures[" + std::to_string(i) + "]", "no material uses it; kept as linear data");
         }
     }
+    dropSpecGlossSources(ctx);
 }
 
 } // namespace vitrine::scene::gltf

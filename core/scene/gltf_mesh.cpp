@@ -51,8 +51,9 @@ std::vector<uint32_t> toTriangleList(const LoadContext& ctx, std::vector<uint32_
 
 // indexAccessor: the primitive's `indices` as the file has it (tinygltf's copy may lack it, see tinygltfInput).
 // weights: the mesh's rest weights, one per morph target (every primitive of a glTF mesh has as many targets).
+// material: the primitive's material index (its own, or its KHR_materials_variants mapping), -1 for glTF's default.
 void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAccessor, const std::vector<float>& weights,
-                   const std::string& e) {
+                   int material, const std::string& e) {
     int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
     if (mode <= TINYGLTF_MODE_LINE_STRIP) {
         ctx.warn(e, "points and lines are not drawn; primitive skipped");
@@ -217,10 +218,10 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     if (!tangents.count || !normals.count) generateTangents(vertices, indices);
 
     Scene& scene = *ctx.scene;
-    if (p.material >= 0 && static_cast<size_t>(p.material) < scene.materials.size()) {
-        if (!uv0.count && usesUvSet(scene.materials[p.material], 0))
+    if (material >= 0 && static_cast<size_t>(material) < scene.materials.size()) {
+        if (!uv0.count && usesUvSet(scene.materials[material], 0))
             ctx.warn(e, "its material samples TEXCOORD_0, which it lacks; (0, 0) used");
-        if (!uv1.count && usesUvSet(scene.materials[p.material], 1))
+        if (!uv1.count && usesUvSet(scene.materials[material], 1))
             ctx.warn(e, "its material samples TEXCOORD_1, which it lacks; (0, 0) used");
     }
     Primitive prim;
@@ -228,7 +229,7 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     prim.indexCount = static_cast<uint32_t>(indices.size());
     prim.vertexOffset = static_cast<uint32_t>(scene.vertices.size());
     prim.vertexCount = static_cast<uint32_t>(vertices.size());
-    prim.material = p.material >= 0 ? static_cast<uint32_t>(p.material) : defaultMaterial(ctx);
+    prim.material = material >= 0 ? static_cast<uint32_t>(material) : defaultMaterial(ctx);
     prim.lightmapUvs = uv1.count > 0;
     if (joints.count) {
         // Bind space as loaded (rest morph weights applied); the loader skins the rest pose once the nodes are known.
@@ -274,7 +275,8 @@ void loadMeshes(LoadContext& ctx) {
         for (size_t j = 0; j < model.meshes[i].primitives.size(); ++j) {
             std::string e = "meshes[" + std::to_string(i) + "].primitives[" + std::to_string(j) + "]";
             int indexAccessor = static_cast<int>(integer(ctx, primsJson[j], "indices", -1, e));
-            loadPrimitive(ctx, model.meshes[i].primitives[j], indexAccessor, mesh.weights, e);
+            int material = variantMaterial(ctx, primsJson[j], model.meshes[i].primitives[j].material, e);
+            loadPrimitive(ctx, model.meshes[i].primitives[j], indexAccessor, mesh.weights, material, e);
         }
         mesh.primitiveCount = static_cast<uint32_t>(ctx.scene->primitives.size()) - mesh.firstPrimitive;
         ctx.scene->meshes.push_back(mesh);

@@ -33,6 +33,10 @@ void LoadContext::fail(const std::string& element, const std::string& what) cons
     throw UserError(located(file, element, what));
 }
 
+std::string LoadContext::message(const std::string& element, const std::string& what) const {
+    return located(file, element, what);
+}
+
 void LoadContext::warn(const std::string& element, const std::string& what) const {
     if (!warnings) return;
     std::string message = located(file, element, what);
@@ -338,9 +342,12 @@ bool looksLikeGlb(const std::filesystem::path& file, const std::vector<uint8_t>&
     return false;
 }
 
-const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength, kLightsPunctual,
-                                          kMeshQuantization, kLayersExtension, kUnlit,
-                                          kTransmission, kIor, kProbesExtension};
+const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength,
+                                          kLightsPunctual,   kMeshQuantization,
+                                          kLayersExtension,  kUnlit,
+                                          kTransmission,     kIor,
+                                          kProbesExtension,  kSpecGloss,
+                                          kVariants};
 
 // An extension the file uses but does not require may be ignored (glTF 2.0, 3.12): a warning per extension.
 void checkUsedExtensions(const LoadContext& ctx) {
@@ -354,6 +361,10 @@ void checkUsedExtensions(const LoadContext& ctx) {
         if (!name.is_string()) ctx.fail(element, "expected an extension name");
         std::string n = name.get<std::string>();
         if (kSupported.count(n)) continue;
+        bool material = false;
+        for (const IgnoredMaterialExtension& ext : kIgnoredMaterialExtensions)
+            material = material || n == ext.name;
+        if (material) continue; // warned by loadMaterials(), naming what is ignored
         if (required && required->is_array() && std::find(required->begin(), required->end(), name) != required->end())
             continue; // refused by checkRequiredExtensions()
         ctx.warn(element, "extension '" + n + "' is not supported by vitrine; what the file puts under that name in "

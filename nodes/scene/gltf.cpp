@@ -11,14 +11,18 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "scene.gltf";
     s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
-            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, KHR_lights_punctual, "
-            "node and morph-weight animations, morph targets, skins.";
+            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, _variants, "
+            "_pbrSpecularGlossiness (converted to metallic-roughness), KHR_lights_punctual, node and morph-weight "
+            "animations, morph targets, skins.";
     s.pass = PassKind::Transfer;
     s.params = {{"path", ParamType::Path, "", {}, {}, {}, "The .gltf or .glb file (relative to the graph file)"},
                 {"strict", ParamType::Bool, false, {}, {}, {},
                  "Refuse the file when loading it gives warnings (what vitrine ignores: unsupported extensions in "
-                 "extensionsUsed, point and line primitives, unused attributes, ...) instead of printing them; `--strict` on the "
-                 "command line"}};
+                 "extensionsUsed, point and line primitives, unused attributes, ...) instead of printing them; "
+                 "`--strict` on the command line"},
+                {"material_variant", ParamType::String, "", {}, {}, {},
+                 "KHR_materials_variants: the variant (by name) whose materials the primitives get; empty: their "
+                 "default materials. A name the file does not define is an error listing its variants"}};
     addSceneNodeSchema(s);
     return s;
 }
@@ -32,7 +36,10 @@ public:
         if (!std::filesystem::exists(file)) ctx.failParam("path", "file not found: " + file.string());
         std::shared_ptr<const scene::Scene> scene;
         try {
-            scene = std::make_shared<const scene::Scene>(scene::loadGltfReporting(file, ctx.params().getBool("strict")));
+            scene = std::make_shared<const scene::Scene>(scene::loadGltfReporting(
+                file, ctx.params().getBool("strict"), ctx.params().getString("material_variant")));
+        } catch (const scene::UnknownMaterialVariant& e) {
+            ctx.failParam("material_variant", e.what());
         } catch (const UserError& e) {
             // The glTF error names its file and element; the graph's file and param say where the path came from.
             ctx.failParam("path", e.what());

@@ -163,6 +163,20 @@ TEST_F(SceneCli, MuseumTexturesComeFromTheBakeCacheOnTheSecondBuild) {
     const CliResult fourth = vitrine(args, env);
     EXPECT_NE(fourth.output.find("procedural textures loaded from the bake cache"), std::string::npos)
         << fourth.output;
+// KHR_materials_variants from the command line: --set scene.params.material_variant=NAME on graphs/gltf.json with
+// --scene; a name the file lacks is an error (exit 1) naming the param and listing the file's variants.
+TEST_F(SceneCli, MaterialVariantFromTheCommandLine) {
+    const std::string graph = quote(kSource + "/graphs/gltf.json");
+    const std::string file = quote(kSource + "/tests/data/gltf/corpus/variants.gltf");
+    const CliResult blue =
+        vitrine("validate " + graph + " --scene " + file + " --set scene.params.material_variant=blue --strict");
+    EXPECT_EQ(blue.status, 0) << blue.output;
+    const CliResult green =
+        vitrine("validate " + graph + " --scene " + file + " --set scene.params.material_variant=green");
+    EXPECT_EQ(green.status, 1) << green.output;
+    EXPECT_NE(green.output.find("material_variant"), std::string::npos) << green.output;
+    EXPECT_NE(green.output.find("no variant named 'green'"), std::string::npos) << green.output;
+    EXPECT_NE(green.output.find("'red', 'blue'"), std::string::npos) << green.output;
 }
 
 } // namespace

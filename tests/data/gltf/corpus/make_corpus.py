@@ -18,6 +18,17 @@ hand, written in the file's asset.extras.expect:
                        (tests/unit/scene/test_gltf_corpus.cpp checks the loaded vertices).
   skin_bend.gltf       a two-bone bend (joint 1 rotates 0 -> 90° about Z over 1 s) against CPU-skinned vertices
                        (unit test) and the rendered silhouette (GPU test).
+  spec_gloss.gltf      KHR_materials_pbrSpecularGlossiness: three factor-only materials (a grey dielectric, gold, a
+                       grey half-metal) and a textured one (2x2 diffuse and specular-glossiness PNGs, nearest
+                       sampling), each on a quad filling one quadrant of an orthographic view (xmag = ymag = 2 at
+                       z = 5). asset.extras.expect holds the metallic-roughness values worked out by hand from the
+                       conversion's quadratic (tests/unit/scene/test_gltf_corpus.cpp, tests/gpu/gltf_corpus_test.cpp).
+  emissive_strength.gltf  two quads with emissiveFactor (1, 0.5, 0.25): the left one with
+                       KHR_materials_emissive_strength 4, the right one without (G-buffer emissive 4x the right's).
+  variants.gltf        KHR_materials_variants "red" and "blue" remapping the left quad's white material; the right quad
+                       has no mapping and stays white whatever the variant.
+  ignored_material_extensions.gltf  KHR_materials_clearcoat, _sheen, _specular, _iridescence (material 0) and
+                       _volume with _transmission (material 1): vitrine warns once per ignored extension.
 Regenerate after editing: python3 tests/data/gltf/corpus/make_corpus.py
 """
 import base64
@@ -25,6 +36,7 @@ import json
 import math
 import os
 import struct
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 FLOAT, USHORT = 5126, 5123
@@ -73,15 +85,39 @@ class Builder:
             f.write("\n")
 
 
-def quad_mesh(b, center, half, material):
-    """A square facing +Z (counter-clockwise seen from +Z) of half size `half` around `center`."""
+def quad_mesh(b, center, half, material, uvs=False, name="marker", half_y=None):
+    """A rectangle facing +Z (counter-clockwise seen from +Z) of half size `half` (`half_y` vertically) around
+    `center`; uvs: TEXCOORD_0 with (0, 0) at the top-left corner, as glTF's UV origin is the image's top left."""
     cx, cy, cz = center
-    pos = [[cx - half, cy - half, cz], [cx + half, cy - half, cz], [cx + half, cy + half, cz], [cx - half, cy + half, cz]]
+    hy = half if half_y is None else half_y
+    pos = [[cx - half, cy - hy, cz], [cx + half, cy - hy, cz], [cx + half, cy + hy, cz], [cx - half, cy + hy, cz]]
     nrm = [[0.0, 0.0, 1.0]] * 4
-    prim = {"attributes": {"POSITION": b.floats(pos, "VEC3", True, 34962), "NORMAL": b.floats(nrm, "VEC3", False, 34962)},
-            "indices": b.indices([0, 1, 2, 0, 2, 3]), "material": material}
-    b.doc.setdefault("meshes", []).append({"name": "marker", "primitives": [prim]})
+    attributes = {"POSITION": b.floats(pos, "VEC3", True, 34962), "NORMAL": b.floats(nrm, "VEC3", False, 34962)}
+    if uvs:
+        attributes["TEXCOORD_0"] = b.floats([[0, 1], [1, 1], [1, 0], [0, 0]], "VEC2", False, 34962)
+    prim = {"attributes": attributes, "indices": b.indices([0, 1, 2, 0, 2, 3]), "material": material}
+    b.doc.setdefault("meshes", []).append({"name": name, "primitives": [prim]})
     return len(b.doc["meshes"]) - 1
+
+
+def png_rgba(width, height, rgba):
+    """An 8-bit RGBA PNG (no filtering) of rows of [r, g, b, a] texels, top row first."""
+    raw = b"".join(b"\x00" + bytes(v for texel in rgba[y * width:(y + 1) * width] for v in texel)
+                   for y in range(height))
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+def ortho_view(b, meshes):
+    """An orthographic camera (xmag = ymag = 2) at z = 5 looking down -Z at one node per mesh."""
+    b.doc["cameras"] = [{"type": "orthographic", "orthographic": {"xmag": 2.0, "ymag": 2.0, "znear": 0.1, "zfar": 20}}]
+    b.doc["nodes"] = [{"name": "camera", "camera": 0, "translation": [0, 0, 5]}]
+    b.doc["nodes"] += [{"name": b.doc["meshes"][m]["name"], "mesh": m} for m in meshes]
+    b.doc["scenes"] = [{"nodes": list(range(len(b.doc["nodes"])))}]
+    b.doc["scene"] = 0
 
 
 def camera_file(name, camera, marker):
@@ -252,6 +288,116 @@ def skin_file():
     b.write("skin_bend.gltf")
 
 
+def srgb_decode(v):
+    c = v / 255.0
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+def spec_gloss_file():
+    """Quadrants (top-left, top-right, bottom-left, bottom-right): a grey dielectric, gold, a grey half-metal (factors
+    only) and a textured material. Hand conversion (see core/scene/gltf_specgloss.cpp for the model): with
+    D = brightness(diffuse) (1 - max(specular)) / 0.96 and S = brightness(specular) the metallic m is the larger root
+    of 0.04 m^2 + (D + S - 0.08) m + (0.04 - S) = 0 (0 when S < 0.04); for grey colours the base colour is
+    D / (1 - m) (m < 1), for m = 1 it is the specular colour; roughness = 1 - glossiness.
+      grey dielectric: diffuse 0.5, specular 0.04, glossiness 0.8: S = 0.04, so c = 0 and m = 0; base = 0.5 x 0.96 /
+        0.96 = 0.5; roughness 0.2.
+      gold: diffuse 0, specular (1, 0.766, 0.336), glossiness 0.6: D = 0, and m = 1 solves 0.04 + (S - 0.08) +
+        (0.04 - S) = 0: metallic 1, base = specular, roughness 0.4.
+      grey half-metal: diffuse 0.3, specular 0.5, glossiness 0.5: D = 0.3 x 0.5 / 0.96 = 0.15625, b = 0.57625,
+        c = -0.46, m = (-0.57625 + sqrt(0.57625^2 + 0.0736)) / 0.08 = 0.758345; base = 0.15625 / (1 - m) = 0.646584
+        (and (0.5 - 0.04 (1 - m)) / m = 0.646584 from the specular side too); roughness 0.5.
+    The textured quadrant's texels (diffuse sRGB rgb + linear alpha; specular sRGB rgb, glossiness linear alpha),
+    left to right, top to bottom, and what they convert to (linear):
+      (128 grey, spec 0, gloss 255): S = 0: m = 0, base = 0.215861 / 0.96 = 0.224856, roughness 0.
+      (0 black, spec 255 white, gloss 0): D = 0, S = 1: m = 1, base = 1 (the specular), roughness 1.
+      (255 red, spec 0, gloss 128): m = 0, base = (1 / 0.96 -> clamped 1, 0, 0), roughness 1 - 128/255.
+      (255 white, spec 188 grey, gloss 64): specular 0.502886 linear: D = 0.497114 / 0.96 = 0.517827, S = 0.502886,
+        m = 0.482173, base = D / (1 - m) = 1.000000 (so does the specular side), roughness 1 - 64/255."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_pbrSpecularGlossiness"]
+    sg = "KHR_materials_pbrSpecularGlossiness"
+    b.doc["materials"] = [
+        {"name": "grey_dielectric", "extensions": {sg: {"diffuseFactor": [0.5, 0.5, 0.5, 1.0],
+                                                        "specularFactor": [0.04, 0.04, 0.04],
+                                                        "glossinessFactor": 0.8}}},
+        {"name": "gold", "extensions": {sg: {"diffuseFactor": [0.0, 0.0, 0.0, 1.0],
+                                             "specularFactor": [1.0, 0.766, 0.336], "glossinessFactor": 0.6}}},
+        {"name": "grey_half_metal", "extensions": {sg: {"diffuseFactor": [0.3, 0.3, 0.3, 1.0],
+                                                        "specularFactor": [0.5, 0.5, 0.5], "glossinessFactor": 0.5}}},
+        {"name": "textured", "extensions": {sg: {"diffuseTexture": {"index": 0},
+                                                 "specularGlossinessTexture": {"index": 1}}}}]
+    diffuse = png_rgba(2, 2, [[128, 128, 128, 255], [0, 0, 0, 255], [255, 0, 0, 255], [255, 255, 255, 255]])
+    specgloss = png_rgba(2, 2, [[0, 0, 0, 255], [255, 255, 255, 0], [0, 0, 0, 128], [188, 188, 188, 64]])
+    b.doc["images"] = [{"name": "diffuse", "mimeType": "image/png", "bufferView": b.view(diffuse)},
+                       {"name": "specular_glossiness", "mimeType": "image/png", "bufferView": b.view(specgloss)}]
+    b.doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"sampler": 0, "source": 0}, {"sampler": 0, "source": 1}]
+    meshes = [quad_mesh(b, c, 1.0, m, uvs=(m == 3), name=b.doc["materials"][m]["name"])
+              for m, c in enumerate([[-1, 1, 0], [1, 1, 0], [-1, -1, 0], [1, -1, 0]])]
+    ortho_view(b, meshes)
+    grey = 0.646584
+    dark = srgb_decode(128)
+    b.doc["asset"]["extras"] = {"expect": {
+        "quadrants": ["top_left", "top_right", "bottom_left", "bottom_right"],
+        "base_color": [[0.5, 0.5, 0.5, 1.0], [1.0, 0.766, 0.336, 1.0], [grey, grey, grey, 1.0]],
+        "metallic": [0.0, 1.0, 0.758345], "roughness": [0.2, 0.4, 0.5],
+        "texels_base_color": [[dark / 0.96] * 3 + [1.0], [1.0, 1.0, 1.0, 1.0], [1.0, 0.0, 0.0, 1.0],
+                              [1.0, 1.0, 1.0, 1.0]],
+        "texels_metallic": [0.0, 1.0, 0.0, 0.482173],
+        "texels_roughness": [0.0, 1.0, 1.0 - 128 / 255, 1.0 - 64 / 255]}}
+    b.write("spec_gloss.gltf")
+
+
+def emissive_strength_file():
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_emissive_strength"]
+    dark = {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0}
+    b.doc["materials"] = [{"name": "strong", "pbrMetallicRoughness": dark, "emissiveFactor": [1.0, 0.5, 0.25],
+                           "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}}},
+                          {"name": "plain", "pbrMetallicRoughness": dark, "emissiveFactor": [1.0, 0.5, 0.25]}]
+    meshes = [quad_mesh(b, [-1, 0, 0], 1.0, 0, name="strong", half_y=2.0),
+              quad_mesh(b, [1, 0, 0], 1.0, 1, name="plain", half_y=2.0)]
+    ortho_view(b, meshes)
+    b.doc["asset"]["extras"] = {"expect": {"left_emissive": [4.0, 2.0, 1.0], "right_emissive": [1.0, 0.5, 0.25]}}
+    b.write("emissive_strength.gltf")
+
+
+def variants_file():
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_variants"]
+    b.doc["extensions"] = {"KHR_materials_variants": {"variants": [{"name": "red"}, {"name": "blue"}]}}
+    flat = lambda c: {"baseColorFactor": c, "metallicFactor": 0}  # noqa: E731
+    b.doc["materials"] = [{"name": "white", "pbrMetallicRoughness": flat([1, 1, 1, 1])},
+                          {"name": "red", "pbrMetallicRoughness": flat([1, 0, 0, 1])},
+                          {"name": "blue", "pbrMetallicRoughness": flat([0, 0, 1, 1])}]
+    meshes = [quad_mesh(b, [-1, 0, 0], 1.0, 0, name="mapped", half_y=2.0),
+              quad_mesh(b, [1, 0, 0], 1.0, 0, name="unmapped", half_y=2.0)]
+    b.doc["meshes"][meshes[0]]["primitives"][0]["extensions"] = {"KHR_materials_variants": {"mappings": [
+        {"material": 1, "variants": [0]}, {"material": 2, "variants": [1]}]}}
+    ortho_view(b, meshes)
+    b.write("variants.gltf")
+
+
+def ignored_material_extensions_file():
+    b = Builder()
+    names = ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular", "KHR_materials_iridescence",
+             "KHR_materials_transmission", "KHR_materials_volume"]
+    b.doc["extensionsUsed"] = names
+    b.doc["materials"] = [
+        {"name": "coated", "extensions": {
+            "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1},
+            "KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessFactor": 0.5},
+            "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1.0, 0.5, 0.5]},
+            "KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 400.0}}},
+        {"name": "thick_glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                        "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationDistance": 1.0,
+                                                 "attenuationColor": [1.0, 0.5, 0.5]}}}]
+    meshes = [quad_mesh(b, [-1, 0, 0], 1.0, 0, name="coated"), quad_mesh(b, [1, 0, 0], 1.0, 1, name="thick_glass")]
+    ortho_view(b, meshes)
+    b.write("ignored_material_extensions.gltf")
+
+
 def main():
     # Perspective: the marker sits at 60 % of the half-height to the right and 40 % up at depth 5, so in a square
     # frame it lands at NDC (0.6, -0.4) (Vulkan y down) when the vertical field of view is kept, and at x = 0.4
@@ -269,6 +415,10 @@ def main():
     morph_cube_file("morph_animated.gltf", True)
     quantized_file()
     skin_file()
+    spec_gloss_file()
+    emissive_strength_file()
+    variants_file()
+    ignored_material_extensions_file()
 
 
 main()

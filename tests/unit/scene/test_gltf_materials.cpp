@@ -1,0 +1,246 @@
+// glTF material extensions on the corpus tests/data/gltf/corpus/ (written by make_corpus.py, validated by ctest
+// gltf.validator; issue #29 item 4): KHR_materials_pbrSpecularGlossiness converted to metallic-roughness against the
+// values worked out by hand in the file's asset.extras.expect and against the specular-glossiness model itself,
+// KHR_materials_emissive_strength, KHR_materials_variants, and the material extensions vitrine ignores with a warning.
+
+#include "core/scene/gltf.hpp"
+
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace vitrine::scene {
+namespace {
+
+std::filesystem::path corpus(const std::string& name) {
+    return test::dataDir() / "corpus" / name;
+}
+
+test::Json expected(const std::string& file) {
+    return test::readJson(corpus(file))["asset"]["extras"]["expect"];
+}
+
+const Material& byName(const Scene& s, const std::string& name) {
+    auto it = std::find_if(s.materials.begin(), s.materials.end(), [&](const Material& m) { return m.name == name; });
+    EXPECT_NE(it, s.materials.end()) << name;
+    return *it;
+}
+
+double srgbDecode(uint8_t v) {
+    double c = v / 255.0;
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// Factor-only materials: the converted factors against the hand-computed ones, and the converted material put back
+// through both models' definitions (glTF Appendix B and the extension): its diffuse reflectance base × 0.96 × (1 − m)
+// must be the file's diffuse × (1 − max(specular)) and its f0 = mix(0.04, base, m) the file's specular (exact for
+// grey colours; for gold f0 is the specular colour itself).
+TEST(GltfMaterials, SpecularGlossinessFactorsConvertToMetallicRoughness) {
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(corpus("spec_gloss.gltf"), warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    // Supported, so a file may require it.
+    test::Json doc = test::readJson(corpus("spec_gloss.gltf"));
+    doc["extensionsRequired"] = {"KHR_materials_pbrSpecularGlossiness"};
+    auto required = test::scratchDir() / "required.gltf";
+    test::writeText(required, doc.dump());
+    EXPECT_EQ(loadGltf(required, warnings).materials, s.materials);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    test::Json want = expected("spec_gloss.gltf");
+    const char* names[] = {"grey_dielectric", "gold", "grey_half_metal"};
+    const float diffuse[] = {0.5f, 0.0f, 0.3f};
+    const glm::vec3 specular[] = {glm::vec3(0.04f), glm::vec3(1.0f, 0.766f, 0.336f), glm::vec3(0.5f)};
+    for (int i = 0; i < 3; ++i) {
+        const MaterialLayer& l = byName(s, names[i]).layers.at(0);
+        SCOPED_TRACE(names[i]);
+        EXPECT_FALSE(l.albedo.texture.valid());
+        for (int c = 0; c < 4; ++c)
+            EXPECT_NEAR(l.albedo.factor[c], want["base_color"][i][c].get<float>(), 2e-5f) << "channel " << c;
+        EXPECT_NEAR(l.metallic.factor, want["metallic"][i].get<float>(), 2e-5f);
+        // shininess = 1 − roughness (the scene model's reading of glTF roughness).
+        EXPECT_NEAR(l.shininess.evaluate(1.0f), 1.0f - want["roughness"][i].get<float>(), 1e-6f);
+        float m = l.metallic.factor, maxSpec = std::max({specular[i].r, specular[i].g, specular[i].b});
+        glm::vec3 base = glm::vec3(l.albedo.factor);
+        glm::vec3 f0 = glm::mix(glm::vec3(0.04f), base, m);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(base[c] * 0.96f * (1.0f - m), diffuse[i] * (1.0f - maxSpec), 2e-5f) << "diffuse " << c;
+            EXPECT_NEAR(f0[c], specular[i][c], 2e-5f) << "f0 " << c;
+        }
+    }
+}
+
+// The textured material: both textures become new scene textures, converted texel by texel: a base colour
+// (sRGB) and a metallic-roughness texture (G roughness, B metallic) sampled as the diffuse texture is.
+TEST(GltfMaterials, SpecularGlossinessTexturesConvertTexelByTexel) {
+    Scene s = loadGltf(corpus("spec_gloss.gltf"));
+    test::Json want = expected("spec_gloss.gltf");
+    const MaterialLayer& l = byName(s, "textured").layers.at(0);
+    ASSERT_TRUE(l.albedo.texture.valid());
+    ASSERT_TRUE(l.metallic.texture.valid());
+    ASSERT_EQ(l.shininess.texture, l.metallic.texture);
+    EXPECT_EQ(l.albedo.factor, glm::vec4(1.0f));
+    EXPECT_EQ(l.metallic.channel, 2u);
+    EXPECT_EQ(l.shininess.channel, 1u);
+    EXPECT_EQ(l.metallic.evaluate(0.25f), 0.25f);  // metallic = texel
+    EXPECT_EQ(l.shininess.evaluate(0.25f), 0.75f); // shininess = 1 − roughness texel
+    // Only the converted textures remain: the sources, read by nothing else, are dropped with their images.
+    EXPECT_EQ(s.textures.size(), 2u);
+    EXPECT_EQ(s.images.size(), 2u);
+    const Texture& baseTex = s.textures[l.albedo.texture.texture];
+    const Texture& mrTex = s.textures[l.metallic.texture.texture];
+    EXPECT_EQ(baseTex.usage, TextureUsage::Color);
+    EXPECT_EQ(mrTex.usage, TextureUsage::Data);
+    EXPECT_EQ(baseTex.sampler.magFilter, Filter::Nearest); // the source's sampler
+    const TextureImage& base = s.images[baseTex.image];
+    const TextureImage& mr = s.images[mrTex.image];
+    ASSERT_EQ(base.width, 2u);
+    ASSERT_EQ(base.height, 2u);
+    ASSERT_EQ(mr.width, 2u);
+    for (uint32_t t = 0; t < 4; ++t) {
+        SCOPED_TRACE("texel " + std::to_string(t));
+        const uint8_t* b = base.at(t % 2, t / 2);
+        const uint8_t* m = mr.at(t % 2, t / 2);
+        for (int c = 0; c < 3; ++c) // 8-bit sRGB: half a step is at most 0.0025 in linear below 1
+            EXPECT_NEAR(srgbDecode(b[c]), want["texels_base_color"][t][c].get<double>(), 0.003) << "channel " << c;
+        EXPECT_NEAR(b[3] / 255.0, want["texels_base_color"][t][3].get<double>(), 0.5 / 255);
+        EXPECT_NEAR(m[1] / 255.0, want["texels_roughness"][t].get<double>(), 0.5 / 255 + 1e-6);
+        EXPECT_NEAR(m[2] / 255.0, want["texels_metallic"][t].get<double>(), 0.5 / 255 + 1e-6);
+    }
+    // Exported, the converted material is plain metallic-roughness and loads back the same.
+    auto file = test::scratchDir() / "spec_gloss.glb";
+    exportGlb(s, file);
+    Scene back = loadGltf(file);
+    EXPECT_EQ(byName(back, "textured"), byName(s, "textured"));
+    EXPECT_EQ(byName(back, "gold"), byName(s, "gold"));
+}
+
+// A source texture that a metallic-roughness material also samples stays, unchanged, next to the converted ones.
+TEST(GltfMaterials, SpecularGlossinessSourceSharedWithAnotherMaterialIsKept) {
+    test::Json doc = test::readJson(corpus("spec_gloss.gltf"));
+    doc["materials"].push_back({{"name", "plain"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    doc["meshes"][0]["primitives"][0]["material"] = 4; // the grey quad: it has no UVs, only (0, 0) is sampled
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] =
+        doc["meshes"][3]["primitives"][0]["attributes"]["TEXCOORD_0"];
+    auto file = test::scratchDir() / "shared.gltf";
+    test::writeText(file, doc.dump());
+    Scene s = loadGltf(file);
+    ASSERT_EQ(s.textures.size(), 3u);
+    ASSERT_EQ(s.images.size(), 3u);
+    const TextureRef& plain = byName(s, "plain").layers.at(0).albedo.texture;
+    ASSERT_TRUE(plain.valid());
+    const TextureImage& image = s.images[s.textures[plain.texture].image];
+    EXPECT_EQ(s.textures[plain.texture].usage, TextureUsage::Color);
+    ASSERT_EQ(image.width, 2u);
+    EXPECT_EQ(image.at(0, 0)[0], 128); // the file's diffuse texels
+    EXPECT_EQ(image.at(1, 1)[0], 255);
+    EXPECT_EQ(image.at(1, 0)[0], 0);
+    const TextureRef& converted = byName(s, "textured").layers.at(0).albedo.texture;
+    EXPECT_NE(converted.texture, plain.texture);
+    EXPECT_EQ(s.images[s.textures[converted.texture].image].name, "diffuse base colour (from specular-glossiness)");
+}
+
+// Files converted from specular-glossiness often keep a pbrMetallicRoughness fallback for viewers without the
+// extension: it is not drawn, its textures raise no "unused" warning and are dropped with the conversion's sources.
+TEST(GltfMaterials, SpecularGlossinessFallbackTexturesAreNeitherWarnedNorKept) {
+    test::Json doc = test::readJson(corpus("spec_gloss.gltf"));
+    doc["textures"].push_back({{"source", 0}}); // a texture only the fallback names
+    doc["materials"][3]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 2}}},
+                                                   {"metallicRoughnessTexture", {{"index", 1}}}};
+    doc["materials"][1]["pbrMetallicRoughness"] = {{"baseColorFactor", {0.1, 0.2, 0.3, 1.0}}, {"metallicFactor", 0.0}};
+    auto file = test::scratchDir() / "fallback.gltf";
+    test::writeText(file, doc.dump());
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(file, warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    EXPECT_EQ(s.textures.size(), 2u);
+    EXPECT_EQ(s.images.size(), 2u);
+    // The extension wins over the fallback's factors.
+    EXPECT_EQ(byName(s, "gold").layers.at(0), byName(loadGltf(corpus("spec_gloss.gltf")), "gold").layers.at(0));
+}
+
+TEST(GltfMaterials, EmissiveStrengthMultipliesTheEmissiveFactor) {
+    Scene s = loadGltf(corpus("emissive_strength.gltf"));
+    const Material& strong = byName(s, "strong");
+    const Material& plain = byName(s, "plain");
+    EXPECT_EQ(strong.emissiveStrength, 4.0f);
+    EXPECT_EQ(plain.emissiveStrength, 1.0f);
+    // What the GPU scene uploads (gpu_scene.cpp) and the G-buffer writes: factor × strength.
+    EXPECT_EQ(strong.emissiveFactor * strong.emissiveStrength, glm::vec3(4.0f, 2.0f, 1.0f));
+    EXPECT_EQ(plain.emissiveFactor * plain.emissiveStrength, glm::vec3(1.0f, 0.5f, 0.25f));
+}
+
+TEST(GltfMaterials, MaterialVariantSelectsEachPrimitivesMapping) {
+    auto materialOf = [](const Scene& s, const std::string& mesh) {
+        for (const Mesh& m : s.meshes)
+            if (m.name == mesh) return s.materials.at(s.primitives.at(m.firstPrimitive).material).name;
+        return std::string("(no mesh " + mesh + ")");
+    };
+    std::vector<std::string> warnings;
+    Scene plain = loadGltf(corpus("variants.gltf"), warnings);
+    EXPECT_TRUE(warnings.empty());
+    EXPECT_EQ(materialOf(plain, "mapped"), "white");
+    EXPECT_EQ(materialOf(plain, "unmapped"), "white");
+    Scene red = loadGltf(corpus("variants.gltf"), warnings, "red");
+    EXPECT_EQ(materialOf(red, "mapped"), "red");
+    EXPECT_EQ(materialOf(red, "unmapped"), "white");
+    Scene blue = loadGltf(corpus("variants.gltf"), warnings, "blue");
+    EXPECT_EQ(materialOf(blue, "mapped"), "blue");
+    EXPECT_EQ(materialOf(blue, "unmapped"), "white");
+    EXPECT_TRUE(warnings.empty());
+
+    test::expectUserError([&] { loadGltf(corpus("variants.gltf"), warnings, "green"); },
+                          {"variants.gltf: extensions.KHR_materials_variants.variants: no variant named 'green'",
+                           "'red', 'blue'", "(at /extensions/KHR_materials_variants/variants)"});
+    test::expectUserError([&] { loadGltf(corpus("emissive_strength.gltf"), warnings, "red"); },
+                          {"material_variant 'red'", "the file defines no material variants"});
+    // Its own type, so that scene.gltf blames its param material_variant rather than the file.
+    EXPECT_THROW(loadGltf(corpus("variants.gltf"), warnings, "green"), UnknownMaterialVariant);
+
+    // A mapping naming a variant the file lacks is an error at its JSON pointer (the validator's error too).
+    test::Json doc = test::readJson(corpus("variants.gltf"));
+    doc["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"][1]["variants"] = {2};
+    auto bad = test::scratchDir() / "bad_mapping.gltf";
+    test::writeText(bad, doc.dump());
+    test::expectUserError(
+        [&] { loadGltf(bad, warnings, "red"); },
+        {"meshes[0].primitives[0].extensions.KHR_materials_variants.mappings[1].variants: 2; expected "
+         "an index into the file's 2 variants",
+         "(at /meshes/0/primitives/0/extensions/KHR_materials_variants/mappings/1/variants)"});
+}
+
+// Each material extension vitrine does not draw gets one warning naming it, what is lost and the materials using it;
+// strict loading refuses the file listing all of them.
+TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(corpus("ignored_material_extensions.gltf"), warnings);
+    const std::pair<const char*, const char*> expectations[] = {{"KHR_materials_clearcoat", "clear coat"},
+                                                                {"KHR_materials_sheen", "sheen"},
+                                                                {"KHR_materials_specular", "specular strength"},
+                                                                {"KHR_materials_iridescence", "iridescence"},
+                                                                {"KHR_materials_volume", "attenuationColor"}};
+    ASSERT_EQ(warnings.size(), 5u);
+    for (const auto& [name, what] : expectations) {
+        size_t n = std::count_if(warnings.begin(), warnings.end(),
+                                 [&](const std::string& w) { return w.find(name) != std::string::npos; });
+        EXPECT_EQ(n, 1u) << name;
+        auto w = std::find_if(warnings.begin(), warnings.end(),
+                              [&](const std::string& w) { return w.find(name) != std::string::npos; });
+        if (w == warnings.end()) continue;
+        EXPECT_NE(w->find(what), std::string::npos) << *w;
+        EXPECT_NE(w->find("ignored"), std::string::npos) << *w;
+        EXPECT_NE(w->find("(at /extensionsUsed/"), std::string::npos) << *w;
+        bool volume = std::string(name) == "KHR_materials_volume";
+        EXPECT_NE(w->find(volume ? "of materials[1]" : "of materials[0]"), std::string::npos) << *w;
+    }
+    // The transmission next to the volume is read.
+    EXPECT_EQ(byName(s, "thick_glass").transmission, 1.0f);
+    test::expectUserError([&] { loadGltfReporting(corpus("ignored_material_extensions.gltf"), true); },
+                          {"5 warnings, which strict loading", "KHR_materials_clearcoat", "KHR_materials_sheen",
+                           "KHR_materials_specular", "KHR_materials_iridescence", "KHR_materials_volume"});
+}
+
+} // namespace
+} // namespace vitrine::scene
