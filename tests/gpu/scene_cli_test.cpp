@@ -163,6 +163,8 @@ TEST_F(SceneCli, MuseumTexturesComeFromTheBakeCacheOnTheSecondBuild) {
     const CliResult fourth = vitrine(args, env);
     EXPECT_NE(fourth.output.find("procedural textures loaded from the bake cache"), std::string::npos)
         << fourth.output;
+}
+
 // KHR_materials_variants from the command line: --set scene.params.material_variant=NAME on graphs/gltf.json with
 // --scene; a name the file lacks is an error (exit 1) naming the param and listing the file's variants.
 TEST_F(SceneCli, MaterialVariantFromTheCommandLine) {
