@@ -45,6 +45,10 @@ vec4 mipSampleLevel(sampler2D atlas, ivec2 size0, int level, vec2 uv) {
 
 // Trilinear: between the two levels around lod (clamped to [0, levels - 1]).
 vec4 mipSample(sampler2D atlas, ivec2 size0, int levels, vec2 uv, float lod) {
+    // A NaN uv or lod (a degenerate ray) reads nothing: clamp() of NaN is undefined, and the level and texel it
+    // gives can lie outside every level, in the atlas's unwritten corner (whatever memory the transient heap left
+    // there: the images then differ from run to run).
+    if (any(isnan(uv)) || isnan(lod)) return vec4(0.0);
     lod = clamp(lod, 0.0, float(levels - 1));
     int l0 = int(floor(lod));
     int l1 = min(l0 + 1, levels - 1);

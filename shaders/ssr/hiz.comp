@@ -139,6 +139,10 @@ vec4 traceRay(vec3 origin, vec3 n, vec3 o, vec3 r, float coneTan) {
     }
 
     vec3 ph = op + dp * t;
+    // A march that went through NaN (measured: a handful of rays per frame at the museum's lower screen edge) has
+    // no hit: its colour coordinates and cone footprint would be NaN, and the pyramid read at NaN coordinates is
+    // undefined (it read the atlas's unwritten corner: images that differed from run to run).
+    if (any(isnan(ph)) || any(isinf(ph))) return vec4(0.0);
     vec2 uvHit = ph.xy / size;
     ivec2 texel = clamp(ivec2(floor(ph.xy)), ivec2(0), u.size.xy - 1);
     float hitDepth = viewDepthOf(ph.z);
@@ -152,6 +156,10 @@ vec4 traceRay(vec3 origin, vec3 n, vec3 o, vec3 r, float coneTan) {
     vec2 edge = min(uvHit, 1.0 - uvHit);
     float fEdge = clamp(min(edge.x, edge.y) / u.params.z, 0.0, 1.0);
     float dist = length(unproject(uvHit, ph.z) - origin);
+    // A hit on the far plane (reverse-Z depth 0: the sky, or a ray that left the scene) unprojects to infinity: it is
+    // no hit. (Its distance, cone footprint and colour coordinates would be NaN, and the pyramid read at NaN
+    // coordinates is undefined: run-to-run differences in the frame.)
+    if (isnan(dist) || isinf(dist)) return vec4(0.0);
     float fLength = clamp((u.params.y - dist) / (0.25 * u.params.y), 0.0, 1.0);
     float confidence = fThickness * fBackFace * fEdge * fLength;
 
