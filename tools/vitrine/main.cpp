@@ -34,7 +34,7 @@ commands:
       and rays/s of primary (one per pixel) and incoherent (bounce) rays.
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
   compare A B [--reference R [--reference-half H | --no-noise-floor]] [--frame N | --frames A:B]
-          [--set K=V]... [--output NAME] [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
+          [--set K=V]... [--output NAME] [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S] [--no-summary]
       A, B, R: graphs (variants too) or images (EXR/PNG), same size. Writes the images, |A-B|,
       FLIP error maps, metrics.json (PSNR, SSIM, FLIP; flicker and error per frame with
       --frames) and a self-contained report.html to DIR (default out/compare/A_vs_B).
@@ -43,6 +43,7 @@ commands:
       render.pathtrace seed + 1, or --reference-half FILE); pairs within 1.5x of it are marked "within
       reference noise". --no-noise-floor: no second half. Every pair also gets the luminance ratio of
       16 px blocks (share within 15 %, mean |log2|) and its heat map (blocks_*.png).
+      --no-summary: print nothing on stdout (metrics.json has it all).
   golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]... [--from DIR]
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
       `accept` (re)writes the golden EXRs, `check` compares with FLIP, per-pixel and block
