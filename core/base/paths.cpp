@@ -39,19 +39,21 @@ Root findRoot() {
     // The Python module: installed as P/lib/python3/dist-packages/vitrine*.so next to P/share/vitrine; in the build
     // tree it reads the source tree (never the share/ of whatever python3 program loaded it).
     const fs::path module = loadedModule();
-    const fs::path exe = module.empty() ? fs::read_symlink("/proc/self/exe", ec) : module;
     fs::path share;
-    if (!ec && !module.empty()) {
-        share = module.parent_path().parent_path().parent_path().parent_path() / "share" / "vitrine";
-        if (module.parent_path().filename().string().ends_with("-packages") && fs::is_directory(share / "shaders", ec))
-            return {share.lexically_normal(), true};
-    } else if (!ec) {
+    if (!module.empty()) {
+        if (module.parent_path().filename().string().ends_with("-packages")) {
+            share = module.parent_path().parent_path().parent_path().parent_path() / "share" / "vitrine";
+            if (fs::is_directory(share / "shaders", ec)) return {share.lexically_normal(), true};
+        }
+    } else if (const fs::path exe = fs::read_symlink("/proc/self/exe", ec); !ec) {
         share = exe.parent_path().parent_path() / "share" / "vitrine";
         if (fs::is_directory(share / "shaders", ec)) return {share.lexically_normal(), true};
     }
     const char* off = std::getenv("VITRINE_NO_SOURCE_TREE");
     if (off && *off && std::strcmp(off, "0") != 0)
-        throw UserError("no installed shaders next to the vitrine binary (expected " +
+        throw UserError(std::string(module.empty() ? "no installed shaders next to the vitrine binary"
+                                                   : "no installed shaders next to the vitrine Python module") +
+                        " (expected " +
                         (share.empty() ? std::string("<prefix>/share/vitrine/shaders") : (share / "shaders").string()) +
                         ") and VITRINE_NO_SOURCE_TREE is set, so the source tree " VITRINE_SOURCE_DIR " is not used");
     return {fs::path(VITRINE_SOURCE_DIR), false};
