@@ -14,6 +14,7 @@ packages=(
     libopenexr-dev libimath-dev libopencolorio-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     python3-jsonschema
+    pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib  # the Python module (tools/python/)
     libcpp-httplib-dev
     dpkg-dev  # dpkg-shlibdeps: the .deb's Depends (cmake/install.cmake)
     slurmctld slurmd slurm-client munge

@@ -7,7 +7,8 @@ namespace vitrine {
 // Where vitrine's shared files live: shaders/, data/ (OCIO config, LUTs, lenses, models), graphs/, editor/dist/.
 //
 // An installed vitrine (`cmake --install build --prefix P`: P/bin/vitrine and P/share/vitrine/...) finds them next to
-// itself, through /proc/self/exe: <dir of the binary>/../share/vitrine when that folder holds shaders/. Otherwise the
+// itself, through /proc/self/exe: <dir of the binary>/../share/vitrine when that folder holds shaders/. The installed
+// Python module (P/lib/python3/dist-packages/vitrine*.so) finds P/share/vitrine the same way from its own file. Otherwise the
 // binary is the one in the build tree and they are the source tree's (the path compiled in at configure time).
 // With VITRINE_NO_SOURCE_TREE=1 in the environment that fallback is off: a binary that is not installed then fails
 // with a clear error instead of reading the source tree (the install test runs the installed copy with it).

@@ -52,6 +52,11 @@ inline void writeExr(const std::filesystem::path& path, const Image& image, ExrP
     writeExr(path, {ExrLayer{"", &image}}, type);
 }
 
+// The 8-bit RGBA pixels (row-major, top row first) encodePng() writes: display/view of config on colour, alpha
+// quantized as it is. The Python module's displayed images.
+std::vector<unsigned char> displayBytes(const Image& linear, const ColorConfig& config = ColorConfig::builtin(),
+                                        const std::string& display = "sRGB", const std::string& view = "Standard");
+
 // Encodes a scene-linear image as an 8-bit RGBA PNG for viewing: applies display/view of config on
 // the CPU, clamps to [0, 1] and rounds. Alpha stays linear (clamped). NaN becomes 0.
 std::vector<unsigned char> encodePng(const Image& linear, const ColorConfig& config = ColorConfig::builtin(),

@@ -70,15 +70,21 @@ Image detail::loadHdrImage(const std::filesystem::path& path) {
     return toImage(static_cast<const float*>(data.get()), width, height, 1.0f);
 }
 
-std::vector<unsigned char> encodePng(const Image& linear, const ColorConfig& config, const std::string& display,
-                                     const std::string& view) {
-    if (linear.empty()) throw InternalError("encodePng: the image is empty");
+std::vector<unsigned char> displayBytes(const Image& linear, const ColorConfig& config, const std::string& display,
+                                        const std::string& view) {
     const Image encoded = config.toDisplay(linear, "scene_linear", display, view);
     std::vector<unsigned char> bytes(linear.pixels.size());
     for (size_t i = 0; i < bytes.size(); ++i) {
         const bool alpha = i % 4 == 3; // alpha is coverage, not colour: it never goes through the display curve
         bytes[i] = quantize(alpha ? linear.pixels[i] : encoded.pixels[i]);
     }
+    return bytes;
+}
+
+std::vector<unsigned char> encodePng(const Image& linear, const ColorConfig& config, const std::string& display,
+                                     const std::string& view) {
+    if (linear.empty()) throw InternalError("encodePng: the image is empty");
+    const std::vector<unsigned char> bytes = displayBytes(linear, config, display, view);
 
     std::vector<unsigned char> png;
     auto append = [](void* context, void* data, int size) {

@@ -24,7 +24,17 @@ done
 if [ -f "$src/editor/dist/index.html" ]; then
     grep -qxF ./usr/share/vitrine/editor/dist/index.html "$work/files.txt" || fail "the editor bundle is not in $deb"
 fi
+# The Python module (when built) in /usr/lib/python3/dist-packages, and the Python it needs in Depends.
+python_module=0
+if compgen -G "$build/python/vitrine*.so" > /dev/null; then
+    python_module=1
+    grep -qE '^\./usr/lib/python3/dist-packages/vitrine\.cpython-[0-9]+-[a-z0-9_-]+\.so$' "$work/files.txt" ||
+        fail "the Python module is not in $deb under /usr/lib/python3/dist-packages (list: $work/files.txt)"
+fi
 depends="$(dpkg-deb -f "$deb" Depends)"
+if [ "$python_module" = 1 ]; then
+    [[ "$depends" == *python3-numpy* ]] || fail "Depends lacks python3-numpy (the Python module imports it): '$depends'"
+fi
 [[ "$depends" == *libvulkan1* ]] || fail "Depends lacks libvulkan1: '$depends'"
 [[ "$depends" == *libc6* ]] || fail "Depends lacks libc6: '$depends'"
 echo "install.deb: $deb, $(stat -c %s "$deb") bytes, $(wc -l < "$work/files.txt") entries"

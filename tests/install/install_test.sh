@@ -89,4 +89,34 @@ for g in fxaa_zoneplate museum; do
     cmp "$work/build-tree/$g/final.png" "$work/installed/$g/final.png" ||
         fail "$g: the installed copy's final.png differs from the build tree's"
 done
-echo "install.prefix: installed into $prefix; fxaa_zoneplate and museum rendered at 160x90 from it (source tree covered: $can_cover)"
+# The Python module (when built): installed into the prefix's Debian Python folder, it finds PREFIX/share/vitrine from
+# its own location; with the source tree hidden it renders the zone plate to the build tree's final.png, byte for
+# byte, while the build tree's module cannot render at all (the control).
+python_checked=""
+if compgen -G "$build/python/vitrine*.so" > /dev/null; then
+    site="$prefix/lib/python3/dist-packages"
+    compgen -G "$site/vitrine*.so" > /dev/null || fail "the Python module is not installed in $site"
+    render_py='
+import sys, numpy as np, matplotlib.image, vitrine
+g = vitrine.Graph.load(sys.argv[1], set={"frame.width": 160, "frame.height": 90}, device=vitrine.Device("", validate=True))
+r = g.run(frames=1)
+assert r.validation_messages == 0, r.validation_messages
+png = np.round(matplotlib.image.imread(sys.argv[2]) * 255.0).astype(np.uint8)
+assert np.array_equal(r.display("final"), png), "the display image differs from the build tree final.png"
+print(vitrine.__file__)'
+    set +e
+    hidden env PYTHONPATH="$build/python" /usr/bin/python3 -c "$render_py" "$prefix/share/vitrine/graphs/fxaa_zoneplate.json" \
+        "$work/build-tree/fxaa_zoneplate/final.png" > "$work/control-python.out" 2>&1
+    rc=$?
+    set -e
+    [ "$rc" -ne 0 ] || fail "the build tree's Python module rendered with the source tree hidden"
+    grep -q "VITRINE_NO_SOURCE_TREE" "$work/control-python.out" ||
+        fail "the Python control failed for another reason: $(cat "$work/control-python.out")"
+    hidden env PYTHONPATH="$site" /usr/bin/python3 -c "$render_py" "$prefix/share/vitrine/graphs/fxaa_zoneplate.json" \
+        "$work/build-tree/fxaa_zoneplate/final.png" > "$work/installed-python.out" 2>&1 ||
+        fail "the installed Python module could not render fxaa_zoneplate: $(cat "$work/installed-python.out")"
+    grep -q "^$site/vitrine" "$work/installed-python.out" ||
+        fail "python3 imported another vitrine module: $(cat "$work/installed-python.out")"
+    python_checked="; the installed Python module rendered fxaa_zoneplate equal to the build tree's"
+fi
+echo "install.prefix: installed into $prefix; fxaa_zoneplate and museum rendered at 160x90 from it (source tree covered: $can_cover)$python_checked"

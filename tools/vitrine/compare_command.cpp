@@ -397,51 +397,55 @@ int compareCommand(const Args& args) {
     writeFileAtomically(out.claim("metrics.json"), compare::metricsJson(report).dump(2) + "\n");
     compare::writeReport(out.claim("report.html"), report);
 
-    for (const compare::PairMetrics& m : report.metrics)
-        std::printf("%-3s vs %-10s PSNR %s   SSIM %.4f   FLIP mean %.4f (weighted median %.4f)   blocks within "
-                    "15%% %5.1f%%, mean |log2| %.3f%s\n",
-                    m.test.c_str(), m.reference.c_str(), formatPsnr(m.psnr).c_str(), m.ssim, m.flip.mean,
-                    m.flip.weightedMedian, 100.0 * m.blocks.withinShare, m.blocks.meanAbsLog2,
-                    !m.withinReferenceNoise   ? ""
-                    : *m.withinReferenceNoise ? "   within reference noise"
-                                              : "   beyond reference noise");
-    if (report.regions) {
-        std::printf("%-22s %8s", "region", "pixels");
-        for (const auto& p : report.regions->pairs)
-            std::printf("  %14s", (p.test + "/" + (p.reference == "reference" ? "R" : p.reference)).c_str());
-        std::printf("   (mean luminance ratio)\n");
-        for (size_t r = 0; r < regions->regions.size(); ++r) {
-            std::printf("%-22s %8d", regions->regions[r].name.c_str(), report.regions->pairs.front().regions[r].pixels);
-            for (const auto& p : report.regions->pairs) std::printf("  %14.3f", p.regions[r].ratio);
-            std::printf("\n");
+    // --no-summary: nothing on stdout (the Python module's vitrine.compare returns metrics.json instead).
+    if (!args.has("no-summary")) {
+        for (const compare::PairMetrics& m : report.metrics)
+            std::printf("%-3s vs %-10s PSNR %s   SSIM %.4f   FLIP mean %.4f (weighted median %.4f)   blocks within "
+                        "15%% %5.1f%%, mean |log2| %.3f%s\n",
+                        m.test.c_str(), m.reference.c_str(), formatPsnr(m.psnr).c_str(), m.ssim, m.flip.mean,
+                        m.flip.weightedMedian, 100.0 * m.blocks.withinShare, m.blocks.meanAbsLog2,
+                        !m.withinReferenceNoise   ? ""
+                        : *m.withinReferenceNoise ? "   within reference noise"
+                                                  : "   beyond reference noise");
+        if (report.regions) {
+            std::printf("%-22s %8s", "region", "pixels");
+            for (const auto& p : report.regions->pairs)
+                std::printf("  %14s", (p.test + "/" + (p.reference == "reference" ? "R" : p.reference)).c_str());
+            std::printf("   (mean luminance ratio)\n");
+            for (size_t r = 0; r < regions->regions.size(); ++r) {
+                std::printf("%-22s %8d", regions->regions[r].name.c_str(), report.regions->pairs.front().regions[r].pixels);
+                for (const auto& p : report.regions->pairs) std::printf("  %14.3f", p.regions[r].ratio);
+                std::printf("\n");
+            }
         }
+        // Whole-frame brightness: which side is darker, and by how much (one term against its twin, a frame against R).
+        std::printf("mean luminance: A %.6g, B %.6g", meanLuminance(a.still), meanLuminance(b.still));
+        if (reference) std::printf(", reference %.6g", meanLuminance(reference->still));
+        const double lumB = meanLuminance(b.still);
+        std::printf("; A / B %.4f", lumB > 0.0 ? meanLuminance(a.still) / lumB : 0.0);
+        if (reference) {
+            const double lumR = meanLuminance(reference->still);
+            std::printf(", A / reference %.4f, B / reference %.4f", lumR > 0.0 ? meanLuminance(a.still) / lumR : 0.0,
+                        lumR > 0.0 ? lumB / lumR : 0.0);
+        }
+        std::printf("\n");
+        if (noiseFloor) {
+            if (noiseFloor->status == compare::NoiseFloor::Status::Measured)
+                std::printf("noise floor: FLIP mean %.4f between the reference and its other half (%s); blocks "
+                            "within 15%% %5.1f%%, mean |log2| %.3f; pairs with FLIP mean <= %.4f are within reference "
+                            "noise\n",
+                            noiseFloor->pair->flip.mean, noiseFloor->reason.c_str(),
+                            100.0 * noiseFloor->pair->blocks.withinShare, noiseFloor->pair->blocks.meanAbsLog2,
+                            noiseFloor->factor * noiseFloor->pair->flip.mean);
+            else
+                std::printf("noise floor: %s (%s)\n",
+                            noiseFloor->status == compare::NoiseFloor::Status::Skipped ? "skipped" : "unknown",
+                            noiseFloor->reason.c_str());
+        }
+        for (const compare::TemporalMetrics& t : report.temporal)
+            std::printf("%-9s flicker %.5f over %d frames\n", t.label.c_str(), t.flicker, t.frameCount);
+        std::printf("wrote %s\n", (out.dir() / "report.html").string().c_str());
     }
-    // Whole-frame brightness: which side is darker, and by how much (one term against its twin, a frame against R).
-    std::printf("mean luminance: A %.6g, B %.6g", meanLuminance(a.still), meanLuminance(b.still));
-    if (reference) std::printf(", reference %.6g", meanLuminance(reference->still));
-    const double lumB = meanLuminance(b.still);
-    std::printf("; A / B %.4f", lumB > 0.0 ? meanLuminance(a.still) / lumB : 0.0);
-    if (reference) {
-        const double lumR = meanLuminance(reference->still);
-        std::printf(", A / reference %.4f, B / reference %.4f", lumR > 0.0 ? meanLuminance(a.still) / lumR : 0.0,
-                    lumR > 0.0 ? lumB / lumR : 0.0);
-    }
-    std::printf("\n");
-    if (noiseFloor) {
-        if (noiseFloor->status == compare::NoiseFloor::Status::Measured)
-            std::printf("noise floor: FLIP mean %.4f between the reference and its other half (%s); blocks within 15%% "
-                        "%5.1f%%, mean |log2| %.3f; pairs with FLIP mean <= %.4f are within reference noise\n",
-                        noiseFloor->pair->flip.mean, noiseFloor->reason.c_str(),
-                        100.0 * noiseFloor->pair->blocks.withinShare, noiseFloor->pair->blocks.meanAbsLog2,
-                        noiseFloor->factor * noiseFloor->pair->flip.mean);
-        else
-            std::printf("noise floor: %s (%s)\n",
-                        noiseFloor->status == compare::NoiseFloor::Status::Skipped ? "skipped" : "unknown",
-                        noiseFloor->reason.c_str());
-    }
-    for (const compare::TemporalMetrics& t : report.temporal)
-        std::printf("%-9s flicker %.5f over %d frames\n", t.label.c_str(), t.flicker, t.frameCount);
-    std::printf("wrote %s\n", (out.dir() / "report.html").string().c_str());
     if (ctx && ctx->validationMessageCount() > 0) {
         logWarning(std::to_string(ctx->validationMessageCount()) + " Vulkan validation message(s)");
         return 2;

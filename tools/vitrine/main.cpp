@@ -35,7 +35,7 @@ commands:
   graph GRAPH --dot                 The compiled graph (passes, resources, lifetimes) as Graphviz.
   compare A B [--reference R [--reference-half H | --no-noise-floor]] [--frame N | --frames A:B] [--regions F]
           [--set K=V]... [--output NAME] [--output-a NAME] [--output-b NAME] [--output-reference NAME]
-          [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S]
+          [--out DIR] [--force] [--hdr] [--ppd X] [--diff-scale S] [--no-summary]
       A, B, R: graphs (variants too) or images (EXR/PNG), same size. --output NAME: the graphs' output
       compared (default "final"), or that layer of an EXR; --output-a/-b/-reference NAME: that side's (e.g.
       one term of the frame, terms/specular_indirect, against its ray-traced twin's). Writes the images, |A-B|,
@@ -48,6 +48,7 @@ commands:
       16 px blocks (share within 15 %, mean |log2|) and its heat map (blocks_*.png). --regions F: the
       mean luminance ratio of each named region of F (e.g. graphs/regions/museum.regions.json) per pair,
       and regions.png showing them.
+      --no-summary: print nothing on stdout (metrics.json has it all).
   golden check|accept [NAME]... [--out DIR] [--manifest FILE] [--set K=V]... [--from DIR]
       Image regression of tests/golden/manifest.json on this device class (lavapipe|gpu):
       `accept` (re)writes the golden EXRs, `check` compares with FLIP, per-pixel and block

@@ -5,6 +5,7 @@
 #include "core/image/image.hpp"
 #include "core/shader/compiler.hpp"
 #include "tools/vitrine/serve/http_util.hpp"
+#include "tools/vitrine/serve/warm_graphs.hpp"
 
 #include <atomic>
 #include <condition_variable>
@@ -18,45 +19,12 @@
 #include <string>
 #include <thread>
 
-namespace vitrine {
-class Executor;
-}
-
 // The GPU side of `vitrine serve`: one thread owns the Vulkan device, the shader compiler and the graphs compiled
 // for earlier requests, and runs the requests' GPU work one at a time in the order they came (the queue is the one
 // place GPU work is serialised). The queue is bounded: past `maxQueued` waiting jobs a new one is refused at once
 // (HttpError 503 with a Retry-After estimate) instead of waiting without end. A request that fails (a UserError from
 // a node's setup, a Vulkan error) fails alone; the thread goes on with the next one.
 namespace vitrine::serve {
-
-// A graph ready to render: the document merged (extends), edited for the preview (size, frames, the one output
-// kept) and validated. WarmGraphs is keyed on its document, directory and file.
-struct PreparedGraph {
-    GraphDesc desc;     // validated, its paths checked against the served directory
-    std::string output; // the one graph output left in it ("" with previews)
-    // A request for several outputs at once ("outputs": [...], the editor's thumbnails): what it asked for, in order;
-    // preview i is the graph output "preview_i".
-    std::vector<std::string> previews;
-};
-
-// Compiled graphs with their executors (pipelines, images, uploaded scenes, baked resources) kept between requests,
-// so that rendering the same document again runs frames only. Least recently used first out.
-class WarmGraphs {
-public:
-    explicit WarmGraphs(size_t capacity);
-    ~WarmGraphs();
-    struct Entry;
-    // The entry for `graph`, compiled (and its executor created) when not kept; `compiled` says whether it was.
-    Entry& get(Context& ctx, ShaderCompiler& shaders, const PreparedGraph& graph, bool& compiled);
-    Executor& executor(Entry& entry);
-    void drop(const Entry& entry);
-    void clear();
-    size_t size() const { return mEntries.size(); }
-
-private:
-    size_t mCapacity;
-    std::list<std::unique_ptr<Entry>> mEntries; // front: most recently used
-};
 
 // What a render job reports while it runs, on the GPU thread: "compiling", then "rendering" with frames done/total.
 using ProgressFn = std::function<void(const std::string& stage, uint32_t done, uint32_t total)>;
