@@ -21,7 +21,8 @@ std::vector<std::string> shippedGraphs() {
     for (const auto& entry : fs::recursive_directory_iterator(root))
         if (entry.is_regular_file() && entry.path().extension() == ".json" &&
             !entry.path().filename().string().ends_with(".schema.json") && // vitrine-graph.schema.json is not a graph
-            !entry.path().filename().string().ends_with(".sweep.json"))    // nor are `vitrine sweep` files
+            !entry.path().filename().string().ends_with(".sweep.json") &&  // nor are `vitrine sweep` files
+            !entry.path().filename().string().ends_with(".regions.json"))  // nor `compare --regions` files
             files.push_back(fs::relative(entry.path(), root).generic_string());
     std::sort(files.begin(), files.end());
     return files;
