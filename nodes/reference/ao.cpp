@@ -9,7 +9,6 @@
 namespace vitrine {
 namespace {
 
-constexpr float kPi = 3.14159265358979f;
 
 NodeSchema schema() {
     NodeSchema s;
@@ -50,15 +49,6 @@ NodeSchema schema() {
     return s;
 }
 
-// An orthonormal basis with n as its third column (Duff et al. 2017).
-glm::mat3 basisAround(glm::vec3 n) {
-    const float sign = n.z >= 0.0f ? 1.0f : -1.0f;
-    const float a = -1.0f / (sign + n.z);
-    const float b = n.x * n.y * a;
-    return glm::mat3(glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x),
-                     glm::vec3(b, sign + n.y * n.y * a, -n.y), n);
-}
-
 class ReferenceAo final : public Node {
 public:
     void setup(SetupContext& ctx) override {
@@ -88,10 +78,8 @@ public:
             CpuSurface s;
             if (!rays.intersect(o, d, 3.4e38f, s)) return glm::vec3(1.0f); // nothing drawn: unoccluded
             glm::vec3 ng = glm::dot(s.geometricNormal, d) > 0.0f ? -s.geometricNormal : s.geometricNormal;
-            const glm::vec2 u = CpuRays::next2(rng);
-            const float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-            const glm::vec3 local(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x)));
-            const glm::vec3 dir = glm::normalize(basisAround(s.normal) * local);
+            const glm::vec3 dir = glm::normalize(cpu_sampling::basisAround(s.normal) *
+                                                 cpu_sampling::sampleCosine(CpuRays::next2(rng)));
             const bool occluded =
                 glm::dot(dir, ng) <= 0.0f || rays.occluded(CpuRays::offset(s.position, ng, dir), dir, radius);
             return glm::vec3(1.0f - intensity * (occluded ? 1.0f : 0.0f));

@@ -72,7 +72,7 @@ protected:
         CpuSurface s;
         if (!rays.intersect(o, d, std::numeric_limits<float>::infinity(), s)) return glm::vec3(0.0f);
         const glm::vec3 n = s.normal, ng = s.geometricNormal;
-        const glm::vec3 l = twinBasisAround(n) * twinSampleCosine(CpuRays::next2(rng));
+        const glm::vec3 l = cpu_sampling::basisAround(n) * cpu_sampling::sampleCosine(CpuRays::next2(rng));
         // The path tracer's rule: no light from below the geometric surface.
         if (glm::dot(ng, l) <= 0.0f) return glm::vec3(0.0f);
         const glm::vec3 L = rays.radiance(CpuRays::offset(s.position, ng, l), l, rng);

@@ -59,12 +59,12 @@ protected:
         if (NoV <= 0.0f || s.cavity <= 0.0f) return glm::vec3(0.0f);
         const glm::vec3 f0 = specularF0(s.baseColor, s.metallic);
         const float alpha = ggxAlpha(s.roughness);
-        const glm::mat3 frame = twinBasisAround(n);
-        const glm::vec3 h = frame * twinSampleGgxVndf(glm::transpose(frame) * v, alpha, CpuRays::next2(rng));
+        const glm::mat3 frame = cpu_sampling::basisAround(n);
+        const glm::vec3 h = frame * cpu_sampling::sampleGgxVndf(glm::transpose(frame) * v, alpha, CpuRays::next2(rng));
         const glm::vec3 l = glm::reflect(-v, h);
         // The path tracer's rule: no light from below the geometric surface.
         if (glm::dot(n, l) <= 0.0f || glm::dot(ng, l) <= 0.0f) return glm::vec3(0.0f);
-        const float pdf = twinGgxVndfPdf(NoV, glm::clamp(glm::dot(n, h), 0.0f, 1.0f), alpha);
+        const float pdf = cpu_sampling::ggxVndfPdf(NoV, glm::clamp(glm::dot(n, h), 0.0f, 1.0f), alpha);
         if (!(pdf > 0.0f)) return glm::vec3(0.0f);
         const glm::vec3 weight = brdfCosineF0(n, v, l, glm::vec3(0.0f), f0, s.roughness) / pdf;
         return s.cavity * weight * rays.radiance(CpuRays::offset(s.position, ng, l), l, rng);

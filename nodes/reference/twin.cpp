@@ -189,38 +189,4 @@ void TwinNode::executeConverge(ExecuteContext& ctx) {
 
 // --- sampling (nodes/render/pathtrace_cpu.cpp's, line for line) ---
 
-glm::mat3 twinBasisAround(glm::vec3 n) {
-    float s = n.z >= 0.0f ? 1.0f : -1.0f;
-    float a = -1.0f / (s + n.z);
-    float b = n.x * n.y * a;
-    glm::vec3 t(1.0f + s * n.x * n.x * a, s * b, -s * n.x);
-    glm::vec3 bt(b, s + n.y * n.y * a, -n.y);
-    return glm::mat3(t, bt, n);
-}
-
-glm::vec3 twinSampleCosine(glm::vec2 u) {
-    constexpr float kPi = 3.14159265358979323846f;
-    float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-    return glm::vec3(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x)));
-}
-
-glm::vec3 twinSampleGgxVndf(glm::vec3 v, float alpha, glm::vec2 u) {
-    constexpr float kPi = 3.14159265358979323846f;
-    glm::vec3 vh = glm::normalize(glm::vec3(alpha * v.x, alpha * v.y, v.z));
-    float lensq = vh.x * vh.x + vh.y * vh.y;
-    glm::vec3 t1 = lensq > 0.0f ? glm::vec3(-vh.y, vh.x, 0.0f) / std::sqrt(lensq) : glm::vec3(1.0f, 0.0f, 0.0f);
-    glm::vec3 t2 = glm::cross(vh, t1);
-    float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
-    float p1 = r * std::cos(phi), p2 = r * std::sin(phi);
-    float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * p2;
-    glm::vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
-    return glm::normalize(glm::vec3(alpha * nh.x, alpha * nh.y, std::max(0.0f, nh.z)));
-}
-
-float twinGgxVndfPdf(float NoV, float NoH, float alpha) {
-    float a2 = alpha * alpha;
-    return shading::ggxD(NoH, alpha) / (2.0f * (NoV + std::sqrt(a2 + (1.0f - a2) * NoV * NoV)));
-}
-
 } // namespace vitrine

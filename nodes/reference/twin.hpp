@@ -63,9 +63,4 @@ private:
 
 // GGX visible-normal sampling (Heitz 2018) and its pdf of the reflected direction: the path tracer's
 // (nodes/render/pathtrace_cpu.cpp, sampleGgxVndf and ggxVndfPdf), which keeps them private.
-glm::vec3 twinSampleGgxVndf(glm::vec3 v, float alpha, glm::vec2 u); // v, result: in the frame of the normal (z)
-float twinGgxVndfPdf(float NoV, float NoH, float alpha);             // of l = reflect(-v, h), per steradian
-glm::mat3 twinBasisAround(glm::vec3 n);                              // columns t, b, n
-glm::vec3 twinSampleCosine(glm::vec2 u);                             // z-up, pdf cos / pi
-
 } // namespace vitrine

@@ -71,6 +71,10 @@ vec2 rngNext2(uint32_t& state) {
     return vec2(a, rngNext(state));
 }
 
+} // namespace
+
+namespace cpu_sampling {
+
 glm::mat3 basisAround(vec3 n) {
     float s = n.z >= 0.0f ? 1.0f : -1.0f;
     float a = -1.0f / (s + n.z);
@@ -83,11 +87,6 @@ glm::mat3 basisAround(vec3 n) {
 vec3 sampleCosine(vec2 u) {
     float r = std::sqrt(u.x), phi = 2.0f * kPi * u.y;
     return vec3(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u.x)));
-}
-
-vec3 sampleUniformSphere(vec2 u) {
-    float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.0f * kPi * u.y;
-    return vec3(r * std::cos(phi), r * std::sin(phi), z);
 }
 
 vec3 sampleGgxVndf(vec3 v, float alpha, vec2 u) {
@@ -106,6 +105,17 @@ vec3 sampleGgxVndf(vec3 v, float alpha, vec2 u) {
 float ggxVndfPdf(float NoV, float NoH, float alpha) {
     float a2 = alpha * alpha;
     return ggxD(NoH, alpha) / (2.0f * (NoV + std::sqrt(a2 + (1.0f - a2) * NoV * NoV)));
+}
+
+} // namespace cpu_sampling
+
+namespace {
+
+using namespace cpu_sampling;
+
+vec3 sampleUniformSphere(vec2 u) {
+    float z = 1.0f - 2.0f * u.x, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.0f * kPi * u.y;
+    return vec3(r * std::cos(phi), r * std::sin(phi), z);
 }
 
 struct BrdfLobes {

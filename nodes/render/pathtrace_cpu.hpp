@@ -138,6 +138,15 @@ private:
     std::unique_ptr<Impl> mImpl;
 };
 
+// The path tracer's own sampling routines, for the ray-traced twins (nodes/reference/) to draw directions exactly as
+// the tracer does.
+namespace cpu_sampling {
+glm::mat3 basisAround(glm::vec3 n);                               // columns t, b, n (Duff et al. 2017)
+glm::vec3 sampleCosine(glm::vec2 u);                              // z-up, pdf cos / pi
+glm::vec3 sampleGgxVndf(glm::vec3 v, float alpha, glm::vec2 u);   // v and the result in the frame of the normal (z)
+float ggxVndfPdf(float NoV, float NoH, float alpha);              // of l = reflect(-v, h), per steradian
+} // namespace cpu_sampling
+
 // CPU time of this process so far (all threads), in seconds: throughput figures that hold on a loaded machine.
 double processCpuSeconds();
 
