@@ -3,7 +3,35 @@
 #include "core/base/error.hpp"
 #include "core/gpu/context.hpp"
 
+#include <cstdlib>
+#include <cstring>
+
 namespace vitrine {
+
+int debugPoisonMemoryByte() {
+    // VITRINE_DEBUG_POISON_MEMORY=<0..255>: every host-visible sub-allocation is filled with that byte when handed out,
+    // so a read of memory nothing wrote shows up (0xff is NaN in every float format) instead of reading whatever the
+    // last owner of the range left there.
+    static const int byte = [] {
+        const char* v = std::getenv("VITRINE_DEBUG_POISON_MEMORY");
+        if (!v || !*v) return -1;
+        char* end = nullptr;
+        long b = std::strtol(v, &end, 0);
+        if (*end || b < 0 || b > 255) throw UserError(std::string("VITRINE_DEBUG_POISON_MEMORY='") + v + "': expected a byte value 0..255");
+        return static_cast<int>(b);
+    }();
+    return byte;
+}
+
+void debugPoisonAllocation(const Allocation& a, const std::string& name) {
+    if (!a.mapped || debugPoisonMemoryByte() < 0) return;
+    static const std::string only = [] {
+        const char* v = std::getenv("VITRINE_DEBUG_POISON_MEMORY_ONLY"); // a part of the resource's name
+        return std::string(v ? v : "");
+    }();
+    if (!only.empty() && name.find(only) == std::string::npos) return;
+    std::memset(a.mapped, debugPoisonMemoryByte(), a.size);
+}
 
 Allocator::Allocator(Context& ctx, VkDeviceSize blockSize) : mCtx(ctx), mBlockSize(blockSize) {
     vkGetPhysicalDeviceMemoryProperties(ctx.physicalDevice(), &mProperties);

@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <map>
+#include <string>
 #include <vector>
 
 namespace vitrine {
+
 
 class Context;
 
@@ -41,6 +43,7 @@ public:
     void free(const Allocation& allocation);
     uint32_t findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags properties) const;
     AllocatorStats stats() const;
+    const VkPhysicalDeviceMemoryProperties& properties() const { return mProperties; }
 
 private:
     struct Block {
@@ -61,5 +64,10 @@ private:
     VkPhysicalDeviceMemoryProperties mProperties{};
     std::vector<Pool> mPools;
 };
+
+// Debugging reads of memory nothing wrote (see allocator.cpp): -1 unless VITRINE_DEBUG_POISON_MEMORY is set.
+int debugPoisonMemoryByte();
+// Fills a fresh host-visible allocation with that byte (when VITRINE_DEBUG_POISON_MEMORY_ONLY is empty or part of name).
+void debugPoisonAllocation(const Allocation& allocation, const std::string& name);
 
 } // namespace vitrine

@@ -42,6 +42,7 @@ GpuImage::GpuImage(Context& ctx, const ImageDesc& desc, const std::string& name)
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(ctx.device(), mImage, &req);
     mAllocation = ctx.allocator().allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, false);
+    debugPoisonAllocation(mAllocation, "image " + name);
     VK_CHECK(vkBindImageMemory(ctx.device(), mImage, mAllocation.memory, mAllocation.offset));
     createViews();
 }
@@ -128,6 +129,7 @@ GpuBuffer::GpuBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, 
                                       ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
     mAllocation = ctx.allocator().allocate(req, props, true);
+    debugPoisonAllocation(mAllocation, "buffer " + name);
     VK_CHECK(vkBindBufferMemory(ctx.device(), mBuffer, mAllocation.memory, mAllocation.offset));
     ctx.setName(reinterpret_cast<uint64_t>(mBuffer), VK_OBJECT_TYPE_BUFFER, name);
 }

@@ -1,4 +1,5 @@
 #include "core/graph/compiler.hpp"
+#include "core/graph/executor.hpp"
 
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
@@ -259,6 +260,7 @@ CompiledGraph compileGraph(GraphDesc desc, const NodeRegistry& registry) {
         // Any texture can be inspected (debug.view, read-back), so every one is sampleable.
         r.desc.usage |= VK_IMAGE_USAGE_SAMPLED_BIT;
         if (r.history) r.desc.usage |= VK_IMAGE_USAGE_TRANSFER_DST_BIT; // cleared before its first frame
+        if (debugPoison().enabled) r.desc.usage |= VK_IMAGE_USAGE_TRANSFER_DST_BIT; // poisoned before its first writer
         if (r.history || r.persistent || r.extracted) {
             r.firstPass = 0;
             r.lastPass = static_cast<uint32_t>(g.passes.size() - 1);

@@ -2,6 +2,7 @@
 
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
+#include "core/gpu/allocator.hpp"
 #include "core/gpu/context.hpp"
 #include "core/gpu/formats.hpp"
 #include "core/gpu/memory_budget.hpp"
@@ -14,10 +15,35 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <cstring>
 #include <set>
 
 namespace vitrine {
+
+const DebugPoison& debugPoison() {
+    static const DebugPoison poison = [] {
+        DebugPoison p;
+        const char* v = std::getenv("VITRINE_DEBUG_POISON");
+        if (!v || !*v) return p;
+        p.enabled = true;
+        if (std::string_view(v) == "nan") {
+            p.value = std::numeric_limits<float>::quiet_NaN();
+        } else {
+            char* end = nullptr;
+            p.value = std::strtof(v, &end);
+            if (end == v || *end)
+                throw UserError(std::string("VITRINE_DEBUG_POISON='") + v + "': expected a number or 'nan'");
+        }
+        if (const char* only = std::getenv("VITRINE_DEBUG_POISON_ONLY")) p.only = only;
+        logWarning("VITRINE_DEBUG_POISON: textures that do not survive the frame are cleared to " + std::string(v) +
+                " before their first pass" + (p.only.empty() ? "" : " (only names containing '" + p.only + "')"));
+        return p;
+    }();
+    return poison;
+}
 
 struct Executor::Pipeline {
     struct Target {
@@ -397,6 +423,17 @@ void Executor::createImages() {
         info.allocationSize = plan.heapSize;
         info.memoryTypeIndex = transientType;
         VK_CHECK(vkAllocateMemory(mCtx.device(), &info, nullptr, &mTransientHeap));
+        if (debugPoisonMemoryByte() >= 0 &&
+            (mCtx.allocator().properties().memoryTypes[transientType].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+            void* mapped = nullptr;
+            VK_CHECK(vkMapMemory(mCtx.device(), mTransientHeap, 0, VK_WHOLE_SIZE, 0, &mapped));
+            Allocation whole;
+            whole.memory = mTransientHeap;
+            whole.size = plan.heapSize;
+            whole.mapped = mapped;
+            debugPoisonAllocation(whole, "transient heap");
+            vkUnmapMemory(mCtx.device(), mTransientHeap);
+        }
     }
 
     mResourcePhysical.assign(mGraph.resources.size(), {UINT32_MAX, UINT32_MAX});
@@ -564,8 +601,39 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
         }
     }
 
+    const DebugPoison& poison = debugPoison();
     for (uint32_t pi = 0; pi < mGraph.passes.size(); ++pi) {
         const CompiledPass& pass = mGraph.passes[pi];
+        if (poison.enabled) {
+            std::vector<uint32_t> poisoned;
+            for (uint32_t i = 0; i < mGraph.resources.size(); ++i) {
+                const GraphResource& r = mGraph.resources[i];
+                if (!r.isTexture() || r.persistent || r.history || r.firstPass != pi) continue;
+                if (!poison.only.empty() && r.name.find(poison.only) == std::string::npos) continue;
+                require(mResourcePhysical[i][0], accessOf(Usage::TransferDst, PassKind::Transfer));
+                poisoned.push_back(mResourcePhysical[i][0]);
+            }
+            flush();
+            for (uint32_t phys : poisoned) {
+                const GpuImage& image = mPhysical[phys].image;
+                VkImageSubresourceRange range{aspectOf(image.desc().format), 0, VK_REMAINING_MIP_LEVELS, 0,
+                                              VK_REMAINING_ARRAY_LAYERS};
+                if (formatInfo(image.desc().format).depth) {
+                    VkClearDepthStencilValue depth{std::isnan(poison.value) ? 0.5f : std::clamp(poison.value, 0.0f, 1.0f), 0};
+                    vkCmdClearDepthStencilImage(cmd, image.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &depth, 1, &range);
+                } else {
+                    VkClearColorValue value;
+                    if (image.desc().format == VK_FORMAT_R32_UINT) {
+                        uint32_t bits;
+                        std::memcpy(&bits, &poison.value, 4);
+                        for (auto& c : value.uint32) c = bits;
+                    } else {
+                        for (auto& c : value.float32) c = poison.value;
+                    }
+                    vkCmdClearColorImage(cmd, image.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &value, 1, &range);
+                }
+            }
+        }
         for (const auto& u : pass.uses)
             if (mGraph.resources[u.resource].isTexture())
                 require(physicalOf(u.resource, u.previous), accessOf(u.usage, pass.schema->pass));

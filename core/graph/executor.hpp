@@ -12,6 +12,17 @@
 
 namespace vitrine {
 
+// Debugging reads of memory no pass wrote: with VITRINE_DEBUG_POISON=<float> (or "nan"), every texture whose
+// contents do not survive the frame is cleared to that value right before its first pass each frame, so a pass that
+// reads texels nobody wrote sees the poison instead of whatever the memory last held. VITRINE_DEBUG_POISON_ONLY=<text>
+// limits it to resources whose name contains <text>. Off by default (the clears cost bandwidth).
+struct DebugPoison {
+    bool enabled = false;
+    float value = 0.0f;
+    std::string only;
+};
+const DebugPoison& debugPoison();
+
 class Context;
 class GpuProfiler;
 class ShaderCompiler;

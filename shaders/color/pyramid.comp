@@ -19,6 +19,14 @@ vec4 sourceTexel(ivec2 p) {
 void main() {
     ivec2 c = ivec2(gl_GlobalInvocationID.xy);
     int source = max(pc.source, 0);
+    if (pc.source < 0) {
+        // The first dispatch covers the atlas's width and defines its padding (see mipAtlasInLevel()): this texel
+        // of the level-0 rows and the one at the same place in the strip of smaller levels below them.
+        ivec2 atlas = imageSize(out_pyramid);
+        ivec2 strip = ivec2(c.x, pc.size.y + c.y);
+        if (all(lessThan(c, atlas)) && !mipAtlasInLevel(pc.size, c)) imageStore(out_pyramid, c, vec4(0.0));
+        if (all(lessThan(strip, atlas)) && !mipAtlasInLevel(pc.size, strip)) imageStore(out_pyramid, strip, vec4(0.0));
+    }
     for (int m = 0; m < pc.count; ++m) {
         int level = pc.first + m;
         if (any(greaterThanEqual(c, mipSize(pc.size, level)))) return;

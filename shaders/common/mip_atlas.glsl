@@ -16,6 +16,27 @@ ivec2 mipOffset(ivec2 size0, int level) {
     return ivec2(x, size0.y);
 }
 
+// Levels down to 1x1 of a level-0 image of size0 (mipAtlasLevels() on the C++ side).
+int mipLevels(ivec2 size0) {
+    int levels = 1;
+    while ((max(size0.x, size0.y) >> levels) > 0) ++levels;
+    return levels;
+}
+
+// Whether atlas texel p belongs to some level. The rest (right of level 0 when the row of levels is wider, right
+// of the row, below the smaller levels) is padding that the reductions fill with zeros: a bilinear lookup at a
+// level's edge touches it with a weight of (about) zero, and NaN garbage there would not vanish (NaN * 0 = NaN).
+bool mipAtlasInLevel(ivec2 size0, ivec2 p) {
+    if (p.y < size0.y) return p.x < size0.x;
+    int y = p.y - size0.y, x = 0, levels = mipLevels(size0);
+    for (int k = 1; k < levels; ++k) {
+        ivec2 s = mipSize(size0, k);
+        if (p.x < x + s.x) return p.x >= x && y < s.y;
+        x += s.x;
+    }
+    return false;
+}
+
 // The texels [lo, hi] of level `source` that texel c of level `target` (>= source) covers.
 void mipFootprint(ivec2 size0, int source, int target, ivec2 c, out ivec2 lo, out ivec2 hi) {
     lo = c;

@@ -226,7 +226,7 @@ def test_gil_released_while_rendering(device):
     assert max(gaps) < 0.5 * elapsed, f"the main thread stalled {max(gaps):.3f} s of {elapsed:.3f} s"
 
 
-def test_museum_equals_cli_and_rerun_skips_scene_build(device, tmp_path):
+def test_museum_equals_cli_and_rerun_skips_scene_build(device, tmp_path, capfd):
     cli("run", SRC / "graphs" / "museum.json", *sets_args(MUSEUM_CHEAP), "--exr", "float", "--quiet",
         "--out", tmp_path / "cli")
     # Without validation (as install.prefix renders the Museum: its probe capture under validation takes minutes).
@@ -237,11 +237,28 @@ def test_museum_equals_cli_and_rerun_skips_scene_build(device, tmp_path):
     assert np.array_equal(r1["final"], layers["final"])
     assert r1["final"].shape == (90, 160, 4)
     # A post param changed: the graph is compiled again, but the Museum's scene (built in setup()) comes from the
-    # in-process cache while the earlier compiled graph is warm, so compiling takes a fraction of the first time.
-    g.set({"grain.params.strength": 0.0})
-    r2 = g.run(frames=1)
+    # in-process cache while the earlier compiled graph is warm. Checked by what is logged, not by timing (speed is
+    # the benchmarks' to measure): the scene node logs "built in" each time it builds the Museum.
+    vitrine.set_log_level("debug")
+    try:
+        capfd.readouterr()
+        g.set({"grain.params.strength": 0.0})
+        r2 = g.run(frames=1)
+        log = capfd.readouterr().err
+    finally:
+        vitrine.set_log_level("warning")
     assert not r2.reused
     print(f"museum 160x90: first compile {r1.compile_ms:.0f} ms, after a post param changed {r2.compile_ms:.0f} ms")
-    assert r2.compile_ms < 0.5 * r1.compile_ms
+    assert "scene 'museum': built" not in log, log
+    # The log is live (a scene built now would have said so): a fresh seed is a different Museum.
+    vitrine.set_log_level("debug")
+    try:
+        capfd.readouterr()
+        g.set({"scene.params.seed": 7})
+        g.run(frames=1)
+        log = capfd.readouterr().err
+    finally:
+        vitrine.set_log_level("warning")
+    assert "scene 'museum': built" in log, log
     assert not np.array_equal(r2["final"], r1["final"])
     plain.close()

@@ -385,8 +385,12 @@ PYBIND11_MODULE(vitrine, m) {
     m.doc() = "vitrine: load, edit and run render graphs; outputs as NumPy arrays; compare images (README \"Python\")";
     m.attr("__version__") = versionNumber();
     m.attr("commit") = versionCommit();
-    if (const char* level = std::getenv("VITRINE_LOG"); !level || std::string(level) != "info")
-        setLogLevel(LogLevel::Warning);
+    // VITRINE_LOG=debug|info|warning|error (default warning), or vitrine.set_log_level() later.
+    static const std::map<std::string, LogLevel> kLevels = {
+        {"debug", LogLevel::Debug}, {"info", LogLevel::Info}, {"warning", LogLevel::Warning}, {"error", LogLevel::Error}};
+    const char* envLevel = std::getenv("VITRINE_LOG");
+    auto envIt = envLevel ? kLevels.find(envLevel) : kLevels.end();
+    setLogLevel(envIt != kLevels.end() ? envIt->second : LogLevel::Warning);
 
     gError = PyErr_NewException("vitrine.Error", PyExc_Exception, nullptr);
     py::tuple userBases = py::make_tuple(py::handle(gError), py::handle(PyExc_ValueError));
@@ -523,6 +527,15 @@ PYBIND11_MODULE(vitrine, m) {
           py::arg("device") = std::shared_ptr<Device>(),
           "`vitrine compare A B [--reference R]`: A, B, R are graph or image paths or float32 arrays; returns the "
           "dict of metrics.json. out=DIR keeps the images, heat maps and report.html there.");
+    m.def(
+        "set_log_level",
+        [](const std::string& level) {
+            auto it = kLevels.find(level);
+            if (it == kLevels.end())
+                throw UserError("vitrine.set_log_level('" + level + "'): expected debug, info, warning or error");
+            setLogLevel(it->second);
+        },
+        py::arg("level"), "What vitrine writes to stderr: 'debug', 'info', 'warning' (the default) or 'error'.");
     m.def("read_exr", &readExr, py::arg("path"), "The layers of an EXR file as float32 (height, width, 4) arrays.");
 
     // The default device goes before the interpreter does (its executors before the Vulkan instance).
