@@ -14,12 +14,16 @@
 #include "core/shader/compiler.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <mutex>
 #include <cstring>
+#include <exception>
 #include <set>
+#include <thread>
 
 namespace vitrine {
 
@@ -531,12 +535,32 @@ void Executor::createPipelines(ShaderCompiler& shaders) {
             jobs.push_back({p, std::move(shader), pass.id + ":" + request.shader});
         }
     }
-    // One at a time. Creating them on every core was tried: it is suspected (not shown) of making an intermittent
-    // garbage-pixel failure of the Museum's SSR on lavapipe more frequent, so it stays serial until that is found.
-    for (PipelineJob& job : jobs) {
-        job.pipeline->pipeline = createComputePipeline(mCtx, job.shader, job.pipeline->layout);
+    // The pipelines themselves on every core: a driver that compiles at creation (lavapipe's LLVM, or a GPU driver
+    // without a cache hit) spends nearly all of the start there, and vkCreateComputePipelines may be called from
+    // several threads at once (the pipeline cache is internally synchronised). (It was serial for a while on the
+    // suspicion of raising the rate of the SSR garbage-pixel failure; that was a read of the colour pyramid's
+    // unwritten padding, which any change of the process's allocation pattern could expose; golden.poison.)
+    std::atomic<size_t> next{0};
+    std::exception_ptr failure;
+    std::mutex failureMutex;
+    auto work = [&] {
+        for (size_t i; (i = next.fetch_add(1)) < jobs.size();) {
+            try {
+                jobs[i].pipeline->pipeline = createComputePipeline(mCtx, jobs[i].shader, jobs[i].pipeline->layout);
+            } catch (...) {
+                std::lock_guard lock(failureMutex);
+                if (!failure) failure = std::current_exception();
+            }
+        }
+    };
+    const size_t threads = std::min<size_t>(jobs.size(), std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    for (const PipelineJob& job : jobs)
         mCtx.setName(reinterpret_cast<uint64_t>(job.pipeline->pipeline), VK_OBJECT_TYPE_PIPELINE, job.name);
-    }
     mPipelineMs = msSince(start);
 }
 
