@@ -201,8 +201,11 @@ void main() {
     float confidence = 0.0;
     for (int i = 0; i < rays; ++i) {
         // Shininess 1 is a mirror: GGX at the smallest alpha still has tails that throw a few percent of rays
-        // pixels off, so it reflects about the normal exactly.
-        vec3 h = roughness > 0.0 ? frame * sampleGgxVndf(vLocal, alpha, rngNext2(seed)) : n;
+        // pixels off, so it reflects about the normal exactly. The G-buffer's Toksvig filter stores a mirror's
+        // roughness as sqrt(kMinGgxAlpha), not 0 (toksvigRoughness() with an unfiltered normal), so a mirror is
+        // any alpha at the floor, with 5 % of slack for the 8-bit roughness channel's rounding.
+        bool mirror = alpha <= 1.05 * kMinGgxAlpha;
+        vec3 h = mirror ? n : frame * sampleGgxVndf(vLocal, alpha, rngNext2(seed));
         vec3 r = reflect(-v, h);
         if (dot(r, n) <= 0.0) continue; // below the surface: no light from there
         vec4 hit = traceRay(world, n, vec3(uv, z), r, coneTan);
