@@ -12,7 +12,8 @@ namespace {
 NodeSchema schema() {
     NodeSchema s;
     s.type = "post.tonemap";
-    s.doc = "Exposure (EV) then a tone curve: ACES fit for display, or an exactly invertible Reinhard curve.";
+    s.doc = "Exposure (EV) then a tone curve: ACES fit or Khronos PBR Neutral for display, or an exactly invertible "
+            "Reinhard curve.";
     s.inputs = {{"color", PortKind::Texture, {}, false, Usage::Sampled, "Linear HDR colour"},
                 {"camera_state", PortKind::Buffer, {}, true, Usage::Sampled,
                  "camera.physical's state: when connected, its exposure replaces the `exposure` param"}};
@@ -25,8 +26,11 @@ NodeSchema schema() {
     s.params = {
         {"exposure", ParamType::Float, 0.0, -24.0, 24.0, {},
          "Exposure in stops: colour is scaled by 2^exposure (ignored when camera_state is connected)"},
-        {"operator", ParamType::Enum, "aces_fit", {}, {}, {"linear", "reinhard", "reinhard_max", "aces_fit"},
-         "Tone curve; reinhard and reinhard_max are exactly invertible"},
+        {"operator", ParamType::Enum, "aces_fit", {}, {}, {"linear", "reinhard", "reinhard_max", "aces_fit", "pbr_neutral"},
+         "Tone curve; reinhard and reinhard_max are exactly invertible. pbr_neutral: Khronos PBR Neutral (the glTF "
+         "Sample Viewer's), which keeps base colours below 0.76 as they are (less the 0.04 of a dielectric's "
+         "reflection) and rolls brighter colours off towards white without shifting their hue; aces_fit: the "
+         "Narkowicz fit of ACES, which shifts saturated colours (orange to amber, blue to cyan)"},
         {"inverse", ParamType::Bool, false, {}, {}, {},
          "Undo the curve and the exposure (invertible operators only): the round trip TAA relies on"},
     };
@@ -37,8 +41,9 @@ class Tonemap final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         const auto& p = ctx.params();
-        if (p.getBool("inverse") && p.getString("operator") == "aces_fit")
-            ctx.failParam("inverse", "aces_fit is clamped and not invertible; use linear, reinhard or reinhard_max");
+        const std::string op = p.getString("operator");
+        if (p.getBool("inverse") && (op == "aces_fit" || op == "pbr_neutral"))
+            ctx.failParam("inverse", op + " is not invertible here; use linear, reinhard or reinhard_max");
         if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
         mPipeline = ctx.computePipeline("post/tonemap.comp");
     }

@@ -22,7 +22,16 @@ NodeSchema schema() {
                  "`--strict` on the command line"},
                 {"material_variant", ParamType::String, "", {}, {}, {},
                  "KHR_materials_variants: the variant (by name) whose materials the primitives get; empty: their "
-                 "default materials. A name the file does not define is an error listing its variants"}};
+                 "default materials. A name the file does not define is an error listing its variants"},
+                {"key_light", ParamType::Bool, false, {}, {}, {},
+                 "When the file has no directional light, give the scene a sun (the one shadowed light, whose "
+                 "direction the sky nodes given the scene and shadow.directional follow) from the camera side: key_light_elevation "
+                 "above the horizon, key_light_azimuth to the right of the direction back to the first frame's camera. "
+                 "Off: such a file's sun comes from the sky node's params"},
+                {"key_light_elevation", ParamType::Float, 35.0, 0.0, 90.0, {},
+                 "key_light: degrees above the horizon"},
+                {"key_light_azimuth", ParamType::Float, 30.0, -180.0, 180.0, {},
+                 "key_light: degrees to the right (seen from the camera) of the direction back to the camera"}};
     addSceneNodeSchema(s);
     return s;
 }
@@ -44,6 +53,9 @@ public:
             // The glTF error names its file and element; the graph's file and param say where the path came from.
             ctx.failParam("path", e.what());
         }
+        mKeyLight.on = ctx.params().getBool("key_light");
+        mKeyLight.elevation = ctx.params().getFloat("key_light_elevation");
+        mKeyLight.azimuth = ctx.params().getFloat("key_light_azimuth");
         publish(ctx, std::move(scene));
     }
 };

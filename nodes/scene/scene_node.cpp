@@ -131,6 +131,20 @@ void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> s
             }
     }
     mScene = std::make_shared<SceneObject>(std::move(scene));
+    if (mKeyLight.on && !mScene->scene().hasSun) {
+        // The sun goes where the camera of the first frame looks from, turned and raised by the key light's angles.
+        const scene::CameraState view = cameraAt(mStart);
+        const glm::vec3 forward = view.orientation * glm::vec3(0.0f, 0.0f, -1.0f);
+        glm::vec3 heading(forward.x, 0.0f, forward.z);
+        heading = glm::length(heading) > 1e-4f ? glm::normalize(heading) : glm::vec3(0.0f, 0.0f, -1.0f);
+        const glm::vec3 right = glm::cross(heading, glm::vec3(0.0f, 1.0f, 0.0f));
+        const float az = glm::radians(mKeyLight.azimuth), el = glm::radians(mKeyLight.elevation);
+        const glm::vec3 horizontal = -heading * std::cos(az) + right * std::sin(az);
+        auto lit = std::make_shared<scene::Scene>(mScene->scene());
+        lit->hasSun = true;
+        lit->sun.toSun = glm::normalize(horizontal * std::cos(el) + glm::vec3(0.0f, std::sin(el), 0.0f));
+        mScene = std::make_shared<SceneObject>(std::move(lit));
+    }
     mScene->anisotropy = p.getFloat("anisotropy");
     mCamera = std::make_shared<CameraObject>();
     mCamera->jitterPattern = mJitter;

@@ -22,6 +22,15 @@ protected:
     // Subclasses load or build the scene, then call this.
     void publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> scene);
 
+    // A key light from the camera side (scene.gltf's key_light): when `on` and the scene has no sun, publish() gives
+    // it one, `elevation` degrees above the horizon and `azimuth` degrees to the right of the direction back to the
+    // camera at the first frame (0: straight from behind the camera).
+    struct KeyLight {
+        bool on = false;
+        float elevation = 35.0f, azimuth = 30.0f;
+    };
+    KeyLight mKeyLight;
+
 private:
     scene::CameraState cameraAt(double t) const;
     // Thin-lens mode: this frame's aperture sample (metres, camera x right / y up) and the focus distance.

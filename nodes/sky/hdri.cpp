@@ -4,6 +4,7 @@
 #include "core/graph/node.hpp"
 #include "core/graph/registry.hpp"
 #include "core/image/io.hpp"
+#include "core/scene/gpu_scene.hpp"
 #include "core/shading/environment.hpp"
 #include "shaders/sky/sky.h"
 
@@ -34,11 +35,17 @@ NodeSchema schema() {
     sh.doc = "16x1: texels 0-8 SH9 radiance without the sun, 9 sun illuminance, 10 direction to the sun, 11 (sun "
              "mean radiance luminance, equivalent angular radius, 0, 0)";
     s.outputs = {cube, sh};
+    s.inputs = {{"scene", PortKind::Scene, {}, true, Usage::Sampled,
+                 "When connected and the scene has a sun (its directional light, or scene.gltf's key_light), that is "
+                 "the sun: its direction and colour, sun_illuminance lux (the image's own sun, if any, stays out of "
+                 "the SH and is not the light), so the light matches shadow.directional's"}};
     s.params = {
         {"path", ParamType::Path, "", {}, {}, {}, "Equirectangular .hdr or .exr, relative to the graph file"},
         {"intensity", ParamType::Float, 1.0, 0.0, 1e9, {}, "Multiplier taking the file's values to cd/m^2"},
         {"size", ParamType::Int, 64, 4.0, 2048.0, {}, "Cube map face size in texels"},
         {"sun_in_cubemap", ParamType::Bool, true, {}, {}, {}, "Keep the sun in the cube map (the SH never holds it)"},
+        {"sun_illuminance", ParamType::Float, 100000.0, 0.0, 1e7, {},
+         "With a scene sun (the scene input): its illuminance in lux on a surface facing it (x the sun's colour)"},
     };
     return s;
 }
@@ -80,6 +87,18 @@ public:
                                0.0721750 * bake.sun.illuminance.z) /
                               omega;
             set(SKY_TEXEL_SUN_INFO, {radiance, std::acos(1.0 - omega / (2.0 * 3.14159265358979323846)), 0.0}, 0.0);
+        }
+        if (ctx.hasInput("scene")) {
+            const scene::Scene& scene = ctx.objectAs<SceneObject>("scene")->scene();
+            if (scene.hasSun) {
+                const glm::dvec3 illuminance = glm::dvec3(scene.sun.color) * static_cast<double>(p.getFloat("sun_illuminance"));
+                const double radius = 0.5 * scene.sun.angularDiameter;
+                const double omega = 2.0 * 3.14159265358979323846 * (1.0 - std::cos(radius));
+                const double luminance = 0.2126729 * illuminance.x + 0.7151522 * illuminance.y + 0.0721750 * illuminance.z;
+                set(SKY_TEXEL_SUN_ILLUMINANCE, illuminance, 0.0);
+                set(SKY_TEXEL_SUN_DIRECTION, glm::normalize(glm::dvec3(scene.sun.toSun)), 0.0);
+                set(SKY_TEXEL_SUN_INFO, {luminance / omega, radius, 0.0}, 0.0);
+            }
         }
         ImageDesc& cube = ctx.output("cubemap");
         cube.width = cube.height = static_cast<uint32_t>(size);

@@ -20,4 +20,24 @@ vec3 tonemapAcesFit(vec3 x) {
     return clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0);
 }
 
+// Khronos PBR Neutral (KhronosGroup/ToneMapping, PBR_Neutral): colours whose largest channel stays below the
+// compression start pass unchanged but for a small offset that takes away the 0.04 dielectric reflection a lit
+// surface adds (a base colour rendered under unit white light comes out as itself); above it the largest channel is
+// rolled off towards 1 with the hue kept, and the colour is pulled towards white in proportion to the compression.
+const float kPbrNeutralStart = 0.8 - 0.04;     // compression starts here (after the offset)
+const float kPbrNeutralDesaturation = 0.15;    // how fast compressed colours go to white
+vec3 tonemapPbrNeutral(vec3 c) {
+    float low = min(c.r, min(c.g, c.b));
+    // The offset is 0.04 for lit surfaces, a quadratic toe (reaching 0 at black) below a channel of 0.08.
+    float offset = low < 0.08 ? low - 6.25 * low * low : 0.04;
+    c -= offset;
+    float peak = max3(c);
+    if (peak < kPbrNeutralStart) return c;
+    float room = 1.0 - kPbrNeutralStart;
+    float compressed = 1.0 - room * room / (peak + room - kPbrNeutralStart);
+    c *= compressed / peak;
+    float toWhite = 1.0 - 1.0 / (kPbrNeutralDesaturation * (peak - compressed) + 1.0);
+    return mix(c, vec3(compressed), toWhite);
+}
+
 #endif

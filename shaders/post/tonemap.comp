@@ -17,6 +17,7 @@ void main() {
         if (pc.op == TONEMAP_REINHARD) rgb = tonemapReinhard(rgb);
         else if (pc.op == TONEMAP_REINHARD_MAX) rgb = tonemapReinhardMax(rgb);
         else if (pc.op == TONEMAP_ACES_FIT) rgb = tonemapAcesFit(rgb);
+        else if (pc.op == TONEMAP_PBR_NEUTRAL) rgb = tonemapPbrNeutral(rgb);
     } else {
         if (pc.op == TONEMAP_REINHARD) rgb = tonemapReinhardInverse(rgb);
         else if (pc.op == TONEMAP_REINHARD_MAX) rgb = tonemapReinhardMaxInverse(rgb);

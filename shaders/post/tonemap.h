@@ -6,6 +6,7 @@
 #define TONEMAP_REINHARD 1
 #define TONEMAP_REINHARD_MAX 2
 #define TONEMAP_ACES_FIT 3
+#define TONEMAP_PBR_NEUTRAL 4
 
 #ifdef __cplusplus
 namespace vitrine::gpu_types {

@@ -5,6 +5,7 @@
 #include "core/base/error.hpp"
 #include "core/image/color.hpp"
 #include "core/image/io.hpp"
+#include "tests/gpu/cli.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -58,6 +59,112 @@ TEST_F(Nodes, TonemapMatchesCpuFormula) {
                 }
             }
         EXPECT_LT(worst, 1e-5) << op;
+    }
+}
+
+// Khronos PBR Neutral from the published formula (KhronosGroup/ToneMapping, PBR_Neutral), in double precision:
+// offset (toe below 0.08, else the 0.04 of a dielectric's reflection), then above the compression start 0.76 the
+// largest channel goes to 1 - (1 - start)^2 / (peak + 1 - 2 start) and the colour towards grey by
+// 1 - 1 / (0.15 (peak - newPeak) + 1).
+glm::dvec3 specPbrNeutral(glm::dvec3 c) {
+    const double start = 0.76, desaturation = 0.15;
+    const double low = std::min({c.r, c.g, c.b});
+    c -= low < 0.08 ? low - 6.25 * low * low : 0.04;
+    const double peak = std::max({c.r, c.g, c.b});
+    if (peak < start) return c;
+    const double newPeak = 1.0 - (1.0 - start) * (1.0 - start) / (peak + (1.0 - start) - start);
+    const double g = 1.0 - 1.0 / (desaturation * (peak - newPeak) + 1.0);
+    glm::dvec3 out;
+    for (int i = 0; i < 3; ++i) out[i] = (1.0 - g) * c[i] * (newPeak / peak) + g * newPeak;
+    return out;
+}
+
+// One pixel per colour of `colors` (a row), written as a float EXR and tone mapped by post.tonemap.
+Image tonemapColors(const std::vector<glm::dvec3>& colors, const std::string& op, double exposure, const std::string& name) {
+    const int w = static_cast<int>(colors.size());
+    Image img(w, 1);
+    for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < 3; ++c) img.at(x, 0)[c] = static_cast<float>(colors[x][c]);
+        img.at(x, 0)[3] = 1.0f;
+    }
+    const std::filesystem::path dir = freshDir(name);
+    writeExr(dir / "colors.exr", img, ExrPixelType::Float);
+    return runGraph(graph({{"img", {{"type", "image.load"}, {"params", {{"path", (dir / "colors.exr").string()}}}}},
+                           {"tm", {{"type", "post.tonemap"},
+                                   {"params", {{"operator", op}, {"exposure", exposure}}},
+                                   {"in", {{"color", "img.color"}}}}}},
+                          {{"out", "tm.color"}}, w, 1))
+        .at("out");
+}
+
+// HSV hue in degrees.
+double hueDegrees(glm::dvec3 c) {
+    const double hi = std::max({c.r, c.g, c.b}), lo = std::min({c.r, c.g, c.b}), d = hi - lo;
+    if (d <= 0.0) return 0.0;
+    double h = hi == c.r ? std::fmod((c.g - c.b) / d + 6.0, 6.0) : hi == c.g ? (c.b - c.r) / d + 2.0 : (c.r - c.g) / d + 4.0;
+    return 60.0 * h;
+}
+
+TEST_F(Nodes, PbrNeutralMatchesTheSpecFormulaOnAnHdrRamp) {
+    // Greys and hues from black to 64 in 1/8 stops, both sides of the toe (0.08), of the compression start (0.76)
+    // and far into the shoulder; exposure 0.5 EV so the scale is applied before the curve.
+    const std::vector<glm::dvec3> hues = {{1, 1, 1}, {1, 0.218, 0}, {0.05, 0.3, 1}, {0.2, 1, 0.4}, {1, 0.6, 0.9}, {1, 0.02, 0.3}};
+    std::vector<glm::dvec3> colors;
+    for (const glm::dvec3& hue : hues)
+        for (int step = -80; step <= 48; ++step) colors.push_back(hue * std::exp2(step / 8.0));
+    colors.push_back(glm::dvec3(0.0));
+    const double exposure = 0.5;
+    const Image out = tonemapColors(colors, "pbr_neutral", exposure, "pbr_neutral_ramp");
+    double worst = 0.0;
+    int below = 0, toe = 0, above = 0;
+    for (size_t i = 0; i < colors.size(); ++i) {
+        const glm::dvec3 in = colors[i] * std::exp2(exposure);
+        const glm::dvec3 expected = specPbrNeutral(in);
+        const double low = std::min({in.r, in.g, in.b}), peak = std::max({in.r, in.g, in.b});
+        if (low < 0.08) ++toe;
+        if (peak > 0.9) ++above;
+        else ++below;
+        for (int c = 0; c < 3; ++c) {
+            const float got = out.at(static_cast<int>(i), 0)[c];
+            worst = std::max(worst, std::fabs(expected[c] - got));
+            ASSERT_LE(got, 1.0f + 1e-6f) << "colour " << i;
+            ASSERT_GE(got, -1e-6f) << "colour " << i;
+        }
+    }
+    EXPECT_LT(worst, 1e-5);
+    EXPECT_GT(toe, 50);
+    EXPECT_GT(below, 100);
+    EXPECT_GT(above, 100);
+}
+
+TEST_F(Nodes, PbrNeutralKeepsBaseColoursAndHues) {
+    // The spec's promise: a base colour whose channels lie below the compression start comes out as itself at
+    // exposure 1 (scale 1), lit (base + the 0.04 of a dielectric's reflection, every channel then >= 0.08) or
+    // unlit (a channel at 0: no offset).
+    std::vector<glm::dvec3> bases;
+    for (double r : {0.04, 0.2, 0.5, 0.75})
+        for (double g : {0.04, 0.35, 0.7})
+            for (double b : {0.04, 0.1, 0.6}) bases.push_back({r, g, b});
+    std::vector<glm::dvec3> colors;
+    for (const glm::dvec3& b : bases) colors.push_back(b + 0.04);
+    for (const glm::dvec3& b : bases) colors.push_back({b.r, 0.0, b.b});
+    const Image out = tonemapColors(colors, "pbr_neutral", 0.0, "pbr_neutral_bases");
+    for (size_t i = 0; i < colors.size(); ++i) {
+        const glm::dvec3 want = i < bases.size() ? bases[i] : colors[i];
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(out.at(static_cast<int>(i), 0)[c], want[c], 1.0 / 255.0) << "colour " << i << " channel " << c;
+    }
+    // Above the compression start the hue stays: UnlitTest's orange (1, 0.218, 0) stays orange (hue 13 degrees)
+    // under PBR Neutral, where the ACES fit turns it amber (24 degrees) and a saturated blue cyan-ward.
+    const std::vector<glm::dvec3> unlit = {{1.0, 0.218, 0.0}, {0.0, 0.218, 1.0}};
+    const Image neutral = tonemapColors(unlit, "pbr_neutral", 0.0, "pbr_neutral_unlit");
+    const Image aces = tonemapColors(unlit, "aces_fit", 0.0, "aces_unlit");
+    for (int i = 0; i < 2; ++i) {
+        auto px = [&](const Image& img) { return glm::dvec3(img.at(i, 0)[0], img.at(i, 0)[1], img.at(i, 0)[2]); };
+        const double want = hueDegrees(unlit[i]);
+        EXPECT_NEAR(hueDegrees(px(neutral)), want, 1.0) << "colour " << i;
+        EXPECT_GT(std::fabs(hueDegrees(px(aces)) - want), 5.0) << "colour " << i << ": ACES was expected to shift it";
+        EXPECT_NEAR(px(neutral)[i == 0 ? 0 : 2], specPbrNeutral(unlit[i])[i == 0 ? 0 : 2], 1e-5);
     }
 }
 

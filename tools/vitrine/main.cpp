@@ -19,7 +19,8 @@ commands:
       OCIO display transform) and all outputs of a frame as one multi-layer EXR. --frames N is
       frame.frames (and frame.write = [N-1]) before validation; later --set frame.* override it.
       --scene FILE (run, bench, compare): the graph's scene node becomes scene.gltf of FILE, e.g.
-      `vitrine run graphs/gltf.json --scene model.glb` (output in out/model/). The glTF loader's warnings
+      `vitrine run graphs/gltf.json --scene model.glb` (output in out/model/; a scene.gltf
+      node's key_light params are kept). The glTF loader's warnings
       (what vitrine ignores: unsupported extensions in extensionsUsed, skins, ...) go to stderr once each;
       --strict (run, bench, compare, validate, export-scene): they are errors (exit 1); without --scene it sets the
       param strict of every scene.gltf node of the graph.

@@ -43,6 +43,11 @@ std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool 
         nlohmann::json node = {{"type", "scene.gltf"},
                                {"params", {{"path", std::filesystem::absolute(file).lexically_normal().string()}}}};
         if (args.has("strict")) node["params"]["strict"] = true;
+        // The graph's look stays: a scene.gltf node's key light (a choice of lighting, not of the file) is kept.
+        const nlohmann::json& old = doc["nodes"][ids[0]];
+        if (old["type"] == "scene.gltf" && old.contains("params") && old["params"].is_object())
+            for (const char* key : {"key_light", "key_light_elevation", "key_light_azimuth"})
+                if (old["params"].contains(key)) node["params"][key] = old["params"][key];
         sets.push_back(ids[0] + "=" + node.dump());
     } else if (args.has("strict") && !graph.empty()) {
         // --strict without --scene: every scene.gltf node of the graph loads strictly.

@@ -24,7 +24,8 @@ ContextOptions contextOptions(const Args& args);
 // `--frames 24 --set frame.write=[0,12,23]` names frames the file alone does not have. An explicit --set of frame.*
 // still wins. keepWrite: only frame.frames (`run --write-all` keeps the file's frame.write).
 // With `--scene FILE` (and `graph`, the graph file the sets are for), the graph's one scene node (type scene.*) is
-// first replaced by {"type": "scene.gltf", "params": {"path": FILE}} under the same id; UserError when the graph has
+// first replaced by {"type": "scene.gltf", "params": {"path": FILE}} under the same id (a scene.gltf node's key_light,
+// key_light_elevation and key_light_azimuth params are kept); UserError when the graph has
 // no scene node or several, or FILE does not exist.
 std::vector<std::string> setsWithFrames(const Args& args, uint32_t frames, bool keepWrite = false,
                                         const std::string& graph = {});
