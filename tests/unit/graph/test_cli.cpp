@@ -84,7 +84,7 @@ const BadGraph kBadGraphRows[] = {
     {"param_out_of_range.json", "", ": /nodes/checker/params/supersample: ", "got 64"},
     {"vec_param_wrong_length.json", "", ": /nodes/view/params/range: ", "expected an array of 2 numbers, got [0,1,2]"},
     {"enum_not_allowed.json", "",
-     ": /nodes/tonemap/params/operator: ", "\"reinhard\", \"reinhard_max\", \"aces_fit\", got \"filmic\""},
+     ": /nodes/tonemap/params/operator: ", "\"reinhard\", \"reinhard_max\", \"aces_fit\", \"pbr_neutral\", got \"filmic\""},
     {"setup_rejects_param.json", "", ": /nodes/tonemap/params/inverse: ", "not invertible"},
     {"unknown_input_port.json", "", ": /nodes/tonemap/in/colour: ", "has no input 'colour'; its inputs: color"},
     {"input_missing_node.json", "", ": /nodes/tonemap/in/color: ", "no node 'fxaa'"},
