@@ -106,6 +106,17 @@ struct SphereMaterial {
     glm::dvec3 centre;
 };
 
+// The sphere of `materials` (all of `radius`) that a ray from o along d meets first, or -1; t: the distance.
+int nearestSphere(glm::dvec3 o, glm::dvec3 d, const SphereMaterial (&materials)[3], double radius, double& t) {
+    int k = -1;
+    t = 1e30;
+    for (int i = 0; i < 3; ++i) {
+        double ti = hitSphere(o, d, materials[i].centre, radius);
+        if (ti > 0.0 && ti < t) t = ti, k = i;
+    }
+    return k;
+}
+
 // A uniform sky whose red is 4x its blue (an equirect .exr, no sun in it), around three spheres: a
 // mirror metal (indirect specular is the cube map alone, so its colour shows directly), a rough
 // dielectric with vertex AO 0.6 and cavity 0.4, and a black emitter. Under a uniform sky the cube map
@@ -174,12 +185,8 @@ TEST_F(LightingTerms, IndirectSpecularOcclusionAndEmissiveMatchCpuUnderColouredS
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             glm::dvec3 d = cam.ray(x, y);
-            int k = -1;
-            double t = 1e30;
-            for (int i = 0; i < 3; ++i) {
-                double ti = hitSphere(cam.position, d, materials[i].centre, radius);
-                if (ti > 0.0 && ti < t) t = ti, k = i;
-            }
+            double t;
+            const int k = nearestSphere(cam.position, d, materials, radius, t);
             if (k < 0) {
                 // The sky seen behind the spheres is the cube map itself.
                 double e = relErr(rgb(out.at("full"), x, y), skyColor);
@@ -280,12 +287,8 @@ TEST_F(LightingTerms, SkyFallbackBlursTowardsItsShWithRoughness) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             glm::dvec3 d = cam.ray(x, y);
-            int k = -1;
-            double t = 1e30;
-            for (int i = 0; i < 3; ++i) {
-                double ti = hitSphere(cam.position, d, materials[i].centre, radius);
-                if (ti > 0.0 && ti < t) t = ti, k = i;
-            }
+            double t;
+            const int k = nearestSphere(cam.position, d, materials, radius, t);
             if (k < 0) continue;
             const SphereMaterial& m = materials[k];
             glm::dvec3 n = glm::normalize(cam.position + t * d - m.centre), v = -d;
