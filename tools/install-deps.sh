@@ -80,3 +80,19 @@ if [ -f "$validator/package-lock.json" ]; then
         echo "$want" > "$stamp"
     fi
 fi
+
+# The Khronos glTF Sample Viewer's engine for ctest gltf.sample_viewer (tests/viewer/): npm @khronosgroup/gltf-viewer
+# exactly as tools/gltf-viewer/package-lock.json pins it, installed the same way, only when the lockfile changed. It runs
+# in the chromium installed above (driven by editor/node_modules/playwright-core); it downloads nothing itself.
+viewer="$(dirname "$0")/gltf-viewer"
+if [ -f "$viewer/package-lock.json" ]; then
+    want="$(sha256sum < "$viewer/package-lock.json" | cut -d' ' -f1) node $(node --version)"
+    stamp="$viewer/node_modules/.vitrine-install-stamp"
+    if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
+        echo "install-deps: tools/gltf-viewer/node_modules is current"
+    else
+        echo "install-deps: npm ci in tools/gltf-viewer/ (from package-lock.json)"
+        (cd "$viewer" && npm ci --no-audit --no-fund)
+        echo "$want" > "$stamp"
+    fi
+fi

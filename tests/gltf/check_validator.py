@@ -2,10 +2,10 @@
 """ctest gltf.validator: every glTF file vitrine writes passes the Khronos glTF-Validator with no cap on messages.
 
 Exports `vitrine export-scene museum` (64-texel textures: the JSON is the same at any size), the showcase model and the
-round trip (load, export) of every file in tests/data/gltf/corpus/ and of quad.gltf and layered.gltf, then runs
-tools/gltf-validator/validate.mjs (npm gltf-validator, pinned by its package-lock.json, installed by
-tools/install-deps.sh) on them and on the corpus files themselves with maxIssues 0. Fails on any error or warning, and
-when the validator is not installed (never skipped). Infos are printed and counted, not failed: the lightmap UVs
+round trip (load, export) of every file in tests/data/gltf/corpus/ and tests/data/gltf/viewer/ and of quad.gltf and
+layered.gltf, then runs tools/gltf-validator/validate.mjs (npm gltf-validator, pinned by its package-lock.json,
+installed by tools/install-deps.sh) on them and on those test files themselves with maxIssues 0. Fails on any error or
+warning, and when the validator is not installed (never skipped). Infos are printed and counted, not failed: the lightmap UVs
 (TEXCOORD_1) and the textures that only VITRINE_material_layers samples are used by vitrine, which the validator
 cannot know.
 Usage: check_validator.py VITRINE SOURCE_DIR OUT_DIR
@@ -28,6 +28,11 @@ def main():
     corpus = sorted(glob.glob(os.path.join(src, "tests", "data", "gltf", "corpus", "*.gltf")))
     if not corpus:
         sys.exit("gltf.validator: no files in tests/data/gltf/corpus/")
+    # ctest gltf.sample_viewer's files (tests/viewer/make_scenes.py), validated and round-tripped as the corpus is.
+    viewer_files = sorted(glob.glob(os.path.join(src, "tests", "data", "gltf", "viewer", "*.gltf")))
+    if not viewer_files:
+        sys.exit("gltf.validator: no files in tests/data/gltf/viewer/")
+    corpus += viewer_files
     sources = [("museum", "museum"), (os.path.join(src, "data", "models", "showcase.gltf"), "showcase")]
     sources += [(os.path.join(src, "tests", "data", "gltf", n + ".gltf"), n) for n in ("quad", "layered")]
     sources += [(f, "corpus_" + os.path.splitext(os.path.basename(f))[0]) for f in corpus]

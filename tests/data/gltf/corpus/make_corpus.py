@@ -421,4 +421,5 @@ def main():
     ignored_material_extensions_file()
 
 
-main()
+if __name__ == "__main__":
+    main()
