@@ -5,9 +5,9 @@ Exports `vitrine export-scene museum` (64-texel textures: the JSON is the same a
 round trip (load, export) of every file in tests/data/gltf/corpus/ and tests/data/gltf/viewer/ and of quad.gltf and
 layered.gltf, then runs tools/gltf-validator/validate.mjs (npm gltf-validator, pinned by its package-lock.json,
 installed by tools/install-deps.sh) on them and on those test files themselves with maxIssues 0. Fails on any error or
-warning, and when the validator is not installed (never skipped). Infos are printed and counted, not failed: the lightmap UVs
-(TEXCOORD_1) and the textures that only VITRINE_material_layers samples are used by vitrine, which the validator
-cannot know.
+warning, and when the validator is not installed (never skipped). Infos are printed and counted, not failed: the
+lightmap UVs (TEXCOORD_1) and the textures that only VITRINE_material_layers samples are used by vitrine, which the
+validator cannot know.
 Usage: check_validator.py VITRINE SOURCE_DIR OUT_DIR
 """
 import glob

@@ -5,8 +5,8 @@ The files are tests/data/gltf/viewer/*.gltf (written by tests/viewer/make_scenes
 KHR_lights_punctual directional light of 100 klux in the direction of graphs/gltf.json's key light, so both renderers
 use the file's camera and the file's light (vitrine takes a file's directional light as its sun in place of the key
 light). vitrine renders them with graphs/gltf.json as shipped (`run --scene FILE`, 256x256). The Sample Viewer
-(npm @khronosgroup/gltf-viewer, pinned by tools/gltf-viewer/package-lock.json, installed by tools/install-deps.sh) renders
-them in Debian's headless Chromium on SwiftShader (tests/viewer/render.mjs, page.html, page.mjs) with the same
+(npm @khronosgroup/gltf-viewer, pinned by tools/gltf-viewer/package-lock.json, installed by tools/install-deps.sh)
+renders them in Debian's headless Chromium on SwiftShader (tests/viewer/render.mjs, page.html, page.mjs) with the same
 settings, as its API takes them:
   - environment: data/env/studio.hdr itself (the engine prefilters it), iblIntensity 10000 / 2^15: sky.hdri's
     intensity (10,000 cd/m^2 per unit) times the graph's exposure of -15 EV; environmentRotation 270 (the viewer's
@@ -198,7 +198,8 @@ def main():
     for name in CASES:
         viewer = os.path.join(out, "viewer", name + ".png")
         gamma22_to_srgb(os.path.join(out, "viewer", name + ".raw.png"), viewer)
-        m = compare(vitrine, os.path.join(out, "vitrine", name, "final.png"), viewer, os.path.join(out, "compare", name))
+        m = compare(vitrine, os.path.join(out, "vitrine", name, "final.png"), viewer,
+                    os.path.join(out, "compare", name))
         raw = compare(vitrine, os.path.join(out, "vitrine", name, "final.png"),
                       os.path.join(out, "viewer", name + ".raw.png"), os.path.join(out, "compare", name + "_raw"))
         v = violations(m)
@@ -217,7 +218,8 @@ def main():
     if sheet:
         contact_sheet(out, sheet)
         print(f"wrote {sheet}")
-    print(f"gltf.sample_viewer: vitrine {t1 - t0:.1f} s, Sample Viewer {t2 - t1:.1f} s, compare {time.time() - t2:.1f} s")
+    print(f"gltf.sample_viewer: vitrine {t1 - t0:.1f} s, Sample Viewer {t2 - t1:.1f} s, "
+          f"compare {time.time() - t2:.1f} s")
     if bad:
         fail("outside the thresholds: " + ", ".join(bad))
     print(f"gltf.sample_viewer: {len(CASES)} files within the thresholds, {len(mutants)} deliberate mismatches caught")

@@ -17,8 +17,8 @@ Files:
                      roughness 0.6: texture decoding, sRGB and UV orientation (a swapped channel or a flipped V shows).
   unlit.gltf         an orange KHR_materials_unlit quad (left) and a black quad with emissiveFactor (0.2, 0.5, 1.0)
                      (right): display-referred colours that must reach the PNG as authored.
-Regenerate after editing: python3 tests/viewer/make_scenes.py [OUT_DIR] (ctest data.viewer_scenes writes them to the build
-tree and compares them byte for byte with the committed ones).
+Regenerate after editing: python3 tests/viewer/make_scenes.py [OUT_DIR] (ctest data.viewer_scenes writes them to the
+build tree and compares them byte for byte with the committed ones).
 """
 import math
 import os

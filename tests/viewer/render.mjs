@@ -26,7 +26,8 @@ if (!fs.existsSync(path.join(dist, 'gltf-viewer.module.js')))
     problems.push(`${dist}/gltf-viewer.module.js is missing (run tools/install-deps.sh: npm ci in tools/gltf-viewer/)`);
 if (!fs.existsSync(path.join(source, 'editor', 'node_modules', 'playwright-core')))
     problems.push('editor/node_modules/playwright-core is missing (run tools/install-deps.sh: npm ci in editor/)');
-if (!fs.existsSync(chromium)) problems.push(`no Chromium at ${chromium} (tools/install-deps.sh installs Debian's chromium)`);
+if (!fs.existsSync(chromium))
+    problems.push(`no Chromium at ${chromium} (tools/install-deps.sh installs Debian's chromium)`);
 if (problems.length) {
     console.error('render.mjs: ' + problems.join('\n  '));
     process.exit(1);
@@ -89,7 +90,8 @@ function viewerModule() {
     let text = fs.readFileSync(path.join(dist, 'gltf-viewer.module.js'), 'utf8');
     for (const [from, to] of iblSizes) {
         const n = text.split(from).length - 1;
-        if (n !== 1) throw new Error(`gltf-viewer.module.js: expected '${from}' once, found it ${n} times (another version?)`);
+        if (n !== 1)
+            throw new Error(`gltf-viewer.module.js: expected '${from}' once, found it ${n} times (another version?)`);
         text = text.replace(from, to);
     }
     return text;
@@ -100,8 +102,10 @@ const types = { '.html': 'text/html', '.mjs': 'text/javascript', '.js': 'text/ja
 
 const require = createRequire(path.join(source, 'editor', 'package.json'));
 const { chromium: launcher } = require('playwright-core');
-const flags = (process.env.VITRINE_VIEWER_CHROMIUM_FLAGS ||
-               '--use-gl=angle --use-angle=swiftshader --enable-unsafe-swiftshader --ignore-gpu-blocklist').split(/\s+/);
+// WebGL 2 on SwiftShader through ANGLE (Chromium's software GL; --enable-unsafe-swiftshader: newer Chromium only falls
+// back to it when asked). VITRINE_VIEWER_CHROMIUM_FLAGS replaces these flags.
+const defaultFlags = '--use-gl=angle --use-angle=swiftshader --enable-unsafe-swiftshader --ignore-gpu-blocklist';
+const flags = (process.env.VITRINE_VIEWER_CHROMIUM_FLAGS || defaultFlags).split(/\s+/);
 const browser = await launcher.launch({
     executablePath: chromium,
     headless: true,
@@ -118,7 +122,8 @@ await page.route('**/*', async route => {
     if (url.origin !== origin) return route.abort('blockedbyclient');
     if (url.pathname === '/viewer/gltf-viewer.module.js')
         return route.fulfill({ status: 200, contentType: 'text/javascript', body: moduleText });
-    if (url.pathname === '/lut_sheen_E.png') return route.fulfill({ status: 200, contentType: 'image/png', body: whitePng() });
+    if (url.pathname === '/lut_sheen_E.png')
+        return route.fulfill({ status: 200, contentType: 'image/png', body: whitePng() });
     const file = files.get(decodeURIComponent(url.pathname));
     if (!file) {
         pageLog.push(`render.mjs: 404 ${url.pathname}`);
@@ -141,7 +146,8 @@ try {
     // clamped and a global rescale).
     const floats = await page.evaluate(() => {
         const gl = document.createElement('canvas').getContext('webgl2');
-        return ['EXT_color_buffer_float', 'OES_texture_float_linear'].map(e => `${e} ${gl.getExtension(e) ? 'yes' : 'no'}`);
+        return ['EXT_color_buffer_float', 'OES_texture_float_linear']
+            .map(e => `${e} ${gl.getExtension(e) ? 'yes' : 'no'}`);
     });
     console.log(`render.mjs: WebGL 2 renderer: ${renderer}; ${floats.join(', ')}`);
     for (const [i, c] of jobs.cases.entries()) {
@@ -151,7 +157,7 @@ try {
             exposure: c.exposure, iblIntensity: c.iblIntensity, lightScale: c.lightScale,
             environmentRotation: c.environmentRotation });
         const viewerLog = await page.evaluate(() => window.viewerLog());
-        const errors = viewerLog.filter(l => l.startsWith('error') || l.startsWith('uncaught') || l.startsWith('unhandled'));
+        const errors = viewerLog.filter(l => /^(error|uncaught|unhandled)/.test(l));
         if (errors.length) throw new Error(`${c.gltf}: the viewer reported errors:\n  ${errors.join('\n  ')}`);
         fs.writeFileSync(c.out, Buffer.from(url.slice(url.indexOf(',') + 1), 'base64'));
         console.log(`render.mjs: ${path.basename(c.gltf)} -> ${c.out} (${Date.now() - t0} ms)`);
