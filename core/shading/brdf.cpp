@@ -26,10 +26,26 @@ float smithGgxVisibility(float NoV, float NoL, float alpha) {
     return 0.5f / std::max(lambdaV + lambdaL, 1e-12f);
 }
 
-glm::vec3 schlickFresnel(glm::vec3 f0, float VoH) {
+glm::vec3 schlickFresnelF90(glm::vec3 f0, float f90, float VoH) {
     float m = 1.0f - std::clamp(VoH, 0.0f, 1.0f);
     float m5 = m * m * m * m * m;
-    return f0 + (glm::vec3(1.0f) - f0) * m5;
+    return f0 + (glm::vec3(f90) - f0) * m5;
+}
+
+glm::vec3 schlickFresnel(glm::vec3 f0, float VoH) {
+    return schlickFresnelF90(f0, 1.0f, VoH);
+}
+
+glm::vec4 dielectricSpecular(float f0Ior, glm::vec4 specular) {
+    return glm::vec4(specular.a * glm::min(f0Ior * glm::vec3(specular), glm::vec3(1.0f)), specular.a);
+}
+
+glm::vec3 specularF0With(glm::vec3 baseColor, float metallic, glm::vec4 dielectric) {
+    return glm::mix(glm::vec3(dielectric), baseColor, metallic);
+}
+
+float specularF90(float metallic, glm::vec4 dielectric) {
+    return dielectric.a + (1.0f - dielectric.a) * metallic;
 }
 
 glm::vec3 specularF0(glm::vec3 baseColor, float metallic) {
@@ -40,15 +56,26 @@ glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic) {
     return baseColor * (1.0f - metallic);
 }
 
-glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness) {
+glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float f90,
+                          float roughness) {
     float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
     if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
     glm::vec3 h = glm::normalize(v + l);
     float NoH = std::clamp(glm::dot(n, h), 0.0f, 1.0f);
     float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
     float alpha = ggxAlpha(roughness);
-    glm::vec3 spec = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+    glm::vec3 spec = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
     return (diffuseColor * lambertDiffuse() + spec) * NoL;
+}
+
+glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness) {
+    return brdfCosineF0F90(n, v, l, diffuseColor, f0, 1.0f, roughness);
+}
+
+glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                             float roughness, glm::vec4 dielectric) {
+    return brdfCosineF0F90(n, v, l, diffuseAlbedo(baseColor, metallic), specularF0With(baseColor, metallic, dielectric),
+                           specularF90(metallic, dielectric), roughness);
 }
 
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {
@@ -58,6 +85,11 @@ glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor,
 glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,
                            glm::vec3 intensity) {
     return brdfCosine(n, v, l, baseColor, metallic, roughness) * (kPi * intensity);
+}
+
+glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                                   float roughness, glm::vec4 dielectric, glm::vec3 intensity) {
+    return brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric) * (kPi * intensity);
 }
 
 float toksvigRoughness(float roughness, float normalLength) {
