@@ -26,22 +26,26 @@ float smithGgxVisibility(float NoV, float NoL, float alpha) {
     return 0.5f / std::max(lambdaV + lambdaL, 1e-12f);
 }
 
+glm::vec3 schlickFresnel(glm::vec3 f0, float VoH) {
+    float m = 1.0f - std::clamp(VoH, 0.0f, 1.0f);
+    float m5 = m * m * m * m * m;
+    return f0 + (glm::vec3(1.0f) - f0) * m5;
+}
+
+// As brdf.glsl: the plain value minus (1 - f90) Fc, an exact 0 at f90 = 1.
 glm::vec3 schlickFresnelF90(glm::vec3 f0, float f90, float VoH) {
     float m = 1.0f - std::clamp(VoH, 0.0f, 1.0f);
     float m5 = m * m * m * m * m;
-    return f0 + (glm::vec3(f90) - f0) * m5;
-}
-
-glm::vec3 schlickFresnel(glm::vec3 f0, float VoH) {
-    return schlickFresnelF90(f0, 1.0f, VoH);
+    return schlickFresnel(f0, VoH) - (1.0f - f90) * m5;
 }
 
 glm::vec4 dielectricSpecular(float f0Ior, glm::vec4 specular) {
     return glm::vec4(specular.a * glm::min(f0Ior * glm::vec3(specular), glm::vec3(1.0f)), specular.a);
 }
 
-glm::vec3 specularF0With(glm::vec3 baseColor, float metallic, glm::vec4 dielectric) {
-    return glm::mix(glm::vec3(dielectric), baseColor, metallic);
+glm::vec3 specularF0With(glm::vec3 baseColor, float metallic, float f0Ior, glm::vec4 dielectric) {
+    return glm::mix(glm::vec3(f0Ior), baseColor, metallic) -
+           (1.0f - metallic) * (glm::vec3(f0Ior) - glm::vec3(dielectric));
 }
 
 float specularF90(float metallic, glm::vec4 dielectric) {
@@ -69,13 +73,21 @@ glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffu
 }
 
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness) {
-    return brdfCosineF0F90(n, v, l, diffuseColor, f0, 1.0f, roughness);
+    float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
+    glm::vec3 h = glm::normalize(v + l);
+    float NoH = std::clamp(glm::dot(n, h), 0.0f, 1.0f);
+    float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+    float alpha = ggxAlpha(roughness);
+    glm::vec3 spec = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+    return (diffuseColor * lambertDiffuse() + spec) * NoL;
 }
 
 glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
                              float roughness, glm::vec4 dielectric) {
-    return brdfCosineF0F90(n, v, l, diffuseAlbedo(baseColor, metallic), specularF0With(baseColor, metallic, dielectric),
-                           specularF90(metallic, dielectric), roughness);
+    return brdfCosineF0F90(n, v, l, diffuseAlbedo(baseColor, metallic),
+                           specularF0With(baseColor, metallic, 0.04f, dielectric), specularF90(metallic, dielectric),
+                           roughness);
 }
 
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {

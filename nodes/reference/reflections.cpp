@@ -57,7 +57,7 @@ protected:
         const glm::vec3 v = -d, n = s.normal, ng = s.geometricNormal;
         const float NoV = glm::dot(n, v);
         if (NoV <= 0.0f || s.cavity <= 0.0f) return glm::vec3(0.0f);
-        const glm::vec3 f0 = specularF0With(s.baseColor, s.metallic, s.dielectric);
+        const glm::vec3 f0 = specularF0With(s.baseColor, s.metallic, 0.04f, s.dielectric);
         const float f90 = specularF90(s.metallic, s.dielectric);
         const float alpha = ggxAlpha(s.roughness);
         const glm::mat3 frame = cpu_sampling::basisAround(n);

@@ -130,8 +130,8 @@ BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, glm::vec4 d
     b.baseColor = baseColor;
     b.metallic = metallic;
     b.roughness = roughness;
-    float s = luminance(
-        schlickFresnelF90(specularF0With(baseColor, metallic, dielectric), specularF90(metallic, dielectric), NoV));
+    vec3 f0 = specularF0With(baseColor, metallic, 0.04f, dielectric);
+    float s = luminance(schlickFresnelF90(f0, specularF90(metallic, dielectric), NoV));
     float d = luminance(diffuseAlbedo(baseColor, metallic));
     b.specularProbability = std::max(s / std::max(s + d, 1e-6f), 0.1f);
     return b;

@@ -65,7 +65,7 @@ void main() {
     // KHR_materials_specular (F90 too).
     float transmission = m.optics.x * (1.0 - metallic);
     vec4 dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, vUv0, vUv1, grads));
-    vec3 f0 = specularF0With(baseColor, metallic, dielectric);
+    vec3 f0 = specularF0With(baseColor, metallic, m.optics.y, dielectric);
     float f90 = specularF90(metallic, dielectric);
     vec3 diffuseColor = baseColor * (1.0 - metallic) * (1.0 - transmission);
 

@@ -90,7 +90,7 @@ void main() {
     float occlusion = baked ? vertexAo * cavity : u.params.x * vertexAo * cavity;
     vec3 diffuse = vec3(0.0);
     if (!lightmapped) diffuse = skyDiffuse(baked ? volume : sh, n, diffuseAlbedo(baseColor, metallic)) * occlusion;
-    vec3 f0 = specularF0With(baseColor, metallic, dielectric);
+    vec3 f0 = specularF0With(baseColor, metallic, 0.04, dielectric);
     float f90 = specularF90(metallic, dielectric);
     vec3 specular = (baked ? volumeSpecularF90(volume, n, v, f0, f90, roughness)
                            : skySpecularF90(in_sky, sh, n, v, f0, f90, roughness)) *

@@ -84,8 +84,8 @@ BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, vec4 dielec
     b.baseColor = baseColor;
     b.metallic = metallic;
     b.roughness = roughness;
-    float s = luminance(
-        schlickFresnelF90(specularF0With(baseColor, metallic, dielectric), specularF90(metallic, dielectric), NoV));
+    vec3 f0 = specularF0With(baseColor, metallic, 0.04, dielectric);
+    float s = luminance(schlickFresnelF90(f0, specularF90(metallic, dielectric), NoV));
     float d = luminance(diffuseAlbedo(baseColor, metallic));
     b.specularProbability = max(s / max(s + d, 1e-6), 0.1); // 1 for metals: no diffuse lobe
     return b;
