@@ -30,6 +30,7 @@ inline constexpr const char* kMeshQuantization = "KHR_mesh_quantization";
 inline constexpr const char* kUnlit = "KHR_materials_unlit";
 inline constexpr const char* kTransmission = "KHR_materials_transmission";
 inline constexpr const char* kIor = "KHR_materials_ior";
+inline constexpr const char* kSpecular = "KHR_materials_specular";
 inline constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 inline constexpr const char* kVariants = "KHR_materials_variants";
 
@@ -42,9 +43,6 @@ struct IgnoredMaterialExtension {
 inline constexpr IgnoredMaterialExtension kIgnoredMaterialExtensions[] = {
     {"KHR_materials_clearcoat", "the clear coat layer (clearcoatFactor, clearcoatRoughnessFactor and their textures)"},
     {"KHR_materials_sheen", "the sheen lobe (sheenColorFactor, sheenRoughnessFactor and their textures)"},
-    {"KHR_materials_specular",
-     "the specular strength and tint (specularFactor, specularColorFactor and their textures; the dielectric "
-     "reflectance stays the ior's, untinted)"},
     {"KHR_materials_iridescence", "the thin-film iridescence (iridescenceFactor, its ior, thickness and textures)"},
     {"KHR_materials_volume",
      "the volume (thicknessFactor, attenuationColor, attenuationDistance; transmission stays thin-walled)"},

@@ -360,6 +360,14 @@ Json Exporter::material(const Material& m) const {
     if (m.unlit) j["extensions"][gltf::kUnlit] = Json::object();
     if (m.transmission != 0.0f) j["extensions"][gltf::kTransmission] = {{"transmissionFactor", m.transmission}};
     if (m.ior != 1.5f) j["extensions"][gltf::kIor] = {{"ior", m.ior}};
+    if (m.hasSpecular()) {
+        Json sp = {{"specularFactor", m.specular}, {"specularColorFactor", vec(m.specularColor)}};
+        if (m.specularTexture.valid())
+            sp["specularTexture"] = writeTextureInfo(m.specularTexture, m.specularTexture.texture);
+        if (m.specularColorTexture.valid())
+            sp["specularColorTexture"] = writeTextureInfo(m.specularColorTexture, m.specularColorTexture.texture);
+        j["extensions"][gltf::kSpecular] = sp;
+    }
 
     if (m.layers.size() == 1 && base == core) return j; // the core material says it all
 
@@ -630,8 +638,9 @@ std::vector<uint8_t> Exporter::run() {
     if (transforms) used.push_back(gltf::kTextureTransform);
     if (strength) used.push_back(gltf::kEmissiveStrength);
     if (mScene.hasSun || !mScene.lights.empty()) used.push_back(gltf::kLightsPunctual);
-    bool unlit = false, transmission = false, ior = false;
+    bool unlit = false, transmission = false, ior = false, specular = false;
     for (const Material& m : mScene.materials) {
+        specular = specular || m.hasSpecular();
         unlit = unlit || m.unlit;
         transmission = transmission || m.transmission != 0.0f;
         ior = ior || m.ior != 1.5f;
@@ -639,6 +648,7 @@ std::vector<uint8_t> Exporter::run() {
     if (unlit) used.push_back(gltf::kUnlit);
     if (transmission) used.push_back(gltf::kTransmission);
     if (ior) used.push_back(gltf::kIor);
+    if (specular) used.push_back(gltf::kSpecular);
     if (!mScene.probes.empty()) used.push_back(kProbesExtension);
     if (!used.empty()) mDoc["extensionsUsed"] = used; // glTF forbids an empty list
     while (mBin.size() % 4)

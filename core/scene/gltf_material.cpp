@@ -290,6 +290,21 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
             if (!(out.ior == 0.0f || (out.ior >= 1.0f && out.ior <= 10.0f)))
                 ctx.fail(ie + ".ior", "expected 0 or a number in [1, 10]");
         }
+        if (const Json* sp = object(ctx, *extensions, kSpecular, e + ".extensions")) {
+            std::string se = e + ".extensions." + kSpecular;
+            out.specular = static_cast<float>(number(ctx, *sp, "specularFactor", 1.0, se));
+            if (!(out.specular >= 0.0f && out.specular <= 1.0f))
+                ctx.fail(se + ".specularFactor", "expected a number in [0, 1]");
+            out.specularColor = glm::vec3(numbers(ctx, *sp, "specularColorFactor", 3, glm::vec4(1.0f), se));
+            for (int c = 0; c < 3; ++c) {
+                if (!(out.specularColor[c] >= 0.0f))
+                    ctx.fail(se + ".specularColorFactor[" + std::to_string(c) + "]", "expected a number >= 0");
+            }
+            if (const Json* t = member(*sp, "specularTexture"))
+                out.specularTexture = readTextureInfo(ctx, *t, TextureUsage::Data, se + ".specularTexture");
+            if (const Json* t = member(*sp, "specularColorTexture"))
+                out.specularColorTexture = readTextureInfo(ctx, *t, TextureUsage::Color, se + ".specularColorTexture");
+        }
     }
     std::string mode = string(ctx, m, "alphaMode", "OPAQUE", e);
     if (mode == "OPAQUE")

@@ -237,6 +237,8 @@ void dropSpecGlossSources(LoadContext& ctx) {
                     f(*r);
             }
             f(m.emissiveTexture);
+            f(m.specularTexture);
+            f(m.specularColorTexture);
         }
     };
     std::vector<bool> used(scene.textures.size(), false);

@@ -121,6 +121,9 @@ void packMaterials(const scene::Scene& scene, std::vector<GpuMaterial>& material
         g.emissiveRef = texRef(m.emissiveTexture);
         float r = m.ior == 0.0f ? 1.0f : (m.ior - 1.0f) / (m.ior + 1.0f); // KHR_materials_ior: 0 means F0 = 1
         g.optics = {m.transmission, r * r, m.unlit ? 1.0f : 0.0f, 0.0f};
+        g.specular = glm::vec4(m.specularColor, m.specular);
+        g.specularRef = texRef(m.specularTexture, 3);
+        g.specularColorRef = texRef(m.specularColorTexture);
         materials.push_back(g);
         for (size_t li = 0; li < m.layers.size(); ++li) {
             const scene::MaterialLayer& l = m.layers[li];

@@ -159,6 +159,19 @@ struct Material {
     // base that lets light through, drawn by forward.transparent as thin glass (tinted by the base colour).
     float transmission = 0.0f;
     float ior = 1.5f; // KHR_materials_ior: the dielectric reflectance at normal incidence is ((ior − 1)/(ior + 1))²
+    // KHR_materials_specular: the dielectric's specular strength k = specular × specularTexture.a and colour
+    // c = specularColor × specularColorTexture.rgb scale its Fresnel: F0 = k · min(F0(ior) · c, 1), F90 = k
+    // (common/brdf.glsl dielectricSpecular). Metals keep F0 = base colour, F90 = 1.
+    float specular = 1.0f;
+    TextureRef specularTexture;      // data, alpha channel
+    glm::vec3 specularColor{1.0f};   // linear, ≥ 0
+    TextureRef specularColorTexture; // sRGB
+
+    // True when KHR_materials_specular changes anything (the defaults leave the dielectric as it was).
+    bool hasSpecular() const {
+        return specular != 1.0f || specularColor != glm::vec3(1.0f) || specularTexture.valid() ||
+               specularColorTexture.valid();
+    }
 
     // Drawn by the transparent pass (alpha blending or transmission), not into the G-buffer.
     bool transparent() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }

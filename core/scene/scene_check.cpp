@@ -56,6 +56,12 @@ void hashMaterial(Hasher& h, const Material& m) {
         h.value(m.transmission);
         h.value(m.ior);
     }
+    if (m.hasSpecular()) {
+        h.value(m.specular);
+        hashRef(h, m.specularTexture);
+        h.value(m.specularColor);
+        hashRef(h, m.specularColorTexture);
+    }
 }
 
 void hashCamera(Hasher& h, const Camera& c) {
@@ -78,7 +84,7 @@ bool usesUvSet(const Material& m, uint32_t uvSet) {
             return true;
         }
     }
-    return uses(m.emissiveTexture);
+    return uses(m.emissiveTexture) || uses(m.specularTexture) || uses(m.specularColorTexture);
 }
 
 bool usesNormalMap(const Material& m) {
@@ -307,6 +313,8 @@ void Scene::validate() const {
             if ((layer.overrides & ~uint32_t(kLayerAll)) != 0) c.fail(le + ".overrides", "unknown bits");
         }
         c.ref(e + ".emissiveTexture", m.emissiveTexture, TextureUsage::Color);
+        c.ref(e + ".specularTexture", m.specularTexture, TextureUsage::Data, 3);
+        c.ref(e + ".specularColorTexture", m.specularColorTexture, TextureUsage::Color);
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
         const Node& n = nodes[i];

@@ -32,12 +32,44 @@ glm::vec3 schlickFresnel(glm::vec3 f0, float VoH) {
     return f0 + (glm::vec3(1.0f) - f0) * m5;
 }
 
+// As brdf.glsl: the plain value minus (1 - f90) Fc, an exact 0 at f90 = 1.
+glm::vec3 schlickFresnelF90(glm::vec3 f0, float f90, float VoH) {
+    float m = 1.0f - std::clamp(VoH, 0.0f, 1.0f);
+    float m5 = m * m * m * m * m;
+    return schlickFresnel(f0, VoH) - (1.0f - f90) * m5;
+}
+
+glm::vec4 dielectricSpecular(float f0Ior, glm::vec4 specular) {
+    return glm::vec4(specular.a * glm::min(f0Ior * glm::vec3(specular), glm::vec3(1.0f)), specular.a);
+}
+
+glm::vec3 specularF0With(glm::vec3 baseColor, float metallic, float f0Ior, glm::vec4 dielectric) {
+    return glm::mix(glm::vec3(f0Ior), baseColor, metallic) -
+           (1.0f - metallic) * (glm::vec3(f0Ior) - glm::vec3(dielectric));
+}
+
+float specularF90(float metallic, glm::vec4 dielectric) {
+    return dielectric.a + (1.0f - dielectric.a) * metallic;
+}
+
 glm::vec3 specularF0(glm::vec3 baseColor, float metallic) {
     return glm::mix(glm::vec3(0.04f), baseColor, metallic);
 }
 
 glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic) {
     return baseColor * (1.0f - metallic);
+}
+
+glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float f90,
+                          float roughness) {
+    float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
+    glm::vec3 h = glm::normalize(v + l);
+    float NoH = std::clamp(glm::dot(n, h), 0.0f, 1.0f);
+    float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+    float alpha = ggxAlpha(roughness);
+    glm::vec3 spec = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
+    return (diffuseColor * lambertDiffuse() + spec) * NoL;
 }
 
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness) {
@@ -51,6 +83,13 @@ glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseC
     return (diffuseColor * lambertDiffuse() + spec) * NoL;
 }
 
+glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                             float roughness, glm::vec4 dielectric) {
+    return brdfCosineF0F90(n, v, l, diffuseAlbedo(baseColor, metallic),
+                           specularF0With(baseColor, metallic, 0.04f, dielectric), specularF90(metallic, dielectric),
+                           roughness);
+}
+
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {
     return brdfCosineF0(n, v, l, diffuseAlbedo(baseColor, metallic), specularF0(baseColor, metallic), roughness);
 }
@@ -58,6 +97,11 @@ glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor,
 glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,
                            glm::vec3 intensity) {
     return brdfCosine(n, v, l, baseColor, metallic, roughness) * (kPi * intensity);
+}
+
+glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                                   float roughness, glm::vec4 dielectric, glm::vec3 intensity) {
+    return brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric) * (kPi * intensity);
 }
 
 float toksvigRoughness(float roughness, float normalLength) {

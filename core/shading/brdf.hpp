@@ -14,11 +14,23 @@ float ggxAlpha(float roughness);
 float ggxD(float NoH, float alpha);
 float smithGgxVisibility(float NoV, float NoL, float alpha);
 glm::vec3 schlickFresnel(glm::vec3 f0, float VoH);
+glm::vec3 schlickFresnelF90(glm::vec3 f0, float f90, float VoH);
 inline float lambertDiffuse() {
     return 1.0f / kPi;
 }
 glm::vec3 specularF0(glm::vec3 baseColor, float metallic);
 glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic);
+// KHR_materials_specular (shaders/common/brdf.glsl): the dielectric's Fresnel (F0 rgb, F90 a) from f0Ior and the
+// extension's colour (rgb) and strength (a), and its blend with the metal's.
+glm::vec4 dielectricSpecular(float f0Ior, glm::vec4 specular);
+glm::vec3 specularF0With(glm::vec3 baseColor, float metallic, float f0Ior, glm::vec4 dielectric);
+float specularF90(float metallic, glm::vec4 dielectric);
+glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float f90,
+                          float roughness);
+glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                             float roughness, glm::vec4 dielectric);
+glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                                   float roughness, glm::vec4 dielectric, glm::vec3 intensity);
 // brdfCosine with the diffuse colour and F0 given apart (shaders/common/brdf.glsl).
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness);
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness);

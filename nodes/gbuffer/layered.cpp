@@ -41,7 +41,7 @@ NodeSchema schema() {
     s.outputs = {
         attachment("normal", VK_FORMAT_R16G16B16A16_SFLOAT, "x, y: octahedral world normal; z: linear view depth (m); w: shininess"),
         attachment("base_color", VK_FORMAT_R8G8B8A8_UNORM, "rgb: base colour (linear); a: metallic"),
-        attachment("material", VK_FORMAT_R8G8B8A8_UNORM, "x: base colour alpha; y: clothness (reserved, 0); z: vertex AO; w: cavity"),
+        attachment("material", VK_FORMAT_R8G8B8A8_UNORM, "x: base colour alpha; y: 1 − KHR_materials_specular strength (0 without it); z: vertex AO; w: cavity"),
         attachment("velocity", VK_FORMAT_R16G16_SFLOAT, "Screen motion in pixels, this frame minus last (camera and object, no jitter)"),
         attachment("emissive", VK_FORMAT_R16G16B16A16_SFLOAT,
                    "rgb: emissive radiance plus, where lightmapped, the baked diffuse (linear, cd/m²); a: 1 where "

@@ -57,7 +57,8 @@ protected:
         const glm::vec3 v = -d, n = s.normal, ng = s.geometricNormal;
         const float NoV = glm::dot(n, v);
         if (NoV <= 0.0f || s.cavity <= 0.0f) return glm::vec3(0.0f);
-        const glm::vec3 f0 = specularF0(s.baseColor, s.metallic);
+        const glm::vec3 f0 = specularF0With(s.baseColor, s.metallic, 0.04f, s.dielectric);
+        const float f90 = specularF90(s.metallic, s.dielectric);
         const float alpha = ggxAlpha(s.roughness);
         const glm::mat3 frame = cpu_sampling::basisAround(n);
         const glm::vec3 h = frame * cpu_sampling::sampleGgxVndf(glm::transpose(frame) * v, alpha, CpuRays::next2(rng));
@@ -66,7 +67,7 @@ protected:
         if (glm::dot(n, l) <= 0.0f || glm::dot(ng, l) <= 0.0f) return glm::vec3(0.0f);
         const float pdf = cpu_sampling::ggxVndfPdf(NoV, glm::clamp(glm::dot(n, h), 0.0f, 1.0f), alpha);
         if (!(pdf > 0.0f)) return glm::vec3(0.0f);
-        const glm::vec3 weight = brdfCosineF0(n, v, l, glm::vec3(0.0f), f0, s.roughness) / pdf;
+        const glm::vec3 weight = brdfCosineF0F90(n, v, l, glm::vec3(0.0f), f0, f90, s.roughness) / pdf;
         return s.cavity * weight * rays.radiance(CpuRays::offset(s.position, ng, l), l, rng);
     }
 };

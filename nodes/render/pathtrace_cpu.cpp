@@ -125,12 +125,13 @@ struct BrdfLobes {
     float specularProbability;
 };
 
-BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, float NoV) {
+BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, glm::vec4 dielectric, float NoV) {
     BrdfLobes b;
     b.baseColor = baseColor;
     b.metallic = metallic;
     b.roughness = roughness;
-    float s = luminance(schlickFresnel(specularF0(baseColor, metallic), NoV));
+    vec3 f0 = specularF0With(baseColor, metallic, 0.04f, dielectric);
+    float s = luminance(schlickFresnelF90(f0, specularF90(metallic, dielectric), NoV));
     float d = luminance(diffuseAlbedo(baseColor, metallic));
     b.specularProbability = std::max(s / std::max(s + d, 1e-6f), 0.1f);
     return b;
@@ -323,6 +324,17 @@ struct Materials {
         return sample(r.info.x, refUv(r, uv0, uv1));
     }
     static float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }
+
+    // scene.glsl materialSpecular: KHR_materials_specular's colour (rgb) and strength (a).
+    vec4 materialSpecular(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
+        vec4 s = m.specular;
+        if (m.specularRef.info.x >= 0) s.a *= sampleRef(m.specularRef, uv0, uv1).a;
+        if (m.specularColorRef.info.x >= 0) {
+            vec3 c = vec3(s) * vec3(sampleRef(m.specularColorRef, uv0, uv1));
+            s = vec4(c, s.a);
+        }
+        return s;
+    }
 
     struct LayeredSurface {
         vec4 albedo{1.0f};
@@ -557,6 +569,7 @@ struct CpuPathTracer::Impl {
         s.metallic = std::clamp(l.metallic, 0.0f, 1.0f);
         s.roughness = roughnessFromShininess(std::clamp(l.shininess, 0.0f, 1.0f));
         s.cavity = std::clamp(l.cavity, 0.0f, 1.0f);
+        s.dielectric = dielectricSpecular(0.04f, materials.materialSpecular(m, uv0, uv1));
         s.emissive = vec3(m.emissive);
         if (m.emissiveRef.info.x >= 0) s.emissive *= vec3(materials.sampleRef(m.emissiveRef, uv0, uv1));
         if (m.optics.z > 0.5f) {
@@ -603,11 +616,12 @@ struct CpuPathTracer::Impl {
             if (bounce >= st.maxBounces) break;
 
             vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
-            BrdfLobes lobes = brdfLobes(s.baseColor, s.metallic, s.roughness, std::clamp(glm::dot(n, v), 0.0f, 1.0f));
+            BrdfLobes lobes =
+                brdfLobes(s.baseColor, s.metallic, s.roughness, s.dielectric, std::clamp(glm::dot(n, v), 0.0f, 1.0f));
             vec3 weight = throughput * s.cavity;
 
             if (sun && glm::dot(ng, sunDir) > 0.0f) {
-                vec3 f = brdfCosine(n, v, sunDir, s.baseColor, s.metallic, s.roughness);
+                vec3 f = brdfCosineSpecular(n, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric);
                 if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, sunDir), sunDir, rays))
                     radiance += weight * f * sunE;
             }
@@ -617,7 +631,7 @@ struct CpuPathTracer::Impl {
                 vec3 l = env.sample(vec3(a, bc));
                 float pdf = env.pdf(l);
                 if (glm::dot(ng, l) > 0.0f && pdf > 0.0f) {
-                    vec3 f = brdfCosine(n, v, l, s.baseColor, s.metallic, s.roughness);
+                    vec3 f = brdfCosineSpecular(n, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric);
                     if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, l), l, rays))
                         radiance += weight * f * env.radiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
                 }
@@ -629,7 +643,7 @@ struct CpuPathTracer::Impl {
             if (!sampleBrdf(lobes, n, v, vec3(a, bc), l) || glm::dot(ng, l) <= 0.0f) break;
             float pdf = brdfPdf(lobes, n, v, l);
             if (pdf <= 0.0f) break;
-            throughput = weight * brdfCosine(n, v, l, s.baseColor, s.metallic, s.roughness) / pdf;
+            throughput = weight * brdfCosineSpecular(n, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric) / pdf;
             brdfPdfPrev = pdf;
             if (bounce >= 2u) {
                 float q = std::min(std::max(std::max(throughput.r, throughput.g), throughput.b), 0.95f);

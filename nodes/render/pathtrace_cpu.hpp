@@ -61,6 +61,9 @@ struct CpuSurface {
     float metallic = 0.0f, roughness = 1.0f, cavity = 1.0f;
     glm::vec3 emissive{0.0f};
     float t = 0.0f; // distance along the ray
+    // The dielectric's Fresnel F0 (rgb) and F90 (a), KHR_materials_specular over F0 0.04 (core/shading
+    // dielectricSpecular).
+    glm::vec4 dielectric{0.04f, 0.04f, 0.04f, 1.0f};
 };
 
 class CpuPathTracer;

@@ -22,7 +22,7 @@ NodeSchema schema() {
         tex("reflection", "ssr.hiz's reflection (or its temporal accumulation): rgb radiance, a confidence"),
         tex("normal", "G-buffer: octahedral normal, view depth, shininess"),
         tex("base_color", "G-buffer: base colour, metallic"),
-        tex("material", "G-buffer: alpha, clothness, vertex AO, cavity"),
+        tex("material", "G-buffer: alpha, 1 − specular strength, vertex AO, cavity"),
         tex("depth", "Hardware depth, reverse Z"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
     };

@@ -47,15 +47,43 @@ vec3 schlickFresnel(vec3 f0, float VoH) {
     return f0 + (1.0 - f0) * (m2 * m2 * m);
 }
 
+// The *F90 functions below (KHR_materials_specular) are written as the plain function minus (1 - f90) x its part
+// that f90 scales: f0 + (f90 - f0) Fc = [f0 + (1 - f0) Fc] - (1 - f90) Fc. At f90 = 1 the correction is an exact 0,
+// so a material without the extension gets the plain function's value to the bit, however the device fuses
+// multiply-adds (the museum goldens hold the default path to that).
+vec3 schlickFresnelF90(vec3 f0, float f90, float VoH) {
+    float m = 1.0 - clamp(VoH, 0.0, 1.0);
+    float m2 = m * m;
+    return schlickFresnel(f0, VoH) - (1.0 - f90) * (m2 * m2 * m);
+}
+
 float lambertDiffuse() { return 1.0 / kPi; }
 
 // Metallic workflow: dielectrics reflect 4 % at normal incidence, metals their base colour.
 vec3 specularF0(vec3 baseColor, float metallic) { return mix(vec3(0.04), baseColor, metallic); }
 vec3 diffuseAlbedo(vec3 baseColor, float metallic) { return baseColor * (1.0 - metallic); }
 
+// KHR_materials_specular: a dielectric's Fresnel F0 and F90 (rgb, a) from its reflectance at normal incidence
+// f0Ior (((ior - 1)/(ior + 1))^2, or the fixed 0.04 of specularF0) and the extension's colour c and strength k
+// (`specular` rgb, a): F0 = k min(f0Ior c, 1), F90 = k, i.e. the Khronos dielectric_brdf's
+// specular_weight x fresnel. Without the extension (c = 1, k = 1) it is (f0Ior, 1): Schlick as before.
+vec4 dielectricSpecular(float f0Ior, vec4 specular) {
+    return vec4(specular.a * min(f0Ior * specular.rgb, vec3(1.0)), specular.a);
+}
+// The metallic blend of it: F0 = mix(dielectric F0, base colour, metallic) (metals reflect their base colour),
+// written as mix(f0Ior, ...) minus the dielectric's departure from f0Ior (0 without the extension: see above).
+vec3 specularF0With(vec3 baseColor, float metallic, float f0Ior, vec4 dielectric) {
+    return mix(vec3(f0Ior), baseColor, metallic) - (1.0 - metallic) * (vec3(f0Ior) - dielectric.rgb);
+}
+// F90 = k + (1 - k) metallic: exactly 1 without the extension.
+float specularF90(float metallic, vec4 dielectric) { return dielectric.a + (1.0 - dielectric.a) * metallic; }
+
 // Specular lobe f_s(l, v) = D V F, without the cosine.
 vec3 ggxSpecular(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0) {
     return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+}
+vec3 ggxSpecularF90(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0, float f90) {
+    return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
 }
 
 // The full BRDF times the cosine, f(l, v) NoL, for unit vectors n (surface), v (to the eye),
@@ -73,14 +101,39 @@ vec3 brdfCosineF0(vec3 n, vec3 v, vec3 l, vec3 diffuseColor, vec3 f0, float roug
     return (diffuseColor * lambertDiffuse() + spec) * NoL;
 }
 
+// With Fresnel towards f90 (KHR_materials_specular; f90 = 1 gives brdfCosineF0's value). The diffuse lobe is not
+// weighted by 1 - F: vitrine's model adds the two lobes (MUSEUM_SPEC §1), with or without the extension.
+vec3 brdfCosineF0F90(vec3 n, vec3 v, vec3 l, vec3 diffuseColor, vec3 f0, float f90, float roughness) {
+    float NoL = dot(n, l);
+    float NoV = dot(n, v);
+    if (NoL <= 0.0 || NoV <= 0.0) return vec3(0.0);
+    vec3 h = normalize(v + l);
+    float NoH = clamp(dot(n, h), 0.0, 1.0);
+    float VoH = clamp(dot(v, h), 0.0, 1.0);
+    vec3 spec = ggxSpecularF90(NoV, NoL, NoH, VoH, ggxAlpha(roughness), f0, f90);
+    return (diffuseColor * lambertDiffuse() + spec) * NoL;
+}
+
 vec3 brdfCosine(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness) {
     return brdfCosineF0(n, v, l, diffuseAlbedo(baseColor, metallic), specularF0(baseColor, metallic), roughness);
+}
+
+// brdfCosine of a surface whose dielectric Fresnel is `dielectric` (dielectricSpecular over the F0 0.04 of
+// specularF0: F0 rgb, F90 a).
+vec3 brdfCosineSpecular(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness, vec4 dielectric) {
+    return brdfCosineF0F90(n, v, l, diffuseAlbedo(baseColor, metallic),
+                           specularF0With(baseColor, metallic, 0.04, dielectric), specularF90(metallic, dielectric),
+                           roughness);
 }
 
 // Outgoing radiance (cd/m^2) from one directional light of intensity I = E / pi (see the top
 // of this file): brdfCosine * pi * I.
 vec3 shadeDirectional(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness, vec3 intensity) {
     return brdfCosine(n, v, l, baseColor, metallic, roughness) * (kPi * intensity);
+}
+vec3 shadeDirectionalSpecular(vec3 n, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness, vec4 dielectric,
+                              vec3 intensity) {
+    return brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric) * (kPi * intensity);
 }
 
 // Toksvig [Toksvig04]: a normal averaged over a footprint (mip-mapped without renormalising)

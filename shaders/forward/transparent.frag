@@ -61,9 +61,12 @@ void main() {
     vec3 emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) emissive *= sampleRef(m.emissiveRef, vUv0, vUv1, grads).rgb;
 
-    // KHR_materials_transmission takes the dielectric's diffuse; F0 from KHR_materials_ior.
+    // KHR_materials_transmission takes the dielectric's diffuse; F0 from KHR_materials_ior, scaled and tinted by
+    // KHR_materials_specular (F90 too).
     float transmission = m.optics.x * (1.0 - metallic);
-    vec3 f0 = mix(vec3(m.optics.y), baseColor, metallic);
+    vec4 dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, vUv0, vUv1, grads));
+    vec3 f0 = specularF0With(baseColor, metallic, m.optics.y, dielectric);
+    float f90 = specularF90(metallic, dielectric);
     vec3 diffuseColor = baseColor * (1.0 - metallic) * (1.0 - transmission);
 
     vec3 sh[9];
@@ -72,21 +75,22 @@ void main() {
     vec3 l = normalize(texelFetch(in_sky_sh, ivec2(10, 0), 0).xyz);
 
     float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, N, vViewDepth) : 1.0;
-    vec3 direct = brdfCosineF0(N, v, l, diffuseColor, f0, roughness) * sunE * visibility * cavity;
-    direct += shadePunctual(world, N, v, diffuseColor, f0, roughness) * cavity;
+    vec3 direct = brdfCosineF0F90(N, v, l, diffuseColor, f0, f90, roughness) * sunE * visibility * cavity;
+    direct += shadePunctual(world, N, v, diffuseColor, f0, f90, roughness) * cavity;
     // The same indirect terms as lighting.deferred: bake.lightmap's irradiance volume where it is connected
     // (transparent surfaces have no lightmap), else the sky scaled by sky_ambient.
     vec3 volume[9];
     bool baked = volumeSh(in_volume, u.volumeOrigin, u.volumeCounts.xyz, world, N, volume);
     float occlusion = baked ? vColor.a * cavity : u.params.x * vColor.a * cavity;
     vec3 diffuse = skyDiffuse(baked ? volume : sh, N, diffuseColor) * occlusion;
-    vec3 specular = (baked ? volumeSpecular(volume, N, v, f0, roughness) : skySpecular(in_sky, sh, N, v, f0, roughness)) *
+    vec3 specular = (baked ? volumeSpecularF90(volume, N, v, f0, f90, roughness)
+                           : skySpecularF90(in_sky, sh, N, v, f0, f90, roughness)) *
                     occlusion;
     vec3 lit = direct + diffuse + specular + emissive * u.params.w;
 
     // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour
     // (no refraction offset, no blur by roughness).
-    vec3 through = transmission * (vec3(1.0) - schlickFresnel(f0, dot(N, v))) * baseColor;
+    vec3 through = transmission * (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * baseColor;
     if (m.optics.z > 0.5) { // KHR_materials_unlit: the colour is the radiance, as through the G-buffer's emissive
         lit = baseColor * u.params.w;
         through = vec3(0.0);

@@ -18,7 +18,7 @@ layout(location = 7) in float vViewDepth;
 
 layout(location = 0) out vec4 outNormal;   // octahedral normal xy, linear view depth, shininess
 layout(location = 1) out vec4 outBase;     // base colour rgb, metallic
-layout(location = 2) out vec4 outMaterial; // base colour alpha, clothness (reserved), vertex AO, cavity
+layout(location = 2) out vec4 outMaterial; // base colour alpha, 1 - specular strength, vertex AO, cavity
 layout(location = 3) out vec2 outVelocity; // pixels, current minus previous position
 layout(location = 4) out vec4 outEmissive; // rgb: emissive + baked diffuse radiance; a: 1 where lightmapped
 
@@ -75,7 +75,10 @@ void main() {
 
     outNormal = vec4(octEncode(N), vViewDepth, shininess);
     outBase = vec4(baseColor, metallic);
-    outMaterial = vec4(coverage, 0.0, vColor.a, cavity);
+    // KHR_materials_specular's strength k (1 without it) as 1 - k in the spare 8-bit channel, so that 0 stays the
+    // default; its colour has no room here and is left to the forward pass and the path tracers.
+    float specular = clamp(materialSpecular(m, vUv0, vUv1, grads).a, 0.0, 1.0);
+    outMaterial = vec4(coverage, 1.0 - specular, vColor.a, cavity);
     outVelocity = velocity;
     applyUnlit(m, outBase, outMaterial, emissive);
     outEmissive = vec4(emissive, lightmapped);

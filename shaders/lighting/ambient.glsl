@@ -23,11 +23,23 @@ vec3 environmentBrdf(vec3 f0, float roughness, float NoV) {
     return f0 * ab.x + ab.y;
 }
 
+// With Fresnel towards f90 (KHR_materials_specular): the split sum's B term scales with f90, f0 A + f90 B, written
+// as f0 A + B - (1 - f90) B (B = environmentBrdf of f0 = 0) so that f90 = 1 is environmentBrdf to the bit.
+vec3 environmentBrdfF90(vec3 f0, float f90, float roughness, float NoV) {
+    return environmentBrdf(f0, roughness, NoV) - (1.0 - f90) * environmentBrdf(vec3(0.0), roughness, NoV);
+}
+
 vec3 skySpecular(samplerCube sky, vec3 sh[9], vec3 n, vec3 v, vec3 f0, float roughness) {
     float NoV = clamp(dot(n, v), 1e-4, 1.0);
     vec3 r = reflect(-v, n);
     vec3 skyR = mix(textureLod(sky, r, 0.0).rgb, max(shRadiance(sh, r), vec3(0.0)), clamp(roughness * 2.0, 0.0, 1.0));
     return environmentBrdf(f0, roughness, NoV) * min(skyR, vec3(kHalfMax));
+}
+vec3 skySpecularF90(samplerCube sky, vec3 sh[9], vec3 n, vec3 v, vec3 f0, float f90, float roughness) {
+    float NoV = clamp(dot(n, v), 1e-4, 1.0);
+    vec3 r = reflect(-v, n);
+    vec3 skyR = mix(textureLod(sky, r, 0.0).rgb, max(shRadiance(sh, r), vec3(0.0)), clamp(roughness * 2.0, 0.0, 1.0));
+    return environmentBrdfF90(f0, f90, roughness, NoV) * min(skyR, vec3(kHalfMax));
 }
 
 // The same with an SH environment (bake.lightmap's irradiance volume): its low-frequency radiance along the
@@ -36,6 +48,11 @@ vec3 volumeSpecular(vec3 volume[9], vec3 n, vec3 v, vec3 f0, float roughness) {
     float NoV = clamp(dot(n, v), 1e-4, 1.0);
     vec3 r = reflect(-v, n);
     return environmentBrdf(f0, roughness, NoV) * min(max(shRadiance(volume, r), vec3(0.0)), vec3(kHalfMax));
+}
+vec3 volumeSpecularF90(vec3 volume[9], vec3 n, vec3 v, vec3 f0, float f90, float roughness) {
+    float NoV = clamp(dot(n, v), 1e-4, 1.0);
+    vec3 r = reflect(-v, n);
+    return environmentBrdfF90(f0, f90, roughness, NoV) * min(max(shRadiance(volume, r), vec3(0.0)), vec3(kHalfMax));
 }
 
 #endif

@@ -70,6 +70,8 @@ void main() {
     float metallic = g1.a;
     float vertexAo = g2.z;
     float cavity = g2.w;
+    // KHR_materials_specular's strength k (G-buffer material.y = 1 - k): the dielectric's F0 0.04 k, F90 k.
+    vec4 dielectric = dielectricSpecular(0.04, vec4(vec3(1.0), 1.0 - g2.y));
 
     vec3 sh[9];
     for (int i = 0; i < 9; ++i) sh[i] = texelFetch(in_sky_sh, ivec2(i, 0), 0).rgb;
@@ -78,7 +80,8 @@ void main() {
 
     // Sun: E / pi is the light's intensity in the pi convention of brdf.glsl.
     float visibility = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, n, viewDepth) : 1.0;
-    vec3 direct = shadeDirectional(n, v, l, baseColor, metallic, roughness, sunE / kPi) * visibility * cavity;
+    vec3 direct =
+        shadeDirectionalSpecular(n, v, l, baseColor, metallic, roughness, dielectric, sunE / kPi) * visibility * cavity;
 
     // Indirect light: baked (lightmap in the emissive channel, or the irradiance volume), else the sky's SH
     // irradiance and the sky along the mirror direction, scaled by the stand-in occlusion.
@@ -87,8 +90,10 @@ void main() {
     float occlusion = baked ? vertexAo * cavity : u.params.x * vertexAo * cavity;
     vec3 diffuse = vec3(0.0);
     if (!lightmapped) diffuse = skyDiffuse(baked ? volume : sh, n, diffuseAlbedo(baseColor, metallic)) * occlusion;
-    vec3 f0 = specularF0(baseColor, metallic);
-    vec3 specular = (baked ? volumeSpecular(volume, n, v, f0, roughness) : skySpecular(in_sky, sh, n, v, f0, roughness)) *
+    vec3 f0 = specularF0With(baseColor, metallic, 0.04, dielectric);
+    float f90 = specularF90(metallic, dielectric);
+    vec3 specular = (baked ? volumeSpecularF90(volume, n, v, f0, f90, roughness)
+                           : skySpecularF90(in_sky, sh, n, v, f0, f90, roughness)) *
                     occlusion;
     // ibl.localized (when connected) replaces the stand-ins: its probes carry the room's own light and occlusion,
     // so only the material's vertex AO and cavity darken it.
@@ -96,7 +101,7 @@ void main() {
     if (!lightmapped && !baked && (u.volumeCounts.w & 2u) != 0u)
         diffuse = texelFetch(in_ibl_diffuse, p, 0).rgb * vertexAo * cavity;
     // KHR_lights_punctual point and spot lights (unshadowed), with the cavity as the sun has it.
-    direct += shadePunctual(world, n, v, diffuseAlbedo(baseColor, metallic), f0, roughness) * cavity;
+    direct += shadePunctual(world, n, v, diffuseAlbedo(baseColor, metallic), f0, f90, roughness) * cavity;
 
     // Screen-space AO on the indirect terms only (MUSEUM_SPEC §5), tinted by the base colour like a little GI; a
     // lightmapped pixel's emissive channel is its baked diffuse (and any emission with it).

@@ -25,12 +25,13 @@ vec3 punctualIlluminance(PunctualLightGpu L, vec3 p, out vec3 toLight) {
 
 // Radiance (cd/m²) at p from every light: brdfCosine × E, the π convention of brdf.glsl (intensity E / π).
 // VITRINE_LIGHTS names the shader's PunctualLights (a uniform member; not copied into an argument).
-vec3 shadePunctual(vec3 p, vec3 n, vec3 v, vec3 diffuseColor, vec3 f0, float roughness) {
+// f90: Schlick's reflectance at grazing incidence (1 but where KHR_materials_specular lowers it).
+vec3 shadePunctual(vec3 p, vec3 n, vec3 v, vec3 diffuseColor, vec3 f0, float f90, float roughness) {
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < VITRINE_LIGHTS.count.x; ++i) {
         vec3 l;
         vec3 e = punctualIlluminance(VITRINE_LIGHTS.lights[i], p, l);
-        sum += brdfCosineF0(n, v, l, diffuseColor, f0, roughness) * e;
+        sum += brdfCosineF0F90(n, v, l, diffuseColor, f0, f90, roughness) * e;
     }
     return sum;
 }

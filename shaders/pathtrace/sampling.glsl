@@ -77,12 +77,15 @@ struct BrdfLobes {
     float specularProbability;
 };
 
-BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, float NoV) {
+// dielectric: the surface's dielectric Fresnel (dielectricSpecular; (0.04, 0.04, 0.04, 1) without
+// KHR_materials_specular).
+BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, vec4 dielectric, float NoV) {
     BrdfLobes b;
     b.baseColor = baseColor;
     b.metallic = metallic;
     b.roughness = roughness;
-    float s = luminance(schlickFresnel(specularF0(baseColor, metallic), NoV));
+    vec3 f0 = specularF0With(baseColor, metallic, 0.04, dielectric);
+    float s = luminance(schlickFresnelF90(f0, specularF90(metallic, dielectric), NoV));
     float d = luminance(diffuseAlbedo(baseColor, metallic));
     b.specularProbability = max(s / max(s + d, 1e-6), 0.1); // 1 for metals: no diffuse lobe
     return b;

@@ -27,7 +27,8 @@ struct PathSurface {
     float metallic;
     float roughness;
     float cavity;
-    vec3 emissive; // cd/m^2, before the node's emissive scale
+    vec3 emissive;   // cd/m^2, before the node's emissive scale
+    vec4 dielectric; // the dielectric's Fresnel F0 (rgb) and F90 (a): common/brdf.glsl dielectricSpecular
 };
 
 vec3 vertexVec3(uint v, uint offset) {
@@ -108,6 +109,9 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.metallic = clamp(l.metallic, 0.0, 1.0);
     s.roughness = roughnessFromShininess(clamp(l.shininess, 0.0, 1.0));
     s.cavity = clamp(l.cavity, 0.0, 1.0);
+    // KHR_materials_specular over the fixed dielectric F0 of specularF0 (the tracer, like the G-buffer path, does
+    // not read KHR_materials_ior).
+    s.dielectric = dielectricSpecular(0.04, materialSpecular(m, uv0, uv1, lod0));
     s.emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) s.emissive *= sampleRef(m.emissiveRef, uv0, uv1, lod0).rgb;
     // KHR_materials_unlit, as gbuffer/unlit.glsl: the colour is emitted and nothing is reflected (cavity 0).

@@ -123,6 +123,15 @@ vec4 sampleRef(GpuTexRef r, vec2 uv0, vec2 uv1, UvGradients g) {
 
 float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }
 
+// KHR_materials_specular at a surface point: rgb the specular colour, a the strength (1, 1 without the
+// extension); common/brdf.glsl dielectricSpecular turns them into the dielectric's F0 and F90.
+vec4 materialSpecular(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
+    vec4 s = m.specular;
+    if (m.specularRef.info.x >= 0) s.a *= sampleRef(m.specularRef, uv0, uv1, g).a;
+    if (m.specularColorRef.info.x >= 0) s.rgb *= sampleRef(m.specularColorRef, uv0, uv1, g).rgb;
+    return s;
+}
+
 // The five blended parameters of a surface point. `normal` is tangent space and NOT normalised: its
 // length is below 1 where a mip averaged disagreeing normals (Toksvig).
 struct LayeredSurface {

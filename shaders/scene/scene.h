@@ -52,6 +52,11 @@ struct GpuMaterial {
     vec4 emissive; // rgb: factor x strength (linear), a: alpha cutoff
     GpuTexRef emissiveRef;
     vec4 optics;   // x: transmission, y: dielectric F0 from the IOR, z: unlit (1/0), w: 0
+    // KHR_materials_specular (1, 1, 1, 1 without it): rgb: specularColorFactor (linear), a: specularFactor; the
+    // textures multiply them (specularRef's alpha, specularColorRef's sRGB colour). scene.glsl materialSpecular.
+    vec4 specular;
+    GpuTexRef specularRef;
+    GpuTexRef specularColorRef;
 };
 
 struct GpuInstance {
@@ -92,7 +97,7 @@ VITRINE_PUSH_END(draw)
 #ifdef __cplusplus
 static_assert(sizeof(GpuTexRef) == 48);
 static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
-static_assert(sizeof(GpuMaterial) == 32 + 48 + 16);
+static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48);
 static_assert(sizeof(GpuInstance) == 192);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
 static_assert(sizeof(SceneDrawPush) == 96);

@@ -45,7 +45,9 @@ void main() {
     vec4 g2 = texelFetch(in_material, p, 0);
     vec3 n = octDecode(g0.xy);
     float NoV = clamp(dot(n, v), 1e-4, 1.0);
-    vec3 brdf = environmentBrdf(specularF0(g1.rgb, g1.a), roughnessFromShininess(g0.w), NoV);
+    vec4 dielectric = dielectricSpecular(0.04, vec4(vec3(1.0), 1.0 - g2.y)); // KHR_materials_specular, as deferred
+    vec3 brdf = environmentBrdfF90(specularF0With(g1.rgb, g1.a, 0.04, dielectric), specularF90(g1.a, dielectric),
+                                   roughnessFromShininess(g0.w), NoV);
     vec3 indirect = texelFetch(in_specular_indirect, p, 0).rgb;
     vec3 reflected = brdf * ssr.rgb * (g2.z * g2.w);
     vec3 final = color.rgb - indirect + mix(indirect, reflected, clamp(ssr.a, 0.0, 1.0));

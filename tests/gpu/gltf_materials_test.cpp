@@ -36,7 +36,10 @@ std::map<std::string, Image> gbuffer(const std::string& file, const std::string&
           {"gbuffer",
            {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}, {"params", {{"toksvig", false}}}}}}},
         {"outputs",
-         {{"base_color", "gbuffer.base_color"}, {"normal", "gbuffer.normal"}, {"emissive", "gbuffer.emissive"}}}};
+         {{"base_color", "gbuffer.base_color"},
+          {"normal", "gbuffer.normal"},
+          {"emissive", "gbuffer.emissive"},
+          {"material", "gbuffer.material"}}}};
     return runGraph(graph);
 }
 
@@ -111,6 +114,28 @@ TEST_F(GltfMaterials, MaterialVariantChangesTheDrawnBaseColour) {
             EXPECT_NEAR(right[c], 1.0f, 1e-3f) << variant << " " << c;
         }
     }
+}
+
+// specular.gltf: KHR_materials_specular's strength k reaches the G-buffer as material.y = 1 - k (UNORM8: the expected
+// values are multiples of 1/255 but for the textured ones, 1 - alpha/255 exactly too); a material without the
+// extension (variants.gltf) keeps 0 there, the value the channel had before it carried anything.
+TEST_F(GltfMaterials, SpecularStrengthReachesTheGbuffer) {
+    json want = expected("specular.gltf");
+    const Image& material = gbuffer("specular.gltf").at("material");
+    const glm::dvec2 centres[] = {{-1, 1}, {1, 1}, {-1, -1}};
+    for (int i = 0; i < 3; ++i) {
+        float got = texel(material, pixelAt(centres[i].x, centres[i].y)).y;
+        std::printf("specular %s: material.y %.4f\n", want["quadrants"][i].get<std::string>().c_str(), got);
+        EXPECT_NEAR(got, want["material_y"][i].get<float>(), 0.5f / 255) << i;
+    }
+    for (int t = 0; t < 4; ++t) {
+        float got = texel(material, pixelAt(0.5 + (t % 2), -0.5 - (t / 2))).y;
+        std::printf("specular texel %d: material.y %.4f\n", t, got);
+        EXPECT_NEAR(got, want["texels_material_y"][t].get<float>(), 0.5f / 255) << "texel " << t;
+    }
+    const Image& plain = gbuffer("variants.gltf").at("material");
+    EXPECT_EQ(texel(plain, pixelAt(-1, 0)).y, 0.0f);
+    EXPECT_EQ(texel(plain, pixelAt(1, 0)).y, 0.0f);
 }
 
 } // namespace

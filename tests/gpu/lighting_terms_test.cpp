@@ -95,6 +95,59 @@ TEST_F(LightingTerms, GrazingSunSpecularFollowsCpuSchlickFresnel) {
     EXPECT_LT(brightest, 40000.0); // nothing measured is near the shader's clamp
 }
 
+// The same glare on a ground with KHR_materials_specular strength k = 0.4 (G-buffer material.y = 0.6 = 153/255,
+// exact): by the extension's closed form a black dielectric's specular is k x (F0 + (1 - F0)(1 - VoH)^5) D V with
+// F0 = 0.04, i.e. k times the plain ground's, at every angle, so the expected value is 0.4 x the CPU value without the
+// extension. Lowering F90 matters most at grazing VoH: F90 left at 1 would be 2.4x brighter there, k on F0 only
+// ~10 % brighter; the bound is 2 % as above.
+TEST_F(LightingTerms, SpecularExtensionStrengthScalesTheGrazingSunSpecular) {
+    const int W = 64, H = 64;
+    const float shininess = 0.55f, k = 0.4f;
+    const double sunElevation = 12.0 * kPi / 180.0;
+    const double sunScale = 0.1;
+    const float groundHalf = 40.0f;
+
+    SceneBuilder b("grazing_specular");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
+    uint32_t black = b.material("black", glm::vec3(0.0f), 0.0f, shininess);
+    b.s.materials[black].specular = k; // written into the .glb as KHR_materials_specular and read back
+    b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, black)));
+    b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
+    b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
+    auto glb = b.write();
+
+    json nodes = baseNodes(glb);
+    nodes["direct"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", sunScale}}, false);
+    auto out = runGraph(graph(nodes, {{"direct", "direct.color"}, {"sh", "sky.sh"}}, W, H));
+    const Image& direct = out.at("direct");
+    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+
+    Pinhole cam(b.s, W, H);
+    int checked = 0, grazing = 0;
+    double worst = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= 0.0) continue;
+            glm::dvec3 p = cam.position - cam.position.y / d.y * d;
+            if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
+            glm::dvec3 v = -d;
+            glm::dvec3 expected = double(k) * cpuSun({0, 1, 0}, v, l, glm::vec3(0.0f), 0.0f, shininess, sunE);
+            if (expected.g < 1.0) continue;
+            ++checked;
+            glm::dvec3 got = rgb(direct, x, y);
+            double e = relErr(got, expected);
+            worst = std::max(worst, e);
+            if (glm::dot(v, glm::normalize(v + l)) <= 0.3) ++grazing;
+            EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << ": " << got.g << " vs " << expected.g;
+        }
+    std::printf("KHR_materials_specular k = 0.4 glare: %d pixels (%d with VoH <= 0.3), max relative error %.2g\n",
+                checked, grazing, worst);
+    EXPECT_GE(grazing, 200);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct SphereMaterial {

@@ -341,6 +341,71 @@ PATHTRACE_TEST(DirectSunMatchesDeferredLighting) {
     }
 }
 
+// KHR_materials_specular in the tracers: a grey rough dielectric ground with strength k = 0.5 and colour
+// c = (1, 0.5, 0.25) lit by a sun 12° up in front of the camera (direct light only, sky off). By the extension's
+// closed form its specular is k (F0c + (1 - F0c)(1 - VoH)^5) D V with F0c = 0.04 c, which is k times the plain BRDF's
+// specular lobe with F0 = F0c (core/shading brdfCosineF0 with no diffuse, code the extension does not touch), plus
+// the Lambert base / pi. The plane's normal is exact and rays go through pixel centres: bound 1 % per channel where
+// the expected value is above 1 % of the brightest, and the glare's grazing pixels (VoH <= 0.3, where F90 = k
+// rather than 1 counts most) must be among them.
+PATHTRACE_TEST(SpecularExtensionDirectSunMatchesItsClosedForm) {
+    const int W = 64, H = 64;
+    const float shininess = 0.55f, k = 0.5f, groundHalf = 40.0f;
+    const glm::vec3 base(0.05f), color(1.0f, 0.5f, 0.25f);
+    const double sunElevation = 12.0 * kPi / 180.0, sunScale = 0.1;
+    SceneBuilder b("pt_specular_ext");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
+    uint32_t m = b.material("tinted", base, 0.0f, shininess);
+    b.s.materials[m].specular = k;
+    b.s.materials[m].specularColor = color;
+    b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, m)));
+    b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
+    b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
+    auto glb = b.write();
+    json nodes = baseNodes(glb);
+    nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
+    nodes["pt"] = pathtraceNode(
+        {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
+    auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
+    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const glm::vec3 f0c = glm::min(0.04f * color, glm::vec3(1.0f));
+    const float roughness = shading::roughnessFromShininess(shininess);
+    Pinhole cam(b.s, W, H);
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    double brightest = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= 0.0) continue;
+            glm::dvec3 p = cam.position - cam.position.y / d.y * d;
+            if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
+            glm::vec3 n(0, 1, 0), v(-d), lf(l);
+            glm::dvec3 spec(float(k) * shading::brdfCosineF0(n, v, lf, glm::vec3(0.0f), f0c, roughness));
+            glm::dvec3 diffuse = glm::dvec3(base) / kPi * std::max(0.0, glm::dot(glm::dvec3(n), l));
+            glm::dvec3 e = (spec + diffuse) * sunE;
+            expected.push_back({{x, y}, e});
+            brightest = std::max(brightest, e.r);
+        }
+    int checked = 0, grazing = 0;
+    double worst = 0.0;
+    for (const auto& [px, e] : expected) {
+        if (e.r < 0.01 * brightest) continue;
+        glm::dvec3 got = rgb(out.at("pt"), px.x, px.y);
+        double err = relErr(got, e);
+        worst = std::max(worst, err);
+        ++checked;
+        glm::dvec3 v = -cam.ray(px.x, px.y);
+        if (glm::dot(v, glm::normalize(v + l)) <= 0.3) ++grazing;
+        EXPECT_LT(err, 0.01) << "pixel " << px.x << "," << px.y << ": " << got.r << " vs " << e.r;
+    }
+    std::printf("%s tracer, KHR_materials_specular ground: %d pixels (%d grazing), worst relative error %.4f\n",
+                gBackend, checked, grazing, worst);
+    EXPECT_GE(checked, 300);
+    EXPECT_GE(grazing, 50);
+}
+
 // Textures as ray tracers sample them (the texel pool: one buffer for all textures, scene.glsl
 // VITRINE_SCENE_TEXEL_POOL) against the G-buffer's hardware samplers: two textured planes under the sun, direct
 // light only, path traced and deferred-lit. The textures are small and magnified (LOD 0 in both), sRGB colour, and

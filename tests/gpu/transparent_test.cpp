@@ -183,7 +183,8 @@ TEST_F(Transparent, ThinGlassReflectsByFresnelAndTintsWhatIsBehind) {
     const int W = 64, H = 64;
     const glm::vec3 tint(0.9f, 0.5f, 0.2f);
     const float shininess = 0.8f;
-    auto scene = [&](const std::string& name, float ior, bool glass, glm::vec3 base) {
+    auto scene = [&](const std::string& name, float ior, bool glass, glm::vec3 base,
+                     glm::vec4 specular = glm::vec4(1.0f)) {
         SceneBuilder b(name);
         std::vector<Tri> wall, pane;
         addQuad(wall, glm::vec3(0, 0, -1), glm::vec3(3, 0, 0), glm::vec3(0, 3, 0), glm::vec3(0, 0, 1));
@@ -193,6 +194,8 @@ TEST_F(Transparent, ThinGlassReflectsByFresnelAndTintsWhatIsBehind) {
         if (glass) {
             b.s.materials[m].transmission = 1.0f;
             b.s.materials[m].ior = ior;
+            b.s.materials[m].specularColor = glm::vec3(specular);
+            b.s.materials[m].specular = specular.a;
         }
         b.node("pane", static_cast<int32_t>(b.mesh("pane", pane, m)));
         b.camera({0.3f, 0.2f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
@@ -243,6 +246,41 @@ TEST_F(Transparent, ThinGlassReflectsByFresnelAndTintsWhatIsBehind) {
                                      {{"out", "lighting.color"}}, W, H));
         check("sky, IOR 1.5", glass.at("out"), glass.at("bg"), 0.04,
               [&](int x, int y, glm::dvec3) { return rgb(opaque.at("out"), x, y); });
+    }
+    {
+        // (c) KHR_materials_specular on the IOR 1.7 glass, strength k = 0.5, colour c = (1, 0.5, 0.25): by the
+        // extension's closed form F = k (F0c + (1 − F0c)(1 − cos)^5) with F0c = min(F0(ior) c, 1) per channel, for
+        // the reflected lobe (k × the plain lobe with F0 = F0c, core/shading) and for what passes (1 − F at NoV).
+        const glm::vec4 spec(1.0f, 0.5f, 0.25f, 0.5f);
+        SceneBuilder b = scene("glass_specular", 1.7f, true, tint, spec);
+        auto out = runGraph(graph(pipeline(b.write(), {{"sky_ambient", 0.0}}, {{"sky_ambient", 0.0}}),
+                                  {{"out", "transparent.color"}, {"bg", "lighting.color"}, {"sh", "sky.sh"}}, W, H));
+        const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+        const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
+        const double k = spec.a;
+        const glm::dvec3 f0c = glm::min(std::pow(0.7 / 2.7, 2.0) * glm::dvec3(spec), glm::dvec3(1.0));
+        int n = 0;
+        double worst = 0.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                if (!hitsQuad(cam.position, d, 0.5, 0.0, 0.7, 0.03)) continue;
+                double NoV = -d.z;
+                glm::dvec3 fresnel = k * (f0c + (1.0 - f0c) * std::pow(1.0 - NoV, 5.0));
+                glm::dvec3 reflection =
+                    k *
+                    glm::dvec3(shading::brdfCosineF0(glm::vec3(0, 0, 1), glm::vec3(-d), glm::vec3(l), glm::vec3(0.0f),
+                                                     glm::vec3(f0c), shading::roughnessFromShininess(shininess))) *
+                    sunE;
+                glm::dvec3 expected = reflection + rgb(out.at("bg"), x, y) * (1.0 - fresnel) * glm::dvec3(tint);
+                double e = relErr(rgb(out.at("out"), x, y), expected);
+                worst = std::max(worst, e);
+                EXPECT_LT(e, 0.01) << "specular glass, pixel " << x << "," << y << ": " << rgb(out.at("out"), x, y).r
+                                   << " vs " << expected.r;
+                ++n;
+            }
+        std::printf("glass, KHR_materials_specular k 0.5: %d pixels, max relative error %.2g\n", n, worst);
+        EXPECT_GE(n, 300);
     }
 }
 

@@ -1,7 +1,8 @@
 // glTF material extensions on the corpus tests/data/gltf/corpus/ (written by make_corpus.py, validated by ctest
 // gltf.validator; issue #29 item 4): KHR_materials_pbrSpecularGlossiness converted to metallic-roughness against the
 // values worked out by hand in the file's asset.extras.expect and against the specular-glossiness model itself,
-// KHR_materials_emissive_strength, KHR_materials_variants, and the material extensions vitrine ignores with a warning.
+// KHR_materials_emissive_strength, KHR_materials_variants, KHR_materials_specular (factors, textures, errors, export),
+// and the material extensions vitrine ignores with a warning.
 
 #include "core/scene/gltf.hpp"
 
@@ -218,10 +219,9 @@ TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
     Scene s = loadGltf(corpus("ignored_material_extensions.gltf"), warnings);
     const std::pair<const char*, const char*> expectations[] = {{"KHR_materials_clearcoat", "clear coat"},
                                                                 {"KHR_materials_sheen", "sheen"},
-                                                                {"KHR_materials_specular", "specular strength"},
                                                                 {"KHR_materials_iridescence", "iridescence"},
                                                                 {"KHR_materials_volume", "attenuationColor"}};
-    ASSERT_EQ(warnings.size(), 5u);
+    ASSERT_EQ(warnings.size(), 4u);
     for (const auto& [name, what] : expectations) {
         size_t n = std::count_if(warnings.begin(), warnings.end(),
                                  [&](const std::string& w) { return w.find(name) != std::string::npos; });
@@ -238,8 +238,78 @@ TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
     // The transmission next to the volume is read.
     EXPECT_EQ(byName(s, "thick_glass").transmission, 1.0f);
     test::expectUserError([&] { loadGltfReporting(corpus("ignored_material_extensions.gltf"), true); },
-                          {"5 warnings, which strict loading", "KHR_materials_clearcoat", "KHR_materials_sheen",
-                           "KHR_materials_specular", "KHR_materials_iridescence", "KHR_materials_volume"});
+                          {"4 warnings, which strict loading", "KHR_materials_clearcoat", "KHR_materials_sheen",
+                           "KHR_materials_iridescence", "KHR_materials_volume"});
+}
+
+// KHR_materials_specular is read, not warned about: factors, the two textures (alpha as data, rgb as sRGB colour),
+// and the defaults for a material without it.
+TEST(GltfMaterials, SpecularExtensionIsReadWithoutWarnings) {
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(corpus("specular.gltf"), warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    test::Json want = expected("specular.gltf");
+    const char* names[] = {"weak", "none", "tinted"};
+    for (int i = 0; i < 3; ++i) {
+        const Material& m = byName(s, names[i]);
+        SCOPED_TRACE(names[i]);
+        EXPECT_EQ(m.specular, want["strength"][i].get<float>());
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(m.specularColor[c], want["color"][i][c].get<float>());
+        EXPECT_FALSE(m.specularTexture.valid());
+        EXPECT_FALSE(m.specularColorTexture.valid());
+        EXPECT_TRUE(m.hasSpecular());
+    }
+    const Material& t = byName(s, "textured");
+    ASSERT_TRUE(t.specularTexture.valid());
+    ASSERT_TRUE(t.specularColorTexture.valid());
+    EXPECT_EQ(s.textures[t.specularTexture.texture].usage, TextureUsage::Data);
+    EXPECT_EQ(s.textures[t.specularColorTexture.texture].usage, TextureUsage::Color);
+    EXPECT_EQ(t.specular, 1.0f);
+    EXPECT_EQ(t.specularColor, glm::vec3(1.0f));
+    EXPECT_TRUE(t.hasSpecular());
+    EXPECT_FALSE(Material{}.hasSpecular());
+    // Supported, so a file may require it.
+    test::Json doc = test::readJson(corpus("specular.gltf"));
+    doc["extensionsRequired"] = {"KHR_materials_specular"};
+    auto required = test::scratchDir() / "specular_required.gltf";
+    test::writeText(required, doc.dump());
+    EXPECT_EQ(loadGltf(required, warnings).materials, s.materials);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+}
+
+TEST(GltfMaterials, SpecularExtensionOutOfRangeIsAnErrorWithItsPath) {
+    test::Json doc = test::readJson(corpus("specular.gltf"));
+    doc["materials"][0]["extensions"]["KHR_materials_specular"]["specularFactor"] = 1.5;
+    auto file = test::scratchDir() / "specular_bad.gltf";
+    test::writeText(file, doc.dump());
+    test::expectUserError([&] { loadGltf(file); },
+                          {"specular_bad.gltf", "materials[0].extensions.KHR_materials_specular.specularFactor",
+                           "expected a number in [0, 1]"});
+    doc = test::readJson(corpus("specular.gltf"));
+    doc["materials"][2]["extensions"]["KHR_materials_specular"]["specularColorFactor"] = {1.0, -0.5, 0.0};
+    test::writeText(file, doc.dump());
+    test::expectUserError(
+        [&] { loadGltf(file); },
+        {"materials[2].extensions.KHR_materials_specular.specularColorFactor[1]", "expected a number >= 0"});
+}
+
+// exportGlb writes the extension back: the materials survive a round trip.
+TEST(GltfMaterials, SpecularExtensionSurvivesExport) {
+    Scene s = loadGltf(corpus("specular.gltf"));
+    auto file = test::scratchDir() / "specular_roundtrip.glb";
+    exportGlb(s, file);
+    std::vector<std::string> warnings;
+    Scene back = loadGltf(file, warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    for (const char* name : {"weak", "none", "tinted", "textured"}) {
+        const Material& a = byName(s, name);
+        const Material& b = byName(back, name);
+        EXPECT_EQ(a.specular, b.specular) << name;
+        EXPECT_EQ(a.specularColor, b.specularColor) << name;
+        EXPECT_EQ(a.specularTexture.valid(), b.specularTexture.valid()) << name;
+        EXPECT_EQ(a.specularColorTexture.valid(), b.specularColorTexture.valid()) << name;
+    }
 }
 
 } // namespace

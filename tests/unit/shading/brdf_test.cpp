@@ -166,3 +166,76 @@ TEST(Brdf, ToksvigWidensTheLobeByTheNormalVariance) {
 
 } // namespace
 } // namespace vitrine::shading
+
+namespace vitrine::shading {
+namespace {
+
+// KHR_materials_specular against the extension's closed form, written here in double from the Khronos text:
+//   dielectric_brdf's specular = k F D V, F = f0c + (1 - f0c) (1 - VoH)^5, f0c = min(((ior - 1)/(ior + 1))^2 c, 1)
+//   metal_brdf = (base + (1 - base) (1 - VoH)^5) D V, material = mix(dielectric, metal, metallic)
+// with GGX D and height-correlated Smith V, plus vitrine's diffuse (1 - metallic) base / pi (the lobes add:
+// MUSEUM_SPEC §1, so the diffuse is not weighted by 1 - k F as Khronos' fresnel_mix would), times NoL.
+glm::dvec3 khronosSpecularCosine(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::dvec3 base, double metallic,
+                                 double roughness, double ior, glm::dvec3 color, double k) {
+    const double pi = 3.14159265358979323846;
+    double NoL = glm::dot(n, l), NoV = glm::dot(n, v);
+    glm::dvec3 h = glm::normalize(v + l);
+    double NoH = glm::dot(n, h), VoH = glm::dot(v, h);
+    double a = std::max(roughness * roughness, 0.002), a2 = a * a;
+    double d = NoH * NoH * (a2 - 1.0) + 1.0;
+    double D = a2 / (pi * d * d);
+    double V = 0.5 / (NoL * std::sqrt(NoV * NoV * (1.0 - a2) + a2) + NoV * std::sqrt(NoL * NoL * (1.0 - a2) + a2));
+    double w = std::pow(1.0 - VoH, 5.0);
+    double r = (ior - 1.0) / (ior + 1.0);
+    glm::dvec3 f0c = glm::min(r * r * color, glm::dvec3(1.0));
+    glm::dvec3 dielectric = k * (f0c + (1.0 - f0c) * w) * D * V;
+    glm::dvec3 metal = (base + (1.0 - base) * w) * D * V;
+    glm::dvec3 diffuse = (1.0 - metallic) * base / pi;
+    return (diffuse + (1.0 - metallic) * dielectric + metallic * metal) * NoL;
+}
+
+TEST(Brdf, SpecularExtensionMatchesTheKhronosClosedForm) {
+    struct Case {
+        glm::vec3 base;
+        float metallic, roughness, ior;
+        glm::vec3 color;
+        float k;
+    };
+    const Case cases[] = {
+        {glm::vec3(0.0f), 0.0f, 0.5f, 1.5f, glm::vec3(1.0f, 0.5f, 0.25f), 0.4f}, // tinted, weakened dielectric
+        {glm::vec3(0.8f, 0.2f, 0.1f), 0.0f, 0.3f, 4.0f, glm::vec3(3.0f, 1.0f, 0.2f), 0.7f}, // f0 0.36 x 3 clamps to 1
+        {glm::vec3(0.9f, 0.6f, 0.3f), 0.5f, 0.7f, 1.5f, glm::vec3(0.5f), 0.25f}, // half metal: F90 = k + (1 - k) / 2
+        {glm::vec3(0.5f), 0.0f, 0.4f, 1.5f, glm::vec3(1.0f), 0.0f},              // no specular at all
+    };
+    // Directions: near normal, and a grazing pair where F90 dominates (VoH ~ 0.17).
+    const glm::vec3 n(0, 0, 1);
+    const glm::vec3 dirs[][2] = {
+        {glm::normalize(glm::vec3(0.2f, 0.1f, 1.0f)), glm::normalize(glm::vec3(-0.3f, 0.0f, 1.0f))},
+        {glm::normalize(glm::vec3(1.0f, 0.0f, 0.2f)), glm::normalize(glm::vec3(-1.0f, 0.1f, 0.25f))}};
+    for (const Case& c : cases) {
+        float r = (c.ior - 1.0f) / (c.ior + 1.0f);
+        glm::vec4 dielectric = dielectricSpecular(r * r, glm::vec4(c.color, c.k));
+        for (const auto& vl : dirs) {
+            glm::vec3 got = brdfCosineSpecular(n, vl[0], vl[1], c.base, c.metallic, c.roughness, dielectric);
+            glm::dvec3 want =
+                khronosSpecularCosine(n, vl[0], vl[1], c.base, c.metallic, c.roughness, c.ior, c.color, c.k);
+            for (int i = 0; i < 3; ++i)
+                EXPECT_NEAR(got[i], want[i], 1e-5 + 1e-4 * want[i]) << "k " << c.k << " channel " << i;
+        }
+    }
+    // Without the extension (c = 1, k = 1) the surface is the plain BRDF, to the bit.
+    glm::vec4 plain = dielectricSpecular(0.04f, glm::vec4(1.0f));
+    EXPECT_EQ(plain, glm::vec4(0.04f, 0.04f, 0.04f, 1.0f));
+    for (const auto& vl : dirs) {
+        for (float metallic : {0.0f, 0.3f, 1.0f}) {
+            glm::vec3 base(0.7f, 0.4f, 0.2f);
+            EXPECT_EQ(brdfCosineSpecular(n, vl[0], vl[1], base, metallic, 0.35f, plain),
+                      brdfCosine(n, vl[0], vl[1], base, metallic, 0.35f));
+            EXPECT_EQ(shadeDirectionalSpecular(n, vl[0], vl[1], base, metallic, 0.35f, plain, glm::vec3(2.0f)),
+                      shadeDirectional(n, vl[0], vl[1], base, metallic, 0.35f, glm::vec3(2.0f)));
+        }
+    }
+}
+
+} // namespace
+} // namespace vitrine::shading

@@ -27,8 +27,11 @@ hand, written in the file's asset.extras.expect:
                        KHR_materials_emissive_strength 4, the right one without (G-buffer emissive 4x the right's).
   variants.gltf        KHR_materials_variants "red" and "blue" remapping the left quad's white material; the right quad
                        has no mapping and stays white whatever the variant.
-  ignored_material_extensions.gltf  KHR_materials_clearcoat, _sheen, _specular, _iridescence (material 0) and
+  ignored_material_extensions.gltf  KHR_materials_clearcoat, _sheen, _iridescence (material 0) and
                        _volume with _transmission (material 1): vitrine warns once per ignored extension.
+  specular.gltf        KHR_materials_specular: strength 0.4, strength 0, a tint alone, and a 2x2 texture read both as
+                       specularTexture (alpha) and specularColorTexture (sRGB rgb), one quadrant each; the G-buffer's
+                       material.y is 1 - strength (tests/gpu/gltf_materials_test.cpp).
 Regenerate after editing: python3 tests/data/gltf/corpus/make_corpus.py
 """
 import base64
@@ -380,14 +383,13 @@ def variants_file():
 
 def ignored_material_extensions_file():
     b = Builder()
-    names = ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular", "KHR_materials_iridescence",
+    names = ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence",
              "KHR_materials_transmission", "KHR_materials_volume"]
     b.doc["extensionsUsed"] = names
     b.doc["materials"] = [
         {"name": "coated", "extensions": {
             "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1},
             "KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessFactor": 0.5},
-            "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1.0, 0.5, 0.5]},
             "KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 400.0}}},
         {"name": "thick_glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
          "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
@@ -396,6 +398,41 @@ def ignored_material_extensions_file():
     meshes = [quad_mesh(b, [-1, 0, 0], 1.0, 0, name="coated"), quad_mesh(b, [1, 0, 0], 1.0, 1, name="thick_glass")]
     ortho_view(b, meshes)
     b.write("ignored_material_extensions.gltf")
+
+
+def specular_file():
+    """Quadrants (top-left, top-right, bottom-left, bottom-right) of a grey rough dielectric with
+    KHR_materials_specular: specularFactor 0.4, specularFactor 0, specularColorFactor (1, 0.5, 0.25) alone, and a 2x2
+    texture (nearest) used as both specularTexture (its alpha: 255, 153, 51, 0) and specularColorTexture (its sRGB rgb).
+    The G-buffer keeps the strength k as 1 - k in material.y: 0.6 (= 153/255, exact in UNORM8), 1, 0 and, per texel,
+    1 - alpha/255 = 0, 0.4, 0.8, 1. The dielectric F0 for the forward pass and the tracers is
+    k min(0.04 c, 1) and F90 = k."""
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_specular"]
+    sp = "KHR_materials_specular"
+    grey = {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0, "roughnessFactor": 0.5}
+    b.doc["materials"] = [
+        {"name": "weak", "pbrMetallicRoughness": grey, "extensions": {sp: {"specularFactor": 0.4}}},
+        {"name": "none", "pbrMetallicRoughness": grey, "extensions": {sp: {"specularFactor": 0.0}}},
+        {"name": "tinted", "pbrMetallicRoughness": grey,
+         "extensions": {sp: {"specularColorFactor": [1.0, 0.5, 0.25]}}},
+        {"name": "textured", "pbrMetallicRoughness": grey,
+         "extensions": {sp: {"specularTexture": {"index": 0}, "specularColorTexture": {"index": 0}}}}]
+    image = png_rgba(2, 2, [[255, 255, 255, 255], [255, 128, 64, 153], [64, 128, 255, 51], [0, 0, 0, 0]])
+    b.doc["images"] = [{"name": "specular", "mimeType": "image/png", "bufferView": b.view(image)}]
+    b.doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"sampler": 0, "source": 0}]
+    meshes = [quad_mesh(b, c, 1.0, m, uvs=(m == 3), name=b.doc["materials"][m]["name"])
+              for m, c in enumerate([[-1, 1, 0], [1, 1, 0], [-1, -1, 0], [1, -1, 0]])]
+    ortho_view(b, meshes)
+    b.doc["asset"]["extras"] = {"expect": {
+        "quadrants": ["top_left", "top_right", "bottom_left", "bottom_right"],
+        "strength": [0.4, 0.0, 1.0], "color": [[1, 1, 1], [1, 1, 1], [1.0, 0.5, 0.25]],
+        "material_y": [0.6, 1.0, 0.0],
+        "texels_material_y": [0.0, 0.4, 0.8, 1.0],
+        "texels_color": [[1.0, 1.0, 1.0], [1.0, srgb_decode(128), srgb_decode(64)],
+                         [srgb_decode(64), srgb_decode(128), 1.0], [0.0, 0.0, 0.0]]}}
+    b.write("specular.gltf")
 
 
 def main():
@@ -419,6 +456,7 @@ def main():
     emissive_strength_file()
     variants_file()
     ignored_material_extensions_file()
+    specular_file()
 
 
 if __name__ == "__main__":
