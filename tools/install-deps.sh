@@ -66,33 +66,23 @@ if [ -f "$editor/package-lock.json" ]; then
     fi
 fi
 
-# The Khronos glTF-Validator for ctest gltf.validator (tests/gltf/check_validator.py): npm gltf-validator exactly as
-# tools/gltf-validator/package-lock.json pins it, installed the same way, only when the lockfile changed.
-validator="$(dirname "$0")/gltf-validator"
-if [ -f "$validator/package-lock.json" ]; then
-    want="$(sha256sum < "$validator/package-lock.json" | cut -d' ' -f1) node $(node --version)"
-    stamp="$validator/node_modules/.vitrine-install-stamp"
+# npm ci in tools/<dir>/ exactly as its package-lock.json pins it, only when the lockfile (or node) changed.
+npm_ci_pinned() {
+    local dir="$(dirname "$0")/$1"
+    [ -f "$dir/package-lock.json" ] || return 0
+    local want stamp="$dir/node_modules/.vitrine-install-stamp"
+    want="$(sha256sum < "$dir/package-lock.json" | cut -d' ' -f1) node $(node --version)"
     if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
-        echo "install-deps: tools/gltf-validator/node_modules is current"
+        echo "install-deps: tools/$1/node_modules is current"
     else
-        echo "install-deps: npm ci in tools/gltf-validator/ (from package-lock.json)"
-        (cd "$validator" && npm ci --no-audit --no-fund)
+        echo "install-deps: npm ci in tools/$1/ (from package-lock.json)"
+        (cd "$dir" && npm ci --no-audit --no-fund)
         echo "$want" > "$stamp"
     fi
-fi
+}
 
-# The Khronos glTF Sample Viewer's engine for ctest gltf.sample_viewer (tests/viewer/): npm @khronosgroup/gltf-viewer
-# exactly as tools/gltf-viewer/package-lock.json pins it, installed the same way, only when the lockfile changed. It runs
-# in the chromium installed above (driven by editor/node_modules/playwright-core); it downloads nothing itself.
-viewer="$(dirname "$0")/gltf-viewer"
-if [ -f "$viewer/package-lock.json" ]; then
-    want="$(sha256sum < "$viewer/package-lock.json" | cut -d' ' -f1) node $(node --version)"
-    stamp="$viewer/node_modules/.vitrine-install-stamp"
-    if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
-        echo "install-deps: tools/gltf-viewer/node_modules is current"
-    else
-        echo "install-deps: npm ci in tools/gltf-viewer/ (from package-lock.json)"
-        (cd "$viewer" && npm ci --no-audit --no-fund)
-        echo "$want" > "$stamp"
-    fi
-fi
+# The Khronos glTF-Validator for ctest gltf.validator (tests/gltf/check_validator.py).
+npm_ci_pinned gltf-validator
+# The Khronos glTF Sample Viewer's engine for ctest gltf.sample_viewer (tests/viewer/). It runs in the chromium
+# installed above (driven by editor/node_modules/playwright-core); it downloads nothing itself.
+npm_ci_pinned gltf-viewer
