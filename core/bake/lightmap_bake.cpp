@@ -13,7 +13,7 @@ namespace vitrine::bake {
 
 namespace {
 
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2; // 2: the filter keeps energy, texels average the paths that start outside geometry
 constexpr char kMagic[4] = {'V', 'T', 'L', 'M'};
 
 struct Header {

@@ -49,10 +49,9 @@ void filterLightmap(LightmapTexels& t, const LightmapFilterOptions& o) {
                 if (guided) nextVariance[c] = variance[c];
                 if (t.region[c] < 0) continue;
                 const float lc = luminanceOf(t.irradiance[c]);
-                // The deviation a difference of two texels may have from noise alone.
-                const float noise = guided ? o.luminanceSigma * std::sqrt(2.0f * std::max(blurred[c], 0.0f)) : 0.0f;
                 glm::vec3 sum(0.0f);
-                float weight = 0.0f, weight2Variance = 0.0f;
+                // kept: the weight the luminance test takes from neighbours, which stays with the centre texel.
+                float weight = 0.0f, weight2Variance = 0.0f, kept = 0.0f;
                 for (int j = -2; j <= 2; ++j)
                     for (int i = -2; i <= 2; ++i) {
                         const int sx = int(x) + i * step, sy = int(y) + j * step;
@@ -64,18 +63,34 @@ void filterLightmap(LightmapTexels& t, const LightmapFilterOptions& o) {
                         const float plane = glm::dot(d, t.normal[c]);
                         const float wp = std::exp(-plane * plane * inv2Sigma2);
                         const float wn = std::pow(std::max(glm::dot(t.normal[s], t.normal[c]), 0.0f), o.normalPower);
+                        const float k = kKernel[i + 2] * kKernel[j + 2] * wp * wn;
                         float wl = 1.0f;
                         if (guided) {
+                            // The deviation the difference of the two texels may have from noise alone: both
+                            // estimates' noise, so that the test is the same from either side.
+                            const float noise =
+                                o.luminanceSigma * std::sqrt(std::max(blurred[c], 0.0f) + std::max(blurred[s], 0.0f));
                             const float dl = std::abs(luminanceOf(t.irradiance[s]) - lc);
                             wl = std::exp(-dl / (noise + 1e-6f * (lc + 1.0f)));
                         }
-                        const float w = kKernel[i + 2] * kKernel[j + 2] * wp * wn * wl;
-                        sum += w * t.irradiance[s];
-                        weight += w;
-                        if (guided) weight2Variance += w * w * variance[s];
+                        // A neighbour the luminance test rejects gives its weight back to the centre rather than
+                        // dropping it: the weights of a pair are then symmetric, and what a bright texel keeps from
+                        // its dim neighbours is what they keep from it, so the filter moves light between texels
+                        // without losing any (dropping the weight darkened the rare bright texels that carry the
+                        // sun's light through an aperture and left their neighbours as they were).
+                        sum += k * wl * t.irradiance[s];
+                        weight += k;
+                        kept += k * (1.0f - wl);
+                        if (guided) weight2Variance += (k * wl) * (k * wl) * variance[s];
                     }
+                sum += kept * t.irradiance[c];
                 next[c] = sum / weight; // the centre's own weight is > 0, so weight > 0
-                if (guided) nextVariance[c] = weight2Variance / (weight * weight);
+                if (guided) {
+                    // The centre's coefficient is its own kernel weight kc plus the weight kept for it.
+                    const float kc = kKernel[2] * kKernel[2], centre = kc + kept;
+                    weight2Variance += (centre * centre - kc * kc) * variance[c];
+                    nextVariance[c] = weight2Variance / (weight * weight);
+                }
             }
         t.irradiance.swap(next);
         if (guided) variance.swap(nextVariance);

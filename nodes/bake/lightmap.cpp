@@ -268,11 +268,16 @@ private:
                     ++job;
                     continue;
                 }
-                const glm::vec3 mean = glm::vec3(sums[2 * job]) * inv;
+                // The texel's light is the mean of the paths that started outside geometry: a path that starts
+                // under a wall brings no light (0), and counting it would darken every texel at a wall's foot by
+                // the share of its footprint the wall covers.
+                const float outside = float(mSettings.samples) - sums[2 * job].w;
+                const float invOutside = 1.0f / std::max(outside, 1.0f);
+                const glm::vec3 mean = glm::vec3(sums[2 * job]) * invOutside;
                 const float meanY = 0.2126f * mean.r + 0.7152f * mean.g + 0.0722f * mean.b;
                 texels.irradiance[i] = mean;
                 // Variance of the mean of the texel's samples' luminance.
-                texels.variance[i] = std::max(sums[2 * job + 1].x * inv - meanY * meanY, 0.0f) * inv;
+                texels.variance[i] = std::max(sums[2 * job + 1].x * invOutside - meanY * meanY, 0.0f) * invOutside;
                 ++job;
             }
         if (job != texelJobs) throw InternalError("bake.lightmap: texel jobs out of step");

@@ -170,6 +170,32 @@ TEST_F(LightmapBake, SkyLightBesideABlackWallFollowsTheViewFactor) {
     }
 }
 
+// The floor beside a wall seen from behind: a single-sided quad at x = 0 facing away from the floor, which the
+// rasteriser culls and the path tracer passes through. A bake path that first meets the back of a single-sided
+// surface counts as started inside geometry and brings no light; the texel's light is the mean of the other paths
+// (were they counted as black, the floor would come out pi C (1 - F(d)), as beside a black wall). Every
+// direction that is not blocked sees the uniform sky, so every texel is pi C, as the path tracer has it.
+TEST_F(LightmapBake, PathsThatStartBehindAWallAreLeftOutOfTheTexelsMean) {
+    const double C = 1000.0;
+    SceneBuilder b("bake_back_wall");
+    std::vector<Tri> floor, wall;
+    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
+    for (Tri& t : floor)
+        for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
+    const uint32_t floorMesh = b.mesh("floor", floor, b.material("floor", glm::vec3(0.5f), 0.0f, 0.0f));
+    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
+    b.node("floor", static_cast<int32_t>(floorMesh));
+    addQuad(wall, {0, kWallHeight / 2, 0}, {0, kWallHeight / 2, 0}, {0, 0, 100.0f}, {-1, 0, 0});
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, b.material("wall", glm::vec3(0.0f), 0.0f, 0.0f))));
+    b.camera({4.0f, 3.0f, 6.0f}, {4.0f, 0.0f, 0.0f}, 0.9f);
+    b.sun({0.3f, 1.0f, 0.2f});
+    const fs::path glb = b.write();
+    const bake::LightmapRegion r = floorRegion(glb);
+    auto out = runGraph(bakeGraph(glb, uniformSky(glb, C), {{"samples", 64}, {"sun_scale", 0.0}, {"filter_iterations", 0}}));
+    std::printf("floor beside a wall seen from behind, 64 samples:\n");
+    expectProfile(out.at("lightmap"), r, [&](double) { return kPi * C; }, 0.02, 0.01);
+}
+
 TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
     const glm::vec3 wallBase(0.5f);
     const fs::path glb = floorAndWall("bake_sun_wall", glm::vec3(0.0f), 1.0f, wallBase, 0.0f, {1.0f, 1.0f, 0.3f});

@@ -103,6 +103,41 @@ TEST(LightmapTexels, FilterKeepsConstantsAndReducesNoise) {
     }
 }
 
+// A sunlit interior's lightmap: most of a texel's 16 paths bring little light, a rare one finds the sun through an
+// aperture and brings a lot. The texels are Monte Carlo estimates of the same irradiance, so any filter that only
+// removes noise keeps their mean; the luminance test must not turn the bright rare estimates into lost energy.
+TEST(LightmapTexels, FilterKeepsTheEnergyOfRareBrightSamples) {
+    constexpr uint32_t kSize = 64, kPaths = 16;
+    constexpr float kDim = 1.0f, kBright = 40.0f, kChance = 1.0f / 32.0f;
+    LightmapTexels t = flat(kSize, kSize);
+    t.variance.assign(t.region.size(), 0.0f);
+    std::mt19937 rng(11);
+    std::bernoulli_distribution bright(kChance);
+    double before = 0.0;
+    for (size_t i = 0; i < t.region.size(); ++i) {
+        t.region[i] = 0;
+        float sum = 0.0f, squares = 0.0f;
+        for (uint32_t p = 0; p < kPaths; ++p) {
+            const float e = bright(rng) ? kBright : kDim;
+            sum += e;
+            squares += e * e;
+        }
+        const float mean = sum / kPaths;
+        t.irradiance[i] = glm::vec3(mean);
+        t.variance[i] = std::max(squares / kPaths - mean * mean, 0.0f) / kPaths; // as bake.lightmap's resolve
+        before += mean;
+    }
+    before /= double(t.region.size());
+    filterLightmap(t);
+    double after = 0.0;
+    for (const glm::vec3& v : t.irradiance) after += v.x;
+    after /= double(t.irradiance.size());
+    const double expected = kDim + (kBright - kDim) * kChance;
+    std::printf("rare bright samples: expected mean %.4f, texels %.4f, filtered %.4f (ratio %.4f)\n", expected, before,
+                after, after / before);
+    EXPECT_NEAR(after / before, 1.0, 0.02);
+}
+
 TEST(LightmapTexels, FilterDoesNotMixRegionsCreasesOrDistantSurfaces) {
     // Left half and right half of a 16x8 atlas, 1 and 10.
     for (int kind = 0; kind < 4; ++kind) {
