@@ -368,6 +368,21 @@ Json Exporter::material(const Material& m) const {
             sp["specularColorTexture"] = writeTextureInfo(m.specularColorTexture, m.specularColorTexture.texture);
         j["extensions"][gltf::kSpecular] = sp;
     }
+    if (m.hasClearcoat()) {
+        Json cc = {{"clearcoatFactor", m.clearcoat}, {"clearcoatRoughnessFactor", m.clearcoatRoughness}};
+        if (m.clearcoatTexture.valid())
+            cc["clearcoatTexture"] = writeTextureInfo(m.clearcoatTexture, m.clearcoatTexture.texture);
+        if (m.clearcoatRoughnessTexture.valid()) {
+            cc["clearcoatRoughnessTexture"] =
+                writeTextureInfo(m.clearcoatRoughnessTexture, m.clearcoatRoughnessTexture.texture);
+        }
+        if (m.clearcoatNormal.texture.valid()) {
+            cc["clearcoatNormalTexture"] =
+                writeTextureInfo(m.clearcoatNormal.texture, m.clearcoatNormal.texture.texture);
+            cc["clearcoatNormalTexture"]["scale"] = m.clearcoatNormal.scale;
+        }
+        j["extensions"][gltf::kClearcoat] = cc;
+    }
 
     if (m.layers.size() == 1 && base == core) return j; // the core material says it all
 
@@ -638,9 +653,10 @@ std::vector<uint8_t> Exporter::run() {
     if (transforms) used.push_back(gltf::kTextureTransform);
     if (strength) used.push_back(gltf::kEmissiveStrength);
     if (mScene.hasSun || !mScene.lights.empty()) used.push_back(gltf::kLightsPunctual);
-    bool unlit = false, transmission = false, ior = false, specular = false;
+    bool unlit = false, transmission = false, ior = false, specular = false, clearcoat = false;
     for (const Material& m : mScene.materials) {
         specular = specular || m.hasSpecular();
+        clearcoat = clearcoat || m.hasClearcoat();
         unlit = unlit || m.unlit;
         transmission = transmission || m.transmission != 0.0f;
         ior = ior || m.ior != 1.5f;
@@ -649,6 +665,7 @@ std::vector<uint8_t> Exporter::run() {
     if (transmission) used.push_back(gltf::kTransmission);
     if (ior) used.push_back(gltf::kIor);
     if (specular) used.push_back(gltf::kSpecular);
+    if (clearcoat) used.push_back(gltf::kClearcoat);
     if (!mScene.probes.empty()) used.push_back(kProbesExtension);
     if (!used.empty()) mDoc["extensionsUsed"] = used; // glTF forbids an empty list
     while (mBin.size() % 4)

@@ -305,6 +305,26 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
             if (const Json* t = member(*sp, "specularColorTexture"))
                 out.specularColorTexture = readTextureInfo(ctx, *t, TextureUsage::Color, se + ".specularColorTexture");
         }
+        if (const Json* cc = object(ctx, *extensions, kClearcoat, e + ".extensions")) {
+            std::string ce = e + ".extensions." + kClearcoat;
+            out.clearcoat = static_cast<float>(number(ctx, *cc, "clearcoatFactor", 0.0, ce));
+            if (!(out.clearcoat >= 0.0f && out.clearcoat <= 1.0f))
+                ctx.fail(ce + ".clearcoatFactor", "expected a number in [0, 1]");
+            out.clearcoatRoughness = static_cast<float>(number(ctx, *cc, "clearcoatRoughnessFactor", 0.0, ce));
+            if (!(out.clearcoatRoughness >= 0.0f && out.clearcoatRoughness <= 1.0f))
+                ctx.fail(ce + ".clearcoatRoughnessFactor", "expected a number in [0, 1]");
+            if (const Json* t = member(*cc, "clearcoatTexture"))
+                out.clearcoatTexture = readTextureInfo(ctx, *t, TextureUsage::Data, ce + ".clearcoatTexture");
+            if (const Json* t = member(*cc, "clearcoatRoughnessTexture"))
+                out.clearcoatRoughnessTexture =
+                    readTextureInfo(ctx, *t, TextureUsage::Data, ce + ".clearcoatRoughnessTexture");
+            if (const Json* n = object(ctx, *cc, "clearcoatNormalTexture", ce)) {
+                out.clearcoatNormal.texture =
+                    readTextureInfo(ctx, *n, TextureUsage::Normal, ce + ".clearcoatNormalTexture");
+                out.clearcoatNormal.scale =
+                    static_cast<float>(number(ctx, *n, "scale", 1.0, ce + ".clearcoatNormalTexture"));
+            }
+        }
     }
     std::string mode = string(ctx, m, "alphaMode", "OPAQUE", e);
     if (mode == "OPAQUE")

@@ -347,7 +347,8 @@ const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength,
                                           kLayersExtension,  kUnlit,
                                           kTransmission,     kIor,
                                           kProbesExtension,  kSpecGloss,
-                                          kVariants,         kSpecular};
+                                          kVariants,         kSpecular,
+                                          kClearcoat};
 
 // An extension the file uses but does not require may be ignored (glTF 2.0, 3.12): a warning per extension.
 void checkUsedExtensions(const LoadContext& ctx) {

@@ -239,6 +239,9 @@ void dropSpecGlossSources(LoadContext& ctx) {
             f(m.emissiveTexture);
             f(m.specularTexture);
             f(m.specularColorTexture);
+            f(m.clearcoatTexture);
+            f(m.clearcoatRoughnessTexture);
+            f(m.clearcoatNormal.texture);
         }
     };
     std::vector<bool> used(scene.textures.size(), false);

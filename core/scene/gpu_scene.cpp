@@ -124,6 +124,10 @@ void packMaterials(const scene::Scene& scene, std::vector<GpuMaterial>& material
         g.specular = glm::vec4(m.specularColor, m.specular);
         g.specularRef = texRef(m.specularTexture, 3);
         g.specularColorRef = texRef(m.specularColorTexture);
+        g.clearcoat = {m.clearcoat, m.clearcoatRoughness, m.clearcoatNormal.scale, 0.0f};
+        g.clearcoatRef = texRef(m.clearcoatTexture, 0);
+        g.clearcoatRoughnessRef = texRef(m.clearcoatRoughnessTexture, 1);
+        g.clearcoatNormalRef = texRef(m.clearcoatNormal.texture);
         materials.push_back(g);
         for (size_t li = 0; li < m.layers.size(); ++li) {
             const scene::MaterialLayer& l = m.layers[li];

@@ -173,6 +173,21 @@ struct Material {
                specularColorTexture.valid();
     }
 
+    // KHR_materials_clearcoat: a dielectric coat (ior 1.5, F0 0.04) over the whole material, of strength
+    // c = clearcoat × clearcoatTexture.r and roughness clearcoatRoughness × clearcoatRoughnessTexture.g, with its own
+    // normal map (else the base normal): f = base · (1 − c·Fc(N_c·V)) + c · coat GGX (common/brdf.glsl clearcoatLayer).
+    float clearcoat = 0.0f;
+    TextureRef clearcoatTexture; // data, red channel
+    float clearcoatRoughness = 0.0f;
+    TextureRef clearcoatRoughnessTexture; // data, green channel
+    NormalParam clearcoatNormal;          // tangent space, as a layer's normal
+
+    // True when KHR_materials_clearcoat says anything (a factor of 0, the default, leaves no coat to draw).
+    bool hasClearcoat() const {
+        return clearcoat != 0.0f || clearcoatRoughness != 0.0f || clearcoatTexture.valid() ||
+               clearcoatRoughnessTexture.valid() || clearcoatNormal.texture.valid();
+    }
+
     // Drawn by the transparent pass (alpha blending or transmission), not into the G-buffer.
     bool transparent() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }
 

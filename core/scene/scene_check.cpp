@@ -62,6 +62,14 @@ void hashMaterial(Hasher& h, const Material& m) {
         h.value(m.specularColor);
         hashRef(h, m.specularColorTexture);
     }
+    if (m.hasClearcoat()) {
+        h.value(m.clearcoat);
+        hashRef(h, m.clearcoatTexture);
+        h.value(m.clearcoatRoughness);
+        hashRef(h, m.clearcoatRoughnessTexture);
+        h.value(m.clearcoatNormal.scale);
+        hashRef(h, m.clearcoatNormal.texture);
+    }
 }
 
 void hashCamera(Hasher& h, const Camera& c) {
@@ -84,11 +92,14 @@ bool usesUvSet(const Material& m, uint32_t uvSet) {
             return true;
         }
     }
-    return uses(m.emissiveTexture) || uses(m.specularTexture) || uses(m.specularColorTexture);
+    return uses(m.emissiveTexture) || uses(m.specularTexture) || uses(m.specularColorTexture) ||
+           uses(m.clearcoatTexture) || uses(m.clearcoatRoughnessTexture) || uses(m.clearcoatNormal.texture);
 }
 
 bool usesNormalMap(const Material& m) {
-    return std::any_of(m.layers.begin(), m.layers.end(), [](const MaterialLayer& l) { return l.normal.texture.valid(); });
+    return m.clearcoatNormal.texture.valid() ||
+           std::any_of(m.layers.begin(), m.layers.end(),
+                       [](const MaterialLayer& l) { return l.normal.texture.valid(); });
 }
 
 uint64_t Scene::contentHash() const { return hashContent(true); }
@@ -315,6 +326,9 @@ void Scene::validate() const {
         c.ref(e + ".emissiveTexture", m.emissiveTexture, TextureUsage::Color);
         c.ref(e + ".specularTexture", m.specularTexture, TextureUsage::Data, 3);
         c.ref(e + ".specularColorTexture", m.specularColorTexture, TextureUsage::Color);
+        c.ref(e + ".clearcoatTexture", m.clearcoatTexture, TextureUsage::Data, 0);
+        c.ref(e + ".clearcoatRoughnessTexture", m.clearcoatRoughnessTexture, TextureUsage::Data, 1);
+        c.ref(e + ".clearcoatNormal", m.clearcoatNormal.texture, TextureUsage::Normal);
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
         const Node& n = nodes[i];

@@ -99,6 +99,32 @@ glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 base
     return brdfCosine(n, v, l, baseColor, metallic, roughness) * (kPi * intensity);
 }
 
+float clearcoatFresnel(float VoH) {
+    float m = 1.0f - std::clamp(VoH, 0.0f, 1.0f);
+    float m2 = m * m;
+    return kClearcoatF0 + (1.0f - kClearcoatF0) * (m2 * m2 * m);
+}
+
+float clearcoatSpecularCosine(glm::vec3 nc, glm::vec3 v, glm::vec3 l, float roughness) {
+    float NoL = glm::dot(nc, l), NoV = glm::dot(nc, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return 0.0f;
+    glm::vec3 h = glm::normalize(v + l);
+    float NoH = std::clamp(glm::dot(nc, h), 0.0f, 1.0f);
+    float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+    float alpha = ggxAlpha(roughness);
+    return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * clearcoatFresnel(VoH) * NoL;
+}
+
+glm::vec3 clearcoatLayer(glm::vec3 base, float clearcoat, float NcoV, glm::vec3 coat) {
+    return base * (1.0f - clearcoat * clearcoatFresnel(NcoV)) + clearcoat * coat;
+}
+
+glm::vec3 brdfCosineClearcoat(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                              float roughness, glm::vec4 dielectric, glm::vec2 coat) {
+    glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+    return clearcoatLayer(base, coat.x, glm::dot(nc, v), glm::vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
+}
+
 glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
                                    float roughness, glm::vec4 dielectric, glm::vec3 intensity) {
     return brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric) * (kPi * intensity);

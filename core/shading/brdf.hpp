@@ -31,6 +31,15 @@ glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 ba
                              float roughness, glm::vec4 dielectric);
 glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
                                    float roughness, glm::vec4 dielectric, glm::vec3 intensity);
+// KHR_materials_clearcoat (shaders/common/brdf.glsl): the coat's Schlick Fresnel (F0 0.04), its GGX lobe times the
+// cosine about the coat normal nc (without the strength), the layering base (1 - c Fc(nc.v)) + c coat, and the
+// coated brdfCosineSpecular (coat = strength, perceptual roughness).
+inline constexpr float kClearcoatF0 = 0.04f;
+float clearcoatFresnel(float VoH);
+float clearcoatSpecularCosine(glm::vec3 nc, glm::vec3 v, glm::vec3 l, float roughness);
+glm::vec3 clearcoatLayer(glm::vec3 base, float clearcoat, float NcoV, glm::vec3 coat);
+glm::vec3 brdfCosineClearcoat(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                              float roughness, glm::vec4 dielectric, glm::vec2 coat);
 // brdfCosine with the diffuse colour and F0 given apart (shaders/common/brdf.glsl).
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness);
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness);

@@ -45,8 +45,9 @@ NodeSchema schema() {
         attachment("velocity", VK_FORMAT_R16G16_SFLOAT, "Screen motion in pixels, this frame minus last (camera and object, no jitter)"),
         attachment("emissive", VK_FORMAT_R16G16B16A16_SFLOAT,
                    "rgb: emissive radiance plus, where lightmapped, the baked diffuse (linear, cd/m²); a: 1 where "
-                   "lightmapped, else 0"),
-        attachment("depth", VK_FORMAT_D32_SFLOAT, "Hardware depth, reverse Z (1 near, 0 infinitely far)", Usage::DepthAttachment),
+                   "lightmapped, else 0, plus 2 × (32 × ⌊31 × clear coat + ½⌋ + ⌊31 × coat roughness + ½⌋)"),
+        attachment("depth", VK_FORMAT_D32_SFLOAT, "Hardware depth, reverse Z (1 near, 0 infinitely far)",
+                   Usage::DepthAttachment),
     };
     s.params = {
         {"toksvig", ParamType::Bool, true, {}, {}, {}, "Reduce shininess by the averaged normal's length (off: plain normal mapping, for A/B)"},

@@ -118,11 +118,15 @@ vec3 sampleUniformSphere(vec2 u) {
     return vec3(r * std::cos(phi), r * std::sin(phi), z);
 }
 
+// pathtrace/sampling.glsl: KHR_materials_clearcoat's lobe chosen first with coatProbability (0 without a coat).
 struct BrdfLobes {
     vec3 baseColor;
     float metallic;
     float roughness;
     float specularProbability;
+    float coatProbability = 0.0f;
+    float coatRoughness = 0.0f;
+    vec3 coatNormal{0.0f};
 };
 
 BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, glm::vec4 dielectric, float NoV) {
@@ -137,7 +141,18 @@ BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, glm::vec4 d
     return b;
 }
 
-float brdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
+void addClearcoatLobe(BrdfLobes& b, vec2 coat, vec3 nc, vec3 v) {
+    b.coatNormal = nc;
+    b.coatRoughness = coat.y;
+    if (coat.x <= 0.0f) return;
+    float NcoV = std::clamp(glm::dot(nc, v), 0.0f, 1.0f);
+    float w = coat.x * clearcoatFresnel(NcoV);
+    float base = luminance(schlickFresnel(specularF0(b.baseColor, b.metallic), NcoV)) +
+                 luminance(diffuseAlbedo(b.baseColor, b.metallic));
+    b.coatProbability = std::clamp(w / std::max(w + (1.0f - w) * base, 1e-6f), 0.05f, 0.95f);
+}
+
+float baseBrdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
     float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
     if (NoL <= 0.0f || NoV <= 0.0f) return 0.0f;
     vec3 h = glm::normalize(v + l);
@@ -145,7 +160,26 @@ float brdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
     return b.specularProbability * spec + (1.0f - b.specularProbability) * NoL / kPi;
 }
 
+float brdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
+    float base = baseBrdfPdf(b, n, v, l);
+    if (b.coatProbability <= 0.0f) return base;
+    const vec3 nc = b.coatNormal;
+    float NcoL = glm::dot(nc, l), NcoV = glm::dot(nc, v), coat = 0.0f;
+    if (NcoL > 0.0f && NcoV > 0.0f)
+        coat = ggxVndfPdf(NcoV, std::clamp(glm::dot(nc, glm::normalize(v + l)), 0.0f, 1.0f), ggxAlpha(b.coatRoughness));
+    return b.coatProbability * coat + (1.0f - b.coatProbability) * base;
+}
+
 bool sampleBrdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 u, vec3& l) {
+    if (b.coatProbability > 0.0f) {
+        if (u.x < b.coatProbability) {
+            glm::mat3 cf = basisAround(b.coatNormal);
+            vec3 h = cf * sampleGgxVndf(glm::transpose(cf) * v, ggxAlpha(b.coatRoughness), vec2(u.y, u.z));
+            l = glm::reflect(-v, h);
+            return glm::dot(n, l) > 0.0f;
+        }
+        u.x = (u.x - b.coatProbability) / (1.0f - b.coatProbability);
+    }
     glm::mat3 frame = basisAround(n);
     if (u.x < b.specularProbability) {
         vec3 vl = glm::transpose(frame) * v;
@@ -324,6 +358,22 @@ struct Materials {
         return sample(r.info.x, refUv(r, uv0, uv1));
     }
     static float channelOf(vec4 t, int c) { return c == 0 ? t.r : c == 1 ? t.g : c == 2 ? t.b : t.a; }
+
+    // scene.glsl materialClearcoat / materialClearcoatNormal: KHR_materials_clearcoat's strength and roughness, and
+    // the coat's tangent-space normal.
+    vec2 materialClearcoat(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
+        vec2 c(m.clearcoat.x, m.clearcoat.y);
+        if (m.clearcoatRef.info.x >= 0) c.x *= sampleRef(m.clearcoatRef, uv0, uv1).r;
+        if (m.clearcoatRoughnessRef.info.x >= 0) c.y *= sampleRef(m.clearcoatRoughnessRef, uv0, uv1).g;
+        return glm::clamp(c, 0.0f, 1.0f);
+    }
+    vec3 materialClearcoatNormal(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
+        if (m.clearcoatNormalRef.info.x < 0) return vec3(0.0f, 0.0f, 1.0f);
+        vec3 n = vec3(sampleRef(m.clearcoatNormalRef, uv0, uv1)) * 2.0f - 1.0f;
+        n.x *= m.clearcoat.z;
+        n.y *= m.clearcoat.z;
+        return n;
+    }
 
     // scene.glsl materialSpecular: KHR_materials_specular's colour (rgb) and strength (a).
     vec4 materialSpecular(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
@@ -564,6 +614,17 @@ struct CpuPathTracer::Impl {
         float NoV = glm::dot(N, -direction);
         if (NoV < 0.01f) N = glm::normalize(N - direction * (0.01f - NoV));
         s.normal = N;
+        s.coat = m.optics.z > 0.5f ? vec2(0.0f) : materials.materialClearcoat(m, uv0, uv1);
+        s.coatNormal = N;
+        if (s.coat.x > 0.0f) { // the same frame about the coat's own tangent-space normal
+            vec3 c = materials.materialClearcoatNormal(m, uv0, uv1);
+            vec3 cts = glm::length(c) > 1e-6f ? glm::normalize(c) : vec3(0.0f, 0.0f, 1.0f);
+            vec3 C = glm::normalize(t * cts.x + b * cts.y + n * cts.z);
+            if (backFace) C = -C;
+            float CoV = glm::dot(C, -direction);
+            if (CoV < 0.01f) C = glm::normalize(C - direction * (0.01f - CoV));
+            s.coatNormal = C;
+        }
 
         s.baseColor = vec3(l.albedo) * vec3(color);
         s.metallic = std::clamp(l.metallic, 0.0f, 1.0f);
@@ -618,11 +679,14 @@ struct CpuPathTracer::Impl {
             vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
             BrdfLobes lobes =
                 brdfLobes(s.baseColor, s.metallic, s.roughness, s.dielectric, std::clamp(glm::dot(n, v), 0.0f, 1.0f));
+            addClearcoatLobe(lobes, s.coat, s.coatNormal, v);
             vec3 weight = throughput * s.cavity;
 
             if (sun && glm::dot(ng, sunDir) > 0.0f) {
-                vec3 f = brdfCosineSpecular(n, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric);
-                if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, sunDir), sunDir, rays))
+                vec3 f = brdfCosineClearcoat(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness,
+                                             s.dielectric, s.coat);
+                if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) &&
+                    !occluded(offsetRay(s.position, ng, sunDir), sunDir, rays))
                     radiance += weight * f * sunE;
             }
             if (envSampling) {
@@ -631,7 +695,8 @@ struct CpuPathTracer::Impl {
                 vec3 l = env.sample(vec3(a, bc));
                 float pdf = env.pdf(l);
                 if (glm::dot(ng, l) > 0.0f && pdf > 0.0f) {
-                    vec3 f = brdfCosineSpecular(n, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric);
+                    vec3 f = brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness,
+                                                 s.dielectric, s.coat);
                     if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, l), l, rays))
                         radiance += weight * f * env.radiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
                 }
@@ -643,7 +708,10 @@ struct CpuPathTracer::Impl {
             if (!sampleBrdf(lobes, n, v, vec3(a, bc), l) || glm::dot(ng, l) <= 0.0f) break;
             float pdf = brdfPdf(lobes, n, v, l);
             if (pdf <= 0.0f) break;
-            throughput = weight * brdfCosineSpecular(n, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric) / pdf;
+            throughput =
+                weight *
+                brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat) /
+                pdf;
             brdfPdfPrev = pdf;
             if (bounce >= 2u) {
                 float q = std::min(std::max(std::max(throughput.r, throughput.g), throughput.b), 0.95f);

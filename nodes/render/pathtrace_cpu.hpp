@@ -64,6 +64,10 @@ struct CpuSurface {
     // The dielectric's Fresnel F0 (rgb) and F90 (a), KHR_materials_specular over F0 0.04 (core/shading
     // dielectricSpecular).
     glm::vec4 dielectric{0.04f, 0.04f, 0.04f, 1.0f};
+    // KHR_materials_clearcoat: strength and perceptual roughness (0, 0 without it), and the coat's shading normal
+    // (its own normal map, else the vertex normal; `normal` without a coat).
+    glm::vec2 coat{0.0f};
+    glm::vec3 coatNormal{0.0f};
 };
 
 class CpuPathTracer;

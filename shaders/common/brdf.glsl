@@ -136,6 +136,43 @@ vec3 shadeDirectionalSpecular(vec3 n, vec3 v, vec3 l, vec3 baseColor, float meta
     return brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric) * (kPi * intensity);
 }
 
+// KHR_materials_clearcoat [Khronos]: a dielectric coat of ior 1.5 (F0 0.04, F90 1) and strength c over the whole
+// material, with its own normal nc (clearcoatNormalTexture, else the interpolated vertex normal) and roughness:
+//     f = f_base (1 - c Fc(nc.v)) + c D V Fc(v.h)   (the glTF Sample Viewer's layering of the spec's fresnel_coat)
+// Fc is Schlick's with F0 = 0.04.
+const float kClearcoatF0 = 0.04;
+float clearcoatFresnel(float VoH) {
+    float m = 1.0 - clamp(VoH, 0.0, 1.0);
+    float m2 = m * m;
+    return kClearcoatF0 + (1.0 - kClearcoatF0) * (m2 * m2 * m);
+}
+
+// The coat's specular lobe times its cosine, c-less: D V Fc (nc.l), GGX of alpha = roughness^2 about nc. Zero when l
+// or v is below the coat.
+float clearcoatSpecularCosine(vec3 nc, vec3 v, vec3 l, float roughness) {
+    float NoL = dot(nc, l);
+    float NoV = dot(nc, v);
+    if (NoL <= 0.0 || NoV <= 0.0) return 0.0;
+    vec3 h = normalize(v + l);
+    float NoH = clamp(dot(nc, h), 0.0, 1.0);
+    float VoH = clamp(dot(v, h), 0.0, 1.0);
+    float alpha = ggxAlpha(roughness);
+    return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * clearcoatFresnel(VoH) * NoL;
+}
+
+// The layering: `base` (the uncoated material's reflected light, or its BRDF) seen through a coat of strength
+// `clearcoat` whose normal makes NcoV with the view, plus `coat` (the coat's own reflected light, c-less).
+vec3 clearcoatLayer(vec3 base, float clearcoat, float NcoV, vec3 coat) {
+    return base * (1.0 - clearcoat * clearcoatFresnel(NcoV)) + clearcoat * coat;
+}
+
+// brdfCosineSpecular under a clear coat: coat = (strength, perceptual roughness), nc the coat's unit normal.
+vec3 brdfCosineClearcoat(vec3 n, vec3 nc, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness,
+                         vec4 dielectric, vec2 coat) {
+    vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+    return clearcoatLayer(base, coat.x, dot(nc, v), vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
+}
+
 // Toksvig [Toksvig04]: a normal averaged over a footprint (mip-mapped without renormalising)
 // has length |Na| < 1; treat the spread as a Gaussian of angular variance (1 - |Na|) / |Na| and
 // widen the lobe. Mapping: GGX alpha to the Blinn-Phong exponent s = 2 / alpha^2 - 2,

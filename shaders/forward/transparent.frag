@@ -91,6 +91,20 @@ void main() {
     // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour
     // (no refraction offset, no blur by roughness).
     vec3 through = transmission * (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * baseColor;
+    // KHR_materials_clearcoat over all of it, with the coat's own normal: the base (and what passes through) seen
+    // through the coat, 1 - c Fc(nc.v), plus the coat's reflection of the sun, the lights and the sky.
+    vec2 coat = materialClearcoat(m, vUv0, vUv1, grads);
+    if (coat.x > 0.0) {
+        vec3 nc = shadingNormal(vNormal, vTangent, materialClearcoatNormal(m, vUv0, vUv1, grads), gl_FrontFacing);
+        vec3 coatLight = vec3(clearcoatSpecularCosine(nc, v, l, coat.y)) * sunE * visibility * cavity;
+        coatLight += shadePunctualClearcoat(world, nc, v, coat.y) * cavity;
+        coatLight += (baked ? volumeSpecular(volume, nc, v, vec3(kClearcoatF0), coat.y)
+                            : skySpecular(in_sky, sh, nc, v, vec3(kClearcoatF0), coat.y)) *
+                     occlusion;
+        float NcoV = dot(nc, v);
+        lit = clearcoatLayer(lit, coat.x, NcoV, coatLight);
+        through = clearcoatLayer(through, coat.x, NcoV, vec3(0.0));
+    }
     if (m.optics.z > 0.5) { // KHR_materials_unlit: the colour is the radiance, as through the G-buffer's emissive
         lit = baseColor * u.params.w;
         through = vec3(0.0);

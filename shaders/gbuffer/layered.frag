@@ -5,6 +5,7 @@
 #include "common/brdf.glsl"
 #include "common/octahedral.glsl"
 #include "gbuffer/unlit.glsl"
+#include "gbuffer/clearcoat_pack.glsl"
 
 // The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
 layout(location = 0) in vec3 vNormal;
@@ -81,5 +82,8 @@ void main() {
     outMaterial = vec4(coverage, 1.0 - specular, vColor.a, cavity);
     outVelocity = velocity;
     applyUnlit(m, outBase, outMaterial, emissive);
-    outEmissive = vec4(emissive, lightmapped);
+    // KHR_materials_clearcoat's strength and roughness packed with the lightmapped flag (gbuffer/clearcoat_pack.glsl);
+    // an unlit surface has no coat.
+    vec2 coat = m.optics.z > 0.5 ? vec2(0.0) : materialClearcoat(m, vUv0, vUv1, grads);
+    outEmissive = vec4(emissive, packClearcoatAlpha(lightmapped > 0.5, coat));
 }

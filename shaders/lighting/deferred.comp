@@ -36,6 +36,7 @@ layout(binding = 15) writeonly uniform image2D out_diffuse_indirect;
 #define VITRINE_SHADOW u.shadow
 #include "lighting/sun_shadow.glsl"
 #include "lighting/punctual.glsl"
+#include "gbuffer/clearcoat_pack.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -62,7 +63,9 @@ void main() {
     vec4 g2 = texelFetch(in_material, p, 0);
     vec4 emissiveLm = texelFetch(in_emissive, p, 0);
     vec3 emissive = emissiveLm.rgb;
-    bool lightmapped = emissiveLm.a > 0.5;
+    bool lightmapped;
+    // KHR_materials_clearcoat (strength, roughness) packed with the flag; the coat shades with the base normal n.
+    vec2 coat = unpackClearcoatAlpha(emissiveLm.a, lightmapped);
     vec3 n = octDecode(g0.xy);
     float viewDepth = g0.z;
     float roughness = roughnessFromShininess(g0.w);
@@ -113,6 +116,20 @@ void main() {
     }
     // Lightmapped pixels carry emission and baked diffuse together: emissive_scale leaves them as baked.
     vec3 color = direct + diffuse + specular + emissive * (lightmapped ? 1.0 : u.params.w);
+    // The clear coat over all of it: the base seen through the coat, 1 - c Fc(n.v), plus the coat's own
+    // reflection of the sun, the lights and the sky (F0 0.04), with the cavity and occlusion the base has.
+    if (coat.x > 0.0) {
+        vec3 coatDirect = vec3(clearcoatSpecularCosine(n, v, l, coat.y)) * sunE * visibility * cavity;
+        coatDirect += shadePunctualClearcoat(world, n, v, coat.y) * cavity;
+        vec3 coatSpecular = (baked ? volumeSpecular(volume, n, v, vec3(kClearcoatF0), coat.y)
+                                   : skySpecular(in_sky, sh, n, v, vec3(kClearcoatF0), coat.y)) *
+                            occlusion;
+        float NoV = dot(n, v);
+        color = clearcoatLayer(color, coat.x, NoV, coatDirect + coatSpecular);
+        specular = clearcoatLayer(specular, coat.x, NoV, coatSpecular);
+        diffuse = clearcoatLayer(diffuse, coat.x, NoV, vec3(0.0));
+        emissive = clearcoatLayer(emissive, coat.x, NoV, vec3(0.0));
+    }
     imageStore(out_color, p, vec4(min(color, vec3(kHalfMax)), 1.0));
     imageStore(out_specular_indirect, p, vec4(min(specular, vec3(kHalfMax)), 1.0));
     // The indirect diffuse alone (the twin of reference.diffuse_indirect): a lightmapped pixel's is its emissive

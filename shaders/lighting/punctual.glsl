@@ -36,4 +36,16 @@ vec3 shadePunctual(vec3 p, vec3 n, vec3 v, vec3 diffuseColor, vec3 f0, float f90
     return sum;
 }
 
+// The clear coat's share of every light (KHR_materials_clearcoat): its lobe about the coat normal nc, without the
+// coat's strength (common/brdf.glsl clearcoatSpecularCosine).
+vec3 shadePunctualClearcoat(vec3 p, vec3 nc, vec3 v, float roughness) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < VITRINE_LIGHTS.count.x; ++i) {
+        vec3 l;
+        vec3 e = punctualIlluminance(VITRINE_LIGHTS.lights[i], p, l);
+        sum += clearcoatSpecularCosine(nc, v, l, roughness) * e;
+    }
+    return sum;
+}
+
 #endif

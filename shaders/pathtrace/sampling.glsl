@@ -70,11 +70,16 @@ float ggxVndfPdf(float NoV, float NoH, float alpha) {
 // The BRDF of common/brdf.glsl, sampled as a mixture of its two lobes: GGX visible normals with
 // probability specularProbability, else cosine-weighted for Lambert. The pdf of a direction is the
 // mixture's (both lobes can produce every direction), so brdfCosine / pdf is the weight.
+// KHR_materials_clearcoat adds a third lobe, the coat's GGX about its own normal, chosen first with probability
+// coatProbability (0 without a coat: the two-lobe mixture as before, to the bit).
 struct BrdfLobes {
     vec3 baseColor;
     float metallic;
     float roughness;
     float specularProbability;
+    float coatProbability;
+    float coatRoughness;
+    vec3 coatNormal;
 };
 
 // dielectric: the surface's dielectric Fresnel (dielectricSpecular; (0.04, 0.04, 0.04, 1) without
@@ -88,10 +93,25 @@ BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, vec4 dielec
     float s = luminance(schlickFresnelF90(f0, specularF90(metallic, dielectric), NoV));
     float d = luminance(diffuseAlbedo(baseColor, metallic));
     b.specularProbability = max(s / max(s + d, 1e-6), 0.1); // 1 for metals: no diffuse lobe
+    b.coatProbability = 0.0;
+    b.coatRoughness = 0.0;
     return b;
 }
 
-float brdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
+// The coat's lobe in the mixture, chosen in proportion to its Fresnel-weighted strength c Fc(nc.v) against the base's
+// share (1 - c Fc) (s + d) of brdfLobes' estimates.
+void addClearcoatLobe(inout BrdfLobes b, vec2 coat, vec3 nc, vec3 v) {
+    b.coatNormal = nc;
+    b.coatRoughness = coat.y;
+    if (coat.x <= 0.0) return;
+    float w = coat.x * clearcoatFresnel(clamp(dot(nc, v), 0.0, 1.0));
+    vec3 f0 = specularF0(b.baseColor, b.metallic);
+    float base = luminance(schlickFresnel(f0, clamp(dot(nc, v), 0.0, 1.0))) +
+                 luminance(diffuseAlbedo(b.baseColor, b.metallic));
+    b.coatProbability = clamp(w / max(w + (1.0 - w) * base, 1e-6), 0.05, 0.95);
+}
+
+float baseBrdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
     float NoL = dot(n, l), NoV = dot(n, v);
     if (NoL <= 0.0 || NoV <= 0.0) return 0.0;
     vec3 h = normalize(v + l);
@@ -99,8 +119,28 @@ float brdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
     return b.specularProbability * spec + (1.0 - b.specularProbability) * NoL / kPi;
 }
 
+float brdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
+    float base = baseBrdfPdf(b, n, v, l);
+    if (b.coatProbability <= 0.0) return base;
+    vec3 nc = b.coatNormal;
+    float NcoL = dot(nc, l), NcoV = dot(nc, v);
+    float coat = 0.0;
+    if (NcoL > 0.0 && NcoV > 0.0)
+        coat = ggxVndfPdf(NcoV, clamp(dot(nc, normalize(v + l)), 0.0, 1.0), ggxAlpha(b.coatRoughness));
+    return b.coatProbability * coat + (1.0 - b.coatProbability) * base;
+}
+
 // A direction from the mixture (world space); false when it fell below the surface.
 bool sampleBrdf(BrdfLobes b, vec3 n, vec3 v, vec3 u, out vec3 l) {
+    if (b.coatProbability > 0.0) {
+        if (u.x < b.coatProbability) { // the coat's lobe, about its own normal
+            mat3 cf = basisAround(b.coatNormal);
+            vec3 h = cf * sampleGgxVndf(transpose(cf) * v, ggxAlpha(b.coatRoughness), u.yz);
+            l = reflect(-v, h);
+            return dot(n, l) > 0.0;
+        }
+        u.x = (u.x - b.coatProbability) / (1.0 - b.coatProbability);
+    }
     mat3 frame = basisAround(n);
     if (u.x < b.specularProbability) {
         vec3 vl = transpose(frame) * v;

@@ -29,6 +29,8 @@ struct PathSurface {
     float cavity;
     vec3 emissive;   // cd/m^2, before the node's emissive scale
     vec4 dielectric; // the dielectric's Fresnel F0 (rgb) and F90 (a): common/brdf.glsl dielectricSpecular
+    vec2 coat;       // KHR_materials_clearcoat: strength, perceptual roughness (0, 0 without it)
+    vec3 coatNormal; // the coat's shading normal (its own normal map, else the vertex normal); `normal` without a coat
 };
 
 vec3 vertexVec3(uint v, uint offset) {
@@ -104,6 +106,17 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     float NoV = dot(N, -direction);
     if (NoV < 0.01) N = normalize(N - direction * (0.01 - NoV));
     s.normal = N;
+    s.coat = m.optics.z > 0.5 ? vec2(0.0) : materialClearcoat(m, uv0, uv1, lod0);
+    s.coatNormal = N;
+    if (s.coat.x > 0.0) { // the same frame about the coat's own tangent-space normal
+        vec3 c = materialClearcoatNormal(m, uv0, uv1, lod0);
+        vec3 cts = length(c) > 1e-6 ? normalize(c) : vec3(0.0, 0.0, 1.0);
+        vec3 C = normalize(t * cts.x + b * cts.y + n * cts.z);
+        if (backFace) C = -C;
+        float CoV = dot(C, -direction);
+        if (CoV < 0.01) C = normalize(C - direction * (0.01 - CoV));
+        s.coatNormal = C;
+    }
 
     s.baseColor = l.albedo.rgb * color.rgb;
     s.metallic = clamp(l.metallic, 0.0, 1.0);

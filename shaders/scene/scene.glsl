@@ -132,6 +132,24 @@ vec4 materialSpecular(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
     return s;
 }
 
+// KHR_materials_clearcoat at a surface point: x the coat's strength (clearcoatFactor x clearcoatTexture.r), y its
+// perceptual roughness (clearcoatRoughnessFactor x clearcoatRoughnessTexture.g); (0, 0) without the extension.
+vec2 materialClearcoat(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
+    vec2 c = m.clearcoat.xy;
+    if (m.clearcoatRef.info.x >= 0) c.x *= sampleRef(m.clearcoatRef, uv0, uv1, g).r;
+    if (m.clearcoatRoughnessRef.info.x >= 0) c.y *= sampleRef(m.clearcoatRoughnessRef, uv0, uv1, g).g;
+    return clamp(c, 0.0, 1.0);
+}
+
+// The coat's tangent-space normal: clearcoatNormalTexture scaled as a layer's normal map, else (0, 0, 1), the
+// interpolated vertex normal (the spec: no normal mapping of the coat without its own map).
+vec3 materialClearcoatNormal(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
+    if (m.clearcoatNormalRef.info.x < 0) return vec3(0.0, 0.0, 1.0);
+    vec3 n = sampleRef(m.clearcoatNormalRef, uv0, uv1, g).xyz * 2.0 - 1.0;
+    n.xy *= m.clearcoat.z;
+    return n;
+}
+
 // The five blended parameters of a surface point. `normal` is tangent space and NOT normalised: its
 // length is below 1 where a mip averaged disagreeing normals (Toksvig).
 struct LayeredSurface {

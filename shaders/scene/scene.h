@@ -57,6 +57,13 @@ struct GpuMaterial {
     vec4 specular;
     GpuTexRef specularRef;
     GpuTexRef specularColorRef;
+    // KHR_materials_clearcoat (0 without it): x: clearcoatFactor, y: clearcoatRoughnessFactor, z: the coat normal
+    // map's scale, w: 0. The textures multiply x (clearcoatRef's red) and y (clearcoatRoughnessRef's green);
+    // clearcoatNormalRef is a tangent-space normal map as a layer's. scene.glsl materialClearcoat.
+    vec4 clearcoat;
+    GpuTexRef clearcoatRef;
+    GpuTexRef clearcoatRoughnessRef;
+    GpuTexRef clearcoatNormalRef;
 };
 
 struct GpuInstance {
@@ -97,7 +104,7 @@ VITRINE_PUSH_END(draw)
 #ifdef __cplusplus
 static_assert(sizeof(GpuTexRef) == 48);
 static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
-static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48);
+static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48 + 16 + 3 * 48);
 static_assert(sizeof(GpuInstance) == 192);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
 static_assert(sizeof(SceneDrawPush) == 96);

@@ -138,5 +138,31 @@ TEST_F(GltfMaterials, SpecularStrengthReachesTheGbuffer) {
     EXPECT_EQ(texel(plain, pixelAt(1, 0)).y, 0.0f);
 }
 
+// clearcoat.gltf: KHR_materials_clearcoat's strength c and roughness r reach the G-buffer packed into the emissive
+// alpha (gbuffer/clearcoat_pack.glsl) as 2 (32 q(c) + q(r)), q(x) = floor(31 x + 0.5), worked out here from the values
+// the file states; fp16 holds these integers exactly. The textured quadrant's texels multiply the factors by the red
+// (strength) and green (roughness) channels. A material without the extension keeps alpha 0 (not lightmapped).
+TEST_F(GltfMaterials, ClearcoatReachesTheGbufferEmissiveAlpha) {
+    json want = expected("clearcoat.gltf");
+    auto pack = [](double c, double r) { return 2.0 * (32.0 * std::floor(31.0 * c + 0.5) + std::floor(31.0 * r + 0.5)); };
+    const Image& emissive = gbuffer("clearcoat.gltf").at("emissive");
+    const glm::dvec2 centres[] = {{-1, 1}, {1, 1}, {-1, -1}};
+    for (int i = 0; i < 3; ++i) {
+        glm::vec4 got = texel(emissive, pixelAt(centres[i].x, centres[i].y));
+        double c = want["clearcoat"][i].get<double>(), r = want["roughness"][i].get<double>();
+        std::printf("clearcoat %s: emissive.a %.1f\n", want["quadrants"][i].get<std::string>().c_str(), got.w);
+        EXPECT_EQ(got.w, static_cast<float>(pack(c, r))) << i;
+        EXPECT_EQ(glm::vec3(got), glm::vec3(0.0f)) << i;
+    }
+    for (int t = 0; t < 4; ++t) {
+        float got = texel(emissive, pixelAt(0.5 + (t % 2), -0.5 - (t / 2))).w;
+        double c = want["texels_clearcoat"][t].get<double>(), r = want["texels_roughness"][t].get<double>();
+        std::printf("clearcoat texel %d: emissive.a %.1f\n", t, got);
+        EXPECT_EQ(got, static_cast<float>(pack(c, r))) << "texel " << t;
+    }
+    const Image& plain = gbuffer("variants.gltf").at("emissive");
+    EXPECT_EQ(texel(plain, pixelAt(-1, 0)).w, 0.0f);
+}
+
 } // namespace
 } // namespace vitrine::test

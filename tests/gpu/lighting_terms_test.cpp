@@ -148,6 +148,67 @@ TEST_F(LightingTerms, SpecularExtensionStrengthScalesTheGrazingSunSpecular) {
     EXPECT_GE(grazing, 200);
 }
 
+// KHR_materials_clearcoat in lighting.deferred: the grazing-sun ground again, black and rough (shininess 0.55) under a
+// full coat (c = 1) of roughness 16/31, a value the G-buffer's 5-bit packing keeps exactly. Expected: core/shading's
+// brdfCosineClearcoat (checked against the Khronos layering in shading.Brdf.ClearcoatMatchesTheKhronosLayering) x E,
+// the coat's normal being the base's (the deferred path's limitation; a flat plane here, so no difference). The coat's
+// smoother lobe makes a glare several times the base's, and at grazing incidence Fc(n.v) dims the base: the bound is
+// 2 % as above, and the coat must matter (the uncoated ground is > 2x off somewhere).
+TEST_F(LightingTerms, ClearcoatGroundMatchesTheCpuLayering) {
+    const int W = 64, H = 64;
+    const float shininess = 0.55f, coatRoughness = 16.0f / 31.0f;
+    const double sunElevation = 12.0 * kPi / 180.0;
+    const double sunScale = 0.1;
+    const float groundHalf = 40.0f;
+
+    SceneBuilder b("grazing_clearcoat");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
+    uint32_t black = b.material("black", glm::vec3(0.0f), 0.0f, shininess);
+    b.s.materials[black].clearcoat = 1.0f; // written into the .glb as KHR_materials_clearcoat and read back
+    b.s.materials[black].clearcoatRoughness = coatRoughness;
+    b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, black)));
+    b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
+    b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
+    auto glb = b.write();
+
+    json nodes = baseNodes(glb);
+    nodes["direct"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", sunScale}}, false);
+    auto out = runGraph(graph(nodes, {{"direct", "direct.color"}, {"sh", "sky.sh"}}, W, H));
+    const Image& direct = out.at("direct");
+    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
+    const float roughness = shading::roughnessFromShininess(shininess);
+
+    Pinhole cam(b.s, W, H);
+    int checked = 0;
+    double worst = 0.0, coatMatters = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= 0.0) continue;
+            glm::dvec3 p = cam.position - cam.position.y / d.y * d;
+            if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
+            const glm::vec3 n(0, 1, 0), v(-d), lf(l);
+            glm::dvec3 expected = glm::dvec3(shading::brdfCosineClearcoat(n, n, v, lf, glm::vec3(0.0f), 0.0f, roughness,
+                                                                          plain, glm::vec2(1.0f, coatRoughness))) *
+                                  sunE;
+            if (expected.g < 1.0) continue;
+            ++checked;
+            glm::dvec3 got = rgb(direct, x, y);
+            double e = relErr(got, expected);
+            worst = std::max(worst, e);
+            glm::dvec3 uncoated = cpuSun({0, 1, 0}, v, l, glm::vec3(0.0f), 0.0f, shininess, sunE);
+            coatMatters = std::max(coatMatters, expected.g / std::max(uncoated.g, 1e-6));
+            EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << ": " << got.g << " vs " << expected.g;
+        }
+    std::printf("KHR_materials_clearcoat glare: %d pixels, max relative error %.2g, coated / uncoated up to %.1f\n",
+                checked, worst, coatMatters);
+    EXPECT_GE(checked, 300);
+    EXPECT_GT(coatMatters, 2.0);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct SphereMaterial {

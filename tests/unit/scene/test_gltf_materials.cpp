@@ -1,7 +1,8 @@
 // glTF material extensions on the corpus tests/data/gltf/corpus/ (written by make_corpus.py, validated by ctest
 // gltf.validator; issue #29 item 4): KHR_materials_pbrSpecularGlossiness converted to metallic-roughness against the
 // values worked out by hand in the file's asset.extras.expect and against the specular-glossiness model itself,
-// KHR_materials_emissive_strength, KHR_materials_variants, KHR_materials_specular (factors, textures, errors, export),
+// KHR_materials_emissive_strength, KHR_materials_variants, KHR_materials_specular and KHR_materials_clearcoat (factors,
+// textures, errors, export),
 // and the material extensions vitrine ignores with a warning.
 
 #include "core/scene/gltf.hpp"
@@ -217,11 +218,10 @@ TEST(GltfMaterials, MaterialVariantSelectsEachPrimitivesMapping) {
 TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
     std::vector<std::string> warnings;
     Scene s = loadGltf(corpus("ignored_material_extensions.gltf"), warnings);
-    const std::pair<const char*, const char*> expectations[] = {{"KHR_materials_clearcoat", "clear coat"},
-                                                                {"KHR_materials_sheen", "sheen"},
+    const std::pair<const char*, const char*> expectations[] = {{"KHR_materials_sheen", "sheen"},
                                                                 {"KHR_materials_iridescence", "iridescence"},
                                                                 {"KHR_materials_volume", "attenuationColor"}};
-    ASSERT_EQ(warnings.size(), 4u);
+    ASSERT_EQ(warnings.size(), 3u);
     for (const auto& [name, what] : expectations) {
         size_t n = std::count_if(warnings.begin(), warnings.end(),
                                  [&](const std::string& w) { return w.find(name) != std::string::npos; });
@@ -238,8 +238,8 @@ TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
     // The transmission next to the volume is read.
     EXPECT_EQ(byName(s, "thick_glass").transmission, 1.0f);
     test::expectUserError([&] { loadGltfReporting(corpus("ignored_material_extensions.gltf"), true); },
-                          {"4 warnings, which strict loading", "KHR_materials_clearcoat", "KHR_materials_sheen",
-                           "KHR_materials_iridescence", "KHR_materials_volume"});
+                          {"3 warnings, which strict loading", "KHR_materials_sheen", "KHR_materials_iridescence",
+                           "KHR_materials_volume"});
 }
 
 // KHR_materials_specular is read, not warned about: factors, the two textures (alpha as data, rgb as sRGB colour),
@@ -313,4 +313,81 @@ TEST(GltfMaterials, SpecularExtensionSurvivesExport) {
 }
 
 } // namespace
+// KHR_materials_clearcoat is read, not warned about: the factors, the three textures (strength and roughness as data
+// with their KHR_texture_transform, the coat normal map with its scale), and a factor of 0 kept as authored.
+TEST(GltfMaterials, ClearcoatExtensionIsReadWithoutWarnings) {
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(corpus("clearcoat.gltf"), warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    test::Json want = expected("clearcoat.gltf");
+    const char* names[] = {"full", "half", "zero", "textured"};
+    for (int i = 0; i < 4; ++i) {
+        const Material& m = byName(s, names[i]);
+        SCOPED_TRACE(names[i]);
+        EXPECT_EQ(m.clearcoat, want["clearcoat"][i].get<float>());
+        EXPECT_EQ(m.clearcoatRoughness, want["roughness"][i].get<float>());
+        EXPECT_EQ(m.clearcoatTexture.valid(), i == 3);
+        EXPECT_EQ(m.clearcoatRoughnessTexture.valid(), i == 3);
+        EXPECT_EQ(m.clearcoatNormal.texture.valid(), i == 3);
+    }
+    EXPECT_FALSE(byName(s, "zero").hasClearcoat());
+    EXPECT_TRUE(byName(s, "half").hasClearcoat());
+    const Material& t = byName(s, "textured");
+    EXPECT_EQ(s.textures[t.clearcoatTexture.texture].usage, TextureUsage::Data);
+    EXPECT_EQ(s.textures[t.clearcoatRoughnessTexture.texture].usage, TextureUsage::Data);
+    EXPECT_EQ(s.textures[t.clearcoatNormal.texture.texture].usage, TextureUsage::Normal);
+    EXPECT_EQ(t.clearcoatNormal.scale, 0.5f);
+    EXPECT_EQ(t.clearcoatTexture.transform.scale, glm::vec2(1.0f));
+    EXPECT_TRUE(usesNormalMap(t)); // the coat's normal map needs the vertices' tangents
+    EXPECT_FALSE(usesNormalMap(byName(s, "full")));
+    EXPECT_FALSE(Material{}.hasClearcoat());
+    // Supported, so a file may require it.
+    test::Json doc = test::readJson(corpus("clearcoat.gltf"));
+    doc["extensionsRequired"] = {"KHR_materials_clearcoat"};
+    auto required = test::scratchDir() / "clearcoat_required.gltf";
+    test::writeText(required, doc.dump());
+    EXPECT_EQ(loadGltf(required, warnings).materials, s.materials);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+}
+
+TEST(GltfMaterials, ClearcoatExtensionOutOfRangeIsAnErrorWithItsPath) {
+    auto file = test::scratchDir() / "clearcoat_bad.gltf";
+    for (const char* key : {"clearcoatFactor", "clearcoatRoughnessFactor"}) {
+        for (double bad : {1.5, -0.25}) {
+            test::Json doc = test::readJson(corpus("clearcoat.gltf"));
+            doc["materials"][1]["extensions"]["KHR_materials_clearcoat"][key] = bad;
+            test::writeText(file, doc.dump());
+            test::expectUserError([&] { loadGltf(file); },
+                                  {"clearcoat_bad.gltf",
+                                   std::string("materials[1].extensions.KHR_materials_clearcoat.") + key,
+                                   "expected a number in [0, 1]"});
+        }
+    }
+    test::Json doc = test::readJson(corpus("clearcoat.gltf"));
+    doc["materials"][3]["extensions"]["KHR_materials_clearcoat"]["clearcoatNormalTexture"]["index"] = 7;
+    test::writeText(file, doc.dump());
+    test::expectUserError([&] { loadGltf(file); },
+                          {"materials[3].extensions.KHR_materials_clearcoat.clearcoatNormalTexture.index"});
+}
+
+// exportGlb writes the extension back: the materials survive a round trip.
+TEST(GltfMaterials, ClearcoatExtensionSurvivesExport) {
+    Scene s = loadGltf(corpus("clearcoat.gltf"));
+    auto file = test::scratchDir() / "clearcoat_roundtrip.glb";
+    exportGlb(s, file);
+    std::vector<std::string> warnings;
+    Scene back = loadGltf(file, warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    for (const char* name : {"full", "half", "zero", "textured"}) {
+        const Material& a = byName(s, name);
+        const Material& b = byName(back, name);
+        EXPECT_EQ(a.clearcoat, b.clearcoat) << name;
+        EXPECT_EQ(a.clearcoatRoughness, b.clearcoatRoughness) << name;
+        EXPECT_EQ(a.clearcoatTexture.valid(), b.clearcoatTexture.valid()) << name;
+        EXPECT_EQ(a.clearcoatRoughnessTexture.valid(), b.clearcoatRoughnessTexture.valid()) << name;
+        EXPECT_EQ(a.clearcoatNormal.texture.valid(), b.clearcoatNormal.texture.valid()) << name;
+        EXPECT_EQ(a.clearcoatNormal.scale, b.clearcoatNormal.scale) << name;
+    }
+}
+
 } // namespace vitrine::scene

@@ -27,11 +27,14 @@ hand, written in the file's asset.extras.expect:
                        KHR_materials_emissive_strength 4, the right one without (G-buffer emissive 4x the right's).
   variants.gltf        KHR_materials_variants "red" and "blue" remapping the left quad's white material; the right quad
                        has no mapping and stays white whatever the variant.
-  ignored_material_extensions.gltf  KHR_materials_clearcoat, _sheen, _iridescence (material 0) and
+  ignored_material_extensions.gltf  KHR_materials_sheen, _iridescence (material 0) and
                        _volume with _transmission (material 1): vitrine warns once per ignored extension.
   specular.gltf        KHR_materials_specular: strength 0.4, strength 0, a tint alone, and a 2x2 texture read both as
                        specularTexture (alpha) and specularColorTexture (sRGB rgb), one quadrant each; the G-buffer's
                        material.y is 1 - strength (tests/gpu/gltf_materials_test.cpp).
+  clearcoat.gltf       KHR_materials_clearcoat: a full smooth coat, a half coat of roughness 0.3, a factor 0, and a
+                       coat textured by a 2x2 image (red: strength, green: roughness, with KHR_texture_transform) and a
+                       coat normal map; the G-buffer's emissive alpha packs them (tests/gpu/gltf_materials_test.cpp).
 Regenerate after editing: python3 tests/data/gltf/corpus/make_corpus.py
 """
 import base64
@@ -383,12 +386,10 @@ def variants_file():
 
 def ignored_material_extensions_file():
     b = Builder()
-    names = ["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_iridescence",
-             "KHR_materials_transmission", "KHR_materials_volume"]
+    names = ["KHR_materials_sheen", "KHR_materials_iridescence", "KHR_materials_transmission", "KHR_materials_volume"]
     b.doc["extensionsUsed"] = names
     b.doc["materials"] = [
         {"name": "coated", "extensions": {
-            "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.1},
             "KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessFactor": 0.5},
             "KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 400.0}}},
         {"name": "thick_glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
@@ -435,6 +436,48 @@ def specular_file():
     b.write("specular.gltf")
 
 
+def clearcoat_file():
+    """Quadrants (top-left, top-right, bottom-left, bottom-right) of a grey rough dielectric with
+    KHR_materials_clearcoat: clearcoatFactor 1 with roughness 0; clearcoatFactor 0.5 with roughness 0.3; factor 0 (no
+    coat); and a textured coat: clearcoatFactor 1 x the red channel and clearcoatRoughnessFactor 0.6 x the green
+    channel of a 2x2 image (nearest), read through KHR_texture_transform (scale 1, offset 0: the identity, so the
+    texels land on the quadrant's quarters as authored), plus a flat clearcoatNormalTexture of scale 0.5."""
+    b = Builder()
+    cc = "KHR_materials_clearcoat"
+    b.doc["extensionsUsed"] = [cc, "KHR_texture_transform"]
+    grey = {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0, "roughnessFactor": 0.5}
+    tt = {"KHR_texture_transform": {"offset": [0, 0], "scale": [1, 1]}}
+    b.doc["materials"] = [
+        {"name": "full", "pbrMetallicRoughness": grey, "extensions": {cc: {"clearcoatFactor": 1.0}}},
+        {"name": "half", "pbrMetallicRoughness": grey,
+         "extensions": {cc: {"clearcoatFactor": 0.5, "clearcoatRoughnessFactor": 0.3}}},
+        {"name": "zero", "pbrMetallicRoughness": grey, "extensions": {cc: {"clearcoatFactor": 0.0}}},
+        {"name": "textured", "pbrMetallicRoughness": grey,
+         "extensions": {cc: {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.6,
+                             "clearcoatTexture": {"index": 0, "extensions": tt},
+                             "clearcoatRoughnessTexture": {"index": 0, "extensions": tt},
+                             "clearcoatNormalTexture": {"index": 1, "scale": 0.5}}}}]
+    # Red 255, 128, 64, 0 (strength 1, 0.502, 0.251, 0); green 0, 255, 128, 255 (roughness 0.6 x that).
+    image = png_rgba(2, 2, [[255, 0, 0, 255], [128, 255, 0, 255], [64, 128, 0, 255], [0, 255, 0, 255]])
+    flat = png_rgba(1, 1, [[128, 128, 255, 255]])
+    b.doc["images"] = [{"name": "clearcoat", "mimeType": "image/png", "bufferView": b.view(image)},
+                       {"name": "clearcoat_normal", "mimeType": "image/png", "bufferView": b.view(flat)}]
+    b.doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"sampler": 0, "source": 0}, {"sampler": 0, "source": 1}]
+    meshes = [quad_mesh(b, c, 1.0, m, uvs=(m == 3), name=b.doc["materials"][m]["name"])
+              for m, c in enumerate([[-1, 1, 0], [1, 1, 0], [-1, -1, 0], [1, -1, 0]])]
+    # The coat normal map needs a tangent space (glTF: the file provides it when no base normal map is there).
+    b.doc["meshes"][3]["primitives"][0]["attributes"]["TANGENT"] = b.floats([[1.0, 0.0, 0.0, 1.0]] * 4, "VEC4",
+                                                                           False, 34962)
+    ortho_view(b, meshes)
+    b.doc["asset"]["extras"] = {"expect": {
+        "quadrants": ["top_left", "top_right", "bottom_left", "bottom_right"],
+        "clearcoat": [1.0, 0.5, 0.0, 1.0], "roughness": [0.0, 0.3, 0.0, 0.6],
+        "texels_clearcoat": [1.0, 128 / 255, 64 / 255, 0.0],
+        "texels_roughness": [0.0, 0.6, 0.6 * 128 / 255, 0.6]}}
+    b.write("clearcoat.gltf")
+
+
 def main():
     # Perspective: the marker sits at 60 % of the half-height to the right and 40 % up at depth 5, so in a square
     # frame it lands at NDC (0.6, -0.4) (Vulkan y down) when the vertical field of view is kept, and at x = 0.4
@@ -457,6 +500,7 @@ def main():
     variants_file()
     ignored_material_extensions_file()
     specular_file()
+    clearcoat_file()
 
 
 if __name__ == "__main__":
