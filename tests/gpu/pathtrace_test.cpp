@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 namespace vitrine::test {
 namespace {
@@ -341,24 +342,24 @@ PATHTRACE_TEST(DirectSunMatchesDeferredLighting) {
     }
 }
 
-// KHR_materials_specular in the tracers: a grey rough dielectric ground with strength k = 0.5 and colour
-// c = (1, 0.5, 0.25) lit by a sun 12° up in front of the camera (direct light only, sky off). By the extension's
-// closed form its specular is k (F0c + (1 - F0c)(1 - VoH)^5) D V with F0c = 0.04 c, which is k times the plain BRDF's
-// specular lobe with F0 = F0c (core/shading brdfCosineF0 with no diffuse, code the extension does not touch), plus
-// the Lambert base / pi. The plane's normal is exact and rays go through pixel centres: bound 1 % per channel where
-// the expected value is above 1 % of the brightest, and the glare's grazing pixels (VoH <= 0.3, where F90 = k
-// rather than 1 counts most) must be among them.
-PATHTRACE_TEST(SpecularExtensionDirectSunMatchesItsClosedForm) {
-    const int W = 64, H = 64;
-    const float shininess = 0.55f, k = 0.5f, groundHalf = 40.0f;
-    const glm::vec3 base(0.05f), color(1.0f, 0.5f, 0.25f);
+// The ground of the material-extension tests below: an 80 m quad of one material (made by `material`) seen from 1 m up,
+// lit by a sun 12° above the horizon in front of the camera (sun_scale 0.1), direct light only (sky off, one bounce),
+// one sample per pixel through its centre, so no noise.
+struct SunlitGround {
+    std::map<std::string, Image> out;
+    glm::dvec3 toSun, sunE;
+    // Every pixel that sees the ground at least 1 m inside its edge, with its view ray.
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> pixels;
+};
+
+SunlitGround traceSunlitGround(const std::string& name, int W, int H,
+                               const std::function<uint32_t(SceneBuilder&)>& material) {
+    const float groundHalf = 40.0f;
     const double sunElevation = 12.0 * kPi / 180.0, sunScale = 0.1;
-    SceneBuilder b("pt_specular_ext");
+    SceneBuilder b(name);
     std::vector<Tri> quad;
     addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
-    uint32_t m = b.material("tinted", base, 0.0f, shininess);
-    b.s.materials[m].specular = k;
-    b.s.materials[m].specularColor = color;
+    const uint32_t m = material(b);
     b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, m)));
     b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
     b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
@@ -367,38 +368,74 @@ PATHTRACE_TEST(SpecularExtensionDirectSunMatchesItsClosedForm) {
     nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
     nodes["pt"] = pathtraceNode(
         {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
-    auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
-    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
-    const glm::vec3 f0c = glm::min(0.04f * color, glm::vec3(1.0f));
-    const float roughness = shading::roughnessFromShininess(shininess);
+    SunlitGround g;
+    g.out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
+    g.toSun = glm::normalize(rgb(g.out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    g.sunE = rgb(g.out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
     Pinhole cam(b.s, W, H);
-    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
-    double brightest = 0.0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             glm::dvec3 d = cam.ray(x, y);
             if (d.y >= 0.0) continue;
             glm::dvec3 p = cam.position - cam.position.y / d.y * d;
             if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
-            glm::vec3 n(0, 1, 0), v(-d), lf(l);
-            glm::dvec3 spec(float(k) * shading::brdfCosineF0(n, v, lf, glm::vec3(0.0f), f0c, roughness));
-            glm::dvec3 diffuse = glm::dvec3(base) / kPi * std::max(0.0, glm::dot(glm::dvec3(n), l));
-            glm::dvec3 e = (spec + diffuse) * sunE;
-            expected.push_back({{x, y}, e});
-            brightest = std::max(brightest, e.r);
+            g.pixels.push_back({{x, y}, d});
         }
-    int checked = 0, grazing = 0;
+    return g;
+}
+
+// Checks the traced pixels against `expected` (per channel, relative, within `bound`) where the expected red is above
+// 1 % of the brightest; returns the pixels checked and the worst error.
+std::pair<int, double> expectPixels(const Image& traced, const std::vector<std::pair<glm::ivec2, glm::dvec3>>& expected,
+                                    double bound) {
+    double brightest = 0.0;
+    for (const auto& [px, e] : expected) brightest = std::max(brightest, e.r);
+    int checked = 0;
     double worst = 0.0;
     for (const auto& [px, e] : expected) {
         if (e.r < 0.01 * brightest) continue;
-        glm::dvec3 got = rgb(out.at("pt"), px.x, px.y);
+        glm::dvec3 got = rgb(traced, px.x, px.y);
         double err = relErr(got, e);
         worst = std::max(worst, err);
         ++checked;
-        glm::dvec3 v = -cam.ray(px.x, px.y);
-        if (glm::dot(v, glm::normalize(v + l)) <= 0.3) ++grazing;
-        EXPECT_LT(err, 0.01) << "pixel " << px.x << "," << px.y << ": " << got.r << " vs " << e.r;
+        EXPECT_LT(err, bound) << "pixel " << px.x << "," << px.y << ": " << got.r << " vs " << e.r;
+    }
+    return {checked, worst};
+}
+
+// KHR_materials_specular in the tracers: a grey rough dielectric ground with strength k = 0.5 and colour
+// c = (1, 0.5, 0.25) under the sun of traceSunlitGround. By the extension's closed form its specular is
+// k (F0c + (1 - F0c)(1 - VoH)^5) D V with F0c = 0.04 c, which is k times the plain BRDF's specular lobe with F0 = F0c
+// (core/shading brdfCosineF0 with no diffuse, code the extension does not touch), plus the Lambert base / pi. The
+// plane's normal is exact and rays go through pixel centres: bound 1 % per channel where the expected value is above
+// 1 % of the brightest, and the glare's grazing pixels (VoH <= 0.3, where F90 = k rather than 1 counts most) must be
+// among them.
+PATHTRACE_TEST(SpecularExtensionDirectSunMatchesItsClosedForm) {
+    const float shininess = 0.55f, k = 0.5f;
+    const glm::vec3 base(0.05f), color(1.0f, 0.5f, 0.25f);
+    const SunlitGround g = traceSunlitGround("pt_specular_ext", 64, 64, [&](SceneBuilder& b) {
+        uint32_t m = b.material("tinted", base, 0.0f, shininess);
+        b.s.materials[m].specular = k;
+        b.s.materials[m].specularColor = color;
+        return m;
+    });
+    const glm::vec3 f0c = glm::min(0.04f * color, glm::vec3(1.0f));
+    const float roughness = shading::roughnessFromShininess(shininess);
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    for (const auto& [px, d] : g.pixels) {
+        glm::vec3 n(0, 1, 0), v(-d), lf(g.toSun);
+        glm::dvec3 spec(float(k) * shading::brdfCosineF0(n, v, lf, glm::vec3(0.0f), f0c, roughness));
+        glm::dvec3 diffuse = glm::dvec3(base) / kPi * std::max(0.0, glm::dot(glm::dvec3(n), g.toSun));
+        expected.push_back({px, (spec + diffuse) * g.sunE});
+    }
+    const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
+    double brightest = 0.0;
+    for (const auto& [px, e] : expected) brightest = std::max(brightest, e.r);
+    int grazing = 0;
+    for (size_t i = 0; i < expected.size(); ++i) {
+        if (expected[i].second.r < 0.01 * brightest) continue;
+        glm::dvec3 v = -g.pixels[i].second;
+        if (glm::dot(v, glm::normalize(v + g.toSun)) <= 0.3) ++grazing;
     }
     std::printf("%s tracer, KHR_materials_specular ground: %d pixels (%d grazing), worst relative error %.4f\n",
                 gBackend, checked, grazing, worst);
@@ -408,60 +445,31 @@ PATHTRACE_TEST(SpecularExtensionDirectSunMatchesItsClosedForm) {
 
 // KHR_materials_clearcoat in the tracers, direct sun: the ground of the test above (grey 0.05, shininess 0.55) under a
 // coat of strength 0.8 and roughness 0.3: the closed form is core/shading brdfCosineClearcoat (checked against the
-// Khronos layering in shading.Brdf.ClearcoatMatchesTheKhronosLayering). One sample per pixel through its centre, sun
-// only, so no noise: bound 1 % per channel where the expected value is above 1 % of the brightest.
+// Khronos layering in shading.Brdf.ClearcoatMatchesTheKhronosLayering). Bound 1 % per channel where the expected value
+// is above 1 % of the brightest.
 PATHTRACE_TEST(ClearcoatDirectSunMatchesItsClosedForm) {
-    const int W = 64, H = 64;
-    const float shininess = 0.55f, groundHalf = 40.0f, c = 0.8f, coatRoughness = 0.3f;
+    const float shininess = 0.55f, c = 0.8f, coatRoughness = 0.3f;
     const glm::vec3 base(0.05f);
-    const double sunElevation = 12.0 * kPi / 180.0, sunScale = 0.1;
-    SceneBuilder b("pt_clearcoat");
-    std::vector<Tri> quad;
-    addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
-    uint32_t m = b.material("coated", base, 0.0f, shininess);
-    b.s.materials[m].clearcoat = c;
-    b.s.materials[m].clearcoatRoughness = coatRoughness;
-    b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, m)));
-    b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
-    b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
-    auto glb = b.write();
-    json nodes = baseNodes(glb);
-    nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
-    nodes["pt"] = pathtraceNode(
-        {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
-    auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
-    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const SunlitGround g = traceSunlitGround("pt_clearcoat", 64, 64, [&](SceneBuilder& b) {
+        uint32_t m = b.material("coated", base, 0.0f, shininess);
+        b.s.materials[m].clearcoat = c;
+        b.s.materials[m].clearcoatRoughness = coatRoughness;
+        return m;
+    });
     const float roughness = shading::roughnessFromShininess(shininess);
     const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
-    Pinhole cam(b.s, W, H);
     std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
-    double brightest = 0.0, coatMatters = 0.0;
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            glm::dvec3 d = cam.ray(x, y);
-            if (d.y >= 0.0) continue;
-            glm::dvec3 p = cam.position - cam.position.y / d.y * d;
-            if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
-            glm::vec3 n(0, 1, 0), v(-d), lf(l);
-            glm::dvec3 e = glm::dvec3(shading::brdfCosineClearcoat(n, n, v, lf, base, 0.0f, roughness, plain,
-                                                                   glm::vec2(c, coatRoughness))) *
-                           sunE;
-            glm::dvec3 uncoated = glm::dvec3(shading::brdfCosine(n, v, lf, base, 0.0f, roughness)) * sunE;
-            coatMatters = std::max(coatMatters, e.r / std::max(uncoated.r, 1e-9));
-            expected.push_back({{x, y}, e});
-            brightest = std::max(brightest, e.r);
-        }
-    int checked = 0;
-    double worst = 0.0;
-    for (const auto& [px, e] : expected) {
-        if (e.r < 0.01 * brightest) continue;
-        glm::dvec3 got = rgb(out.at("pt"), px.x, px.y);
-        double err = relErr(got, e);
-        worst = std::max(worst, err);
-        ++checked;
-        EXPECT_LT(err, 0.01) << "pixel " << px.x << "," << px.y << ": " << got.r << " vs " << e.r;
+    double coatMatters = 0.0;
+    for (const auto& [px, d] : g.pixels) {
+        glm::vec3 n(0, 1, 0), v(-d), lf(g.toSun);
+        glm::dvec3 e = glm::dvec3(shading::brdfCosineClearcoat(n, n, v, lf, base, 0.0f, roughness, plain,
+                                                               glm::vec2(c, coatRoughness))) *
+                       g.sunE;
+        glm::dvec3 uncoated = glm::dvec3(shading::brdfCosine(n, v, lf, base, 0.0f, roughness)) * g.sunE;
+        coatMatters = std::max(coatMatters, e.r / std::max(uncoated.r, 1e-9));
+        expected.push_back({px, e});
     }
+    const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
     std::printf("%s tracer, KHR_materials_clearcoat ground: %d pixels, worst relative error %.4f, coated / uncoated "
                 "up to %.1f\n",
                 gBackend, checked, worst, coatMatters);
@@ -498,7 +506,8 @@ PATHTRACE_TEST(ClearcoatFurnaceSphereReflectsItsAlbedo) {
                 double phi = 2.0 * kPi * (j + 0.5) / nphi;
                 glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
                             static_cast<float>(u));
-                sum += shading::brdfCosineClearcoat(n, n, v, l, glm::vec3(1.0f), 0.0f, 1.0f - shininess, plain,
+                sum += shading::brdfCosineClearcoat(n, n, v, l, glm::vec3(1.0f), 0.0f,
+                                                    shading::roughnessFromShininess(shininess), plain,
                                                     glm::vec2(1.0f, coatRoughness))
                            .g;
             }
