@@ -182,6 +182,22 @@ double relErr(glm::dvec3 a, glm::dvec3 b) {
     return e;
 }
 
+double directionalAlbedo(double NoV, int steps,
+                         const std::function<double(glm::vec3 n, glm::vec3 v, glm::vec3 l)>& brdfCosine) {
+    const glm::vec3 n(0, 0, 1), v(static_cast<float>(std::sqrt(1.0 - NoV * NoV)), 0.0f, static_cast<float>(NoV));
+    double sum = 0.0;
+    for (int i = 0; i < steps; ++i) {
+        double u = (i + 0.5) / steps, r = std::sqrt(1.0 - u * u);
+        for (int j = 0; j < steps; ++j) {
+            double phi = 2.0 * kPi * (j + 0.5) / steps;
+            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
+                        static_cast<float>(u));
+            sum += brdfCosine(n, v, l);
+        }
+    }
+    return sum * (1.0 / steps) * (2.0 * kPi / steps);
+}
+
 nlohmann::json lightingNode(nlohmann::json params, bool shadowMap) {
     nlohmann::json in = {{"normal", "gbuffer.normal"},     {"base_color", "gbuffer.base_color"},
                          {"material", "gbuffer.material"}, {"emissive", "gbuffer.emissive"},

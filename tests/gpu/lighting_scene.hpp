@@ -9,6 +9,7 @@
 #include "core/shading/sh.hpp"
 
 #include <filesystem>
+#include <functional>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -76,6 +77,11 @@ glm::dvec3 cpuSun(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, glm::vec3 base, floa
 
 // Largest per-channel error of a relative to b.
 double relErr(glm::dvec3 a, glm::dvec3 b);
+
+// Directional albedo at NoV of a BRDF x cosine (n = +Z, v in the xz plane): the integral of brdfCosine(n, v, l) over
+// the hemisphere of l, by the midpoint rule on `steps` x `steps` cells uniform in cos(theta) and phi.
+double directionalAlbedo(double NoV, int steps,
+                         const std::function<double(glm::vec3 n, glm::vec3 v, glm::vec3 l)>& brdfCosine);
 
 // A lighting.deferred node reading the nodes of baseNodes(); shadowMap adds a node "shadow".
 nlohmann::json lightingNode(nlohmann::json params, bool shadowMap);

@@ -97,20 +97,10 @@ double schlick(double f0, double cosine) {
 
 // Directional albedo of the shared BRDF (core/shading, the CPU mirror of brdf.glsl) for a view at NoV:
 // the integral of brdfCosine over the hemisphere, midpoint rule in (cos theta, phi), 256 x 256 cells.
-double directionalAlbedo(double NoV, glm::vec3 base, float metallic, float roughness) {
-    const int nu = 256, nphi = 256;
-    const glm::vec3 n(0, 0, 1), v(static_cast<float>(std::sqrt(1.0 - NoV * NoV)), 0.0f, static_cast<float>(NoV));
-    double sum = 0.0;
-    for (int i = 0; i < nu; ++i) {
-        double u = (i + 0.5) / nu, r = std::sqrt(1.0 - u * u);
-        for (int j = 0; j < nphi; ++j) {
-            double phi = 2.0 * kPi * (j + 0.5) / nphi;
-            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                        static_cast<float>(u));
-            sum += shading::brdfCosine(n, v, l, base, metallic, roughness).g;
-        }
-    }
-    return sum * (1.0 / nu) * (2.0 * kPi / nphi);
+double brdfAlbedo(double NoV, glm::vec3 base, float metallic, float roughness) {
+    return directionalAlbedo(NoV, 256, [&](glm::vec3 n, glm::vec3 v, glm::vec3 l) {
+        return shading::brdfCosine(n, v, l, base, metallic, roughness).g;
+    });
 }
 
 // White furnace: a white sphere alone under a uniform sky C. A white mirror metal returns C, a white
@@ -143,7 +133,7 @@ PATHTRACE_TEST(WhiteFurnaceSphereReturnsTheEnvironment) {
         if (c.shininess < 1.0f)
             for (int i = 0; i <= 64; ++i)
                 albedo.push_back(
-                    directionalAlbedo(0.2 + 0.8 * i / 64.0, glm::vec3(1.0f), c.metallic, 1.0f - c.shininess));
+                    brdfAlbedo(0.2 + 0.8 * i / 64.0, glm::vec3(1.0f), c.metallic, 1.0f - c.shininess));
         auto roughAlbedo = [&](double NoV) {
             double f = std::clamp((NoV - 0.2) / 0.8 * 64.0, 0.0, 63.999);
             int i = static_cast<int>(f);
@@ -497,22 +487,12 @@ PATHTRACE_TEST(ClearcoatFurnaceSphereReflectsItsAlbedo) {
     const Image& img = out.at("color");
     const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
     auto albedoAt = [&](double NoV) {
-        const int nu = 512, nphi = 512;
-        const glm::vec3 n(0, 0, 1), v(static_cast<float>(std::sqrt(1.0 - NoV * NoV)), 0.0f, static_cast<float>(NoV));
-        double sum = 0.0;
-        for (int i = 0; i < nu; ++i) {
-            double u = (i + 0.5) / nu, r = std::sqrt(1.0 - u * u);
-            for (int j = 0; j < nphi; ++j) {
-                double phi = 2.0 * kPi * (j + 0.5) / nphi;
-                glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                            static_cast<float>(u));
-                sum += shading::brdfCosineClearcoat(n, n, v, l, glm::vec3(1.0f), 0.0f,
-                                                    shading::roughnessFromShininess(shininess), plain,
-                                                    glm::vec2(1.0f, coatRoughness))
-                           .g;
-            }
-        }
-        return sum * (1.0 / nu) * (2.0 * kPi / nphi);
+        return directionalAlbedo(NoV, 512, [&](glm::vec3 n, glm::vec3 v, glm::vec3 l) {
+            return shading::brdfCosineClearcoat(n, n, v, l, glm::vec3(1.0f), 0.0f,
+                                                shading::roughnessFromShininess(shininess), plain,
+                                                glm::vec2(1.0f, coatRoughness))
+                .g;
+        });
     };
     std::vector<double> albedo;
     for (int i = 0; i <= 32; ++i)

@@ -62,19 +62,9 @@ double schlick(double f0, double cosine) {
 
 // The specular lobe's directional albedo at NoV (core/shading's brdfCosineF0 with no diffuse), midpoint rule.
 double specularAlbedo(double NoV, glm::vec3 f0, float roughness) {
-    const int nu = 256, nphi = 256;
-    const glm::vec3 n(0, 0, 1), v(static_cast<float>(std::sqrt(1.0 - NoV * NoV)), 0.0f, static_cast<float>(NoV));
-    double sum = 0.0;
-    for (int i = 0; i < nu; ++i) {
-        double u = (i + 0.5) / nu, r = std::sqrt(1.0 - u * u);
-        for (int j = 0; j < nphi; ++j) {
-            double phi = 2.0 * kPi * (j + 0.5) / nphi;
-            glm::vec3 l(static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)),
-                        static_cast<float>(u));
-            sum += shading::brdfCosineF0(n, v, l, glm::vec3(0.0f), f0, roughness).g;
-        }
-    }
-    return sum * (1.0 / nu) * (2.0 * kPi / nphi);
+    return directionalAlbedo(NoV, 256, [&](glm::vec3 n, glm::vec3 v, glm::vec3 l) {
+        return shading::brdfCosineF0(n, v, l, glm::vec3(0.0f), f0, roughness).g;
+    });
 }
 
 // Form factor from a floor point to a parallel rectangle at height h with one corner straight above it and sides
