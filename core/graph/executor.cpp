@@ -1,6 +1,7 @@
 #include "core/graph/executor.hpp"
 
 #include "core/base/error.hpp"
+#include "core/graph/descriptor_pools.hpp"
 #include "core/base/log.hpp"
 #include "core/gpu/allocator.hpp"
 #include "core/gpu/context.hpp"
@@ -163,6 +164,7 @@ public:
     void splitSubmission() override {
         VK_CHECK(vkEndCommandBuffer(mCmd));
         mEx.mCtx.waitSerial(mEx.mCtx.submit(mCmd));
+        mEx.mDescriptorPools->reset(); // the sets bound so far were only in the work just finished
         VK_CHECK(vkResetCommandBuffer(mCmd, 0));
         VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
         begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -189,11 +191,9 @@ private:
         if (p.nodeSets) mEx.createNodeSetPipeline(p, layouts, pass().id);
         VkDescriptorSet set = VK_NULL_HANDLE;
         if (p.setLayout) {
-            VkDescriptorSetAllocateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-            info.descriptorPool = mEx.mDescriptorPool;
-            info.descriptorSetCount = 1;
-            info.pSetLayouts = &p.setLayout;
-            VK_CHECK(vkAllocateDescriptorSets(mEx.mCtx.device(), &info, &set));
+            std::vector<VkDescriptorType> types;
+            for (const auto& t : p.targets) types.push_back(t.type);
+            set = mEx.mDescriptorPools->allocate(p.setLayout, DescriptorPools::countsOf(types));
             std::vector<VkDescriptorImageInfo> images(p.targets.size());
             VkDescriptorBufferInfo uniforms{};
             std::vector<VkWriteDescriptorSet> writes;
@@ -284,16 +284,7 @@ void Executor::create(ShaderCompiler& shaders) {
     si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
     VK_CHECK(vkCreateSampler(ctx.device(), &si, nullptr, &mNearestSampler));
 
-    std::vector<VkDescriptorPoolSize> sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4096},
-                                               {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1024},
-                                               {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 4096},
-                                               {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 256},
-                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 256}};
-    VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    pi.maxSets = 2048;
-    pi.poolSizeCount = static_cast<uint32_t>(sizes.size());
-    pi.pPoolSizes = sizes.data();
-    VK_CHECK(vkCreateDescriptorPool(ctx.device(), &pi, nullptr, &mDescriptorPool));
+    mDescriptorPools = std::make_unique<DescriptorPools>(ctx.device());
 
     ImageDesc dummy;
     dummy.format = VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -342,10 +333,10 @@ void Executor::destroy() {
     for (auto& list : mPipelines)
         for (auto& p : list) all.push_back(std::move(p));
     VkSampler sampler = mSampler, nearest = mNearestSampler;
-    VkDescriptorPool pool = mDescriptorPool;
+    std::shared_ptr<DescriptorPools> pools(std::move(mDescriptorPools));
     VkDeviceMemory heap = mTransientHeap;
     auto shared = std::make_shared<std::vector<std::unique_ptr<Pipeline>>>(std::move(all));
-    mCtx.destroyLater([device, shared, sampler, nearest, pool, heap] {
+    mCtx.destroyLater([device, shared, sampler, nearest, pools, heap]() mutable {
         for (auto& p : *shared) {
             if (p->pipeline) vkDestroyPipeline(device, p->pipeline, nullptr);
             if (p->layout) vkDestroyPipelineLayout(device, p->layout, nullptr);
@@ -353,12 +344,11 @@ void Executor::destroy() {
         }
         if (sampler) vkDestroySampler(device, sampler, nullptr);
         if (nearest) vkDestroySampler(device, nearest, nullptr);
-        if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
+        pools.reset();
         if (heap) vkFreeMemory(device, heap, nullptr);
     });
     mSampler = VK_NULL_HANDLE;
     mNearestSampler = VK_NULL_HANDLE;
-    mDescriptorPool = VK_NULL_HANDLE;
     mTransientHeap = VK_NULL_HANDLE;
     mPipelines.clear();
     mCtx.collectGarbage();
@@ -686,7 +676,7 @@ uint32_t Executor::run(const RunOptions& options) {
         VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
         begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
-        VK_CHECK(vkResetDescriptorPool(mCtx.device(), mDescriptorPool, 0));
+        mDescriptorPools->reset();
         recordFrame(cmd);
         VK_CHECK(vkEndCommandBuffer(cmd));
         FrameTiming timing;

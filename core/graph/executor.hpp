@@ -2,6 +2,7 @@
 
 #include "core/graph/barriers.hpp"
 #include "core/graph/compiler.hpp"
+#include "core/graph/descriptor_pools.hpp"
 #include "core/image/image.hpp"
 
 #include <functional>
@@ -98,7 +99,7 @@ private:
     VkSampler mSampler = VK_NULL_HANDLE;
     VkSampler mNearestSampler = VK_NULL_HANDLE;
     std::map<VkFormat, bool> mLinearFilterable;
-    VkDescriptorPool mDescriptorPool = VK_NULL_HANDLE;
+    std::unique_ptr<DescriptorPools> mDescriptorPools; // the per-dispatch sets, reset every frame and submission
     GpuImage mDummy; // bound to unconnected optional inputs
     std::unique_ptr<GpuProfiler> mProfiler;
     std::vector<FrameTiming> mTimings;

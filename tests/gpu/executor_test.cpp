@@ -2,7 +2,9 @@
 // timestamps are produced, and multi-frame runs are repeatable.
 #include "tests/gpu/gpu_test.hpp"
 
+#include "core/base/error.hpp"
 #include "core/graph/compiler.hpp"
+#include "core/graph/descriptor_pools.hpp"
 #include "core/graph/executor.hpp"
 #include "core/graph/loader.hpp"
 #include "core/graph/registry.hpp"
@@ -59,6 +61,43 @@ TEST_F(ExecutorGpu, RunsAreRepeatable) {
     auto a = runGraph(chain());
     auto b = runGraph(chain());
     EXPECT_EQ(maxAbsDiff(a["chain"], b["chain"]), 0.0);
+}
+
+// The NVIDIA driver refuses a descriptor set past a pool's sizes (VK_ERROR_OUT_OF_POOL_MEMORY: render.pathtrace
+// converging for hundreds of batches in one frame on an H200); lavapipe never does. The pools count for themselves and
+// move on to the next pool at the same point on every device, and a reset makes all of them available again.
+TEST_F(ExecutorGpu, DescriptorPoolsMoveToTheNextPoolBeforeOneIsFull) {
+    VkDevice device = gpu().device();
+    std::array<VkDescriptorSetLayoutBinding, 2> bindings{};
+    for (uint32_t i = 0; i < bindings.size(); ++i) {
+        bindings[i].binding = i;
+        bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+        bindings[i].descriptorCount = 1;
+        bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    VkDescriptorSetLayoutCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    info.bindingCount = static_cast<uint32_t>(bindings.size());
+    info.pBindings = bindings.data();
+    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    ASSERT_EQ(vkCreateDescriptorSetLayout(device, &info, nullptr, &layout), VK_SUCCESS);
+    {
+        DescriptorPools::Capacity capacity;
+        capacity.sets = 4;
+        capacity.descriptors = {0, 0, 7, 0, 0}; // three sets of two storage images fit a pool, not four
+        DescriptorPools pools(device, capacity);
+        const std::array<VkDescriptorType, 2> types = {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+        const DescriptorPools::Counts counts = DescriptorPools::countsOf(types);
+        EXPECT_EQ(counts[2], 2u);
+        for (int i = 0; i < 10; ++i) EXPECT_NE(pools.allocate(layout, counts), VkDescriptorSet{VK_NULL_HANDLE});
+        EXPECT_EQ(pools.poolCount(), 4u); // 3 + 3 + 3 + 1
+        pools.reset();
+        for (int i = 0; i < 9; ++i) pools.allocate(layout, counts);
+        EXPECT_EQ(pools.poolCount(), 4u) << "a reset pool is used again, not a new one created";
+        capacity.descriptors[2] = 1;
+        DescriptorPools small(device, capacity);
+        EXPECT_THROW(small.allocate(layout, counts), InternalError);
+    }
+    vkDestroyDescriptorSetLayout(device, layout, nullptr);
 }
 
 } // namespace
