@@ -13,7 +13,8 @@ namespace vitrine::bake {
 
 namespace {
 
-constexpr uint32_t kVersion = 2; // 2: the filter keeps energy, texels average the paths that start outside geometry
+constexpr uint32_t kVersion = 3; // 2: the filter keeps energy, texels average the paths that start outside geometry;
+                                 // 3: bounces reflect with the full material (GGX + Lambert), 8 of them by default
 constexpr char kMagic[4] = {'V', 'T', 'L', 'M'};
 
 struct Header {

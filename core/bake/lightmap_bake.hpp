@@ -34,7 +34,7 @@ namespace vitrine::bake {
 struct LightmapBakeSettings {
     LightmapAtlasOptions atlas;
     uint32_t samples = 64;    // paths per texel (and per probe ray)
-    uint32_t maxBounces = 4;  // surfaces that reflect light along a path after the texel
+    uint32_t maxBounces = 8;  // surfaces that reflect light along a path after the texel
     float probeSpacing = 2.0f; // metres between irradiance-volume probes
     uint32_t probeRays = 64;  // directions per probe
     uint32_t maxProbes = 4096; // the spacing grows when the scene would need more

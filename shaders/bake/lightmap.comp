@@ -54,14 +54,22 @@ vec3 incoming(vec3 origin, vec3 dir, inout uint rng, out bool inside) {
         PathSurface s = pathSurface(hit, origin, dir);
         radiance += throughput * s.emissive * push.scales.z;
         if (bounce >= push.counts.w) break;
-        vec3 n = s.normal, ng = s.geometricNormal;
-        vec3 albedo = min(diffuseAlbedo(s.baseColor, s.metallic) + specularF0(s.baseColor, s.metallic), vec3(1.0)) * s.cavity;
+        // The surface reflects with its full material, as render.pathtrace's does (common/brdf.glsl).
+        vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
+        BrdfLobes lobes = brdfLobes(s.baseColor, s.metallic, s.roughness, s.dielectric, clamp(dot(n, v), 0.0, 1.0));
+        addClearcoatLobe(lobes, s.coat, s.coatNormal, v);
+        vec3 weight = throughput * s.cavity;
         if (sun && dot(ng, sunDir) > 0.0 && !bvhTraceAny(offsetRay(s.position, ng, sunDir), sunDir, 0.0, kInfinity))
-            radiance += throughput * albedo / kPi * sunE * max(dot(n, sunDir), 0.0);
-        // Lambert: cosine-distributed directions, weight albedo.
-        vec3 l = basisAround(n) * sampleCosine(vec2(rngNext(rng), rngNext(rng)));
-        if (dot(ng, l) <= 0.0) break;
-        throughput *= albedo;
+            radiance += weight * sunE *
+                        brdfCosineClearcoat(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                            s.coat);
+        vec3 l;
+        if (!sampleBrdf(lobes, n, v, vec3(rngNext(rng), rngNext(rng), rngNext(rng)), l) || dot(ng, l) <= 0.0) break;
+        float pdf = brdfPdf(lobes, n, v, l);
+        if (pdf <= 0.0) break;
+        throughput = weight *
+                     brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat) /
+                     pdf;
         if (bounce >= 1u) { // Russian roulette, unbiased
             float q = min(max(max(throughput.r, throughput.g), throughput.b), 0.95);
             if (rngNext(rng) >= q) break;

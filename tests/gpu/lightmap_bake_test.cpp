@@ -25,6 +25,7 @@
 #include "core/scene/gltf.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "core/scene/museum.hpp"
+#include "core/shading/brdf.hpp"
 #include "core/shader/compiler.hpp"
 #include "shaders/sky/sky.h"
 
@@ -76,10 +77,16 @@ fs::path floorAndWall(const std::string& name, glm::vec3 floorBase, float floorM
     addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
     for (Tri& t : floor)
         for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
-    const uint32_t floorMesh = b.mesh("floor", floor, b.material("floor", floorBase, floorMetallic, 0.0f));
+    // Lambertian surfaces (KHR_materials_specular's strength 0 takes the dielectric's specular lobe away), so that
+    // the view-factor cases stay exact now that bake paths reflect with the full material.
+    const uint32_t floorMaterial = b.material("floor", floorBase, floorMetallic, 0.0f);
+    const uint32_t wallMaterial = b.material("wall", wallBase, wallMetallic, 0.0f);
+    b.s.materials[floorMaterial].specular = 0.0f;
+    b.s.materials[wallMaterial].specular = 0.0f;
+    const uint32_t floorMesh = b.mesh("floor", floor, floorMaterial);
     b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
     b.node("floor", static_cast<int32_t>(floorMesh));
-    const uint32_t wall = b.mesh("wall", boxTris({0.1f, kWallHeight / 2, 100.0f}), b.material("wall", wallBase, wallMetallic, 0.0f));
+    const uint32_t wall = b.mesh("wall", boxTris({0.1f, kWallHeight / 2, 100.0f}), wallMaterial);
     b.node("wall", static_cast<int32_t>(wall), {-0.1f, kWallHeight / 2, 0.0f});
     b.camera({4.0f, 3.0f, 6.0f}, {4.0f, 0.0f, 0.0f}, 0.9f);
     b.sun(toSun);
@@ -204,8 +211,8 @@ TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
     auto out = runGraph(bakeGraph(glb, sky, {{"samples", 1024}, {"sky_scale", 0.0}, {"filter_iterations", 0}}));
     const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
     const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-    // The bake's albedo-only material: diffuse albedo + F0 (0.5 + 0.04 for a white-ish dielectric).
-    const double albedo = wallBase.r + 0.04;
+    // A Lambertian wall (no specular lobe): it reflects its base colour.
+    const double albedo = wallBase.r;
     const double cosine = glm::dot(toSun, glm::dvec3(1, 0, 0));
     ASSERT_GT(cosine, 0.3);
     std::printf("sun off a white wall (E_sun %.0f lux, cos %.3f):\n", sunE.r, cosine);
@@ -214,10 +221,14 @@ TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
                   0.02, 3.0);
 }
 
-TEST_F(LightmapBake, ClosedEmissiveBoxFollowsTheGeometricSeries) {
-    const float Le = 100.0f, base = 0.5f;
-    SceneBuilder b("bake_emissive_box");
+// A closed box whose six walls glow with Le and reflect with the material of (base, shininess 0 = roughness 1):
+// the floor's irradiance after k bounces. Lambertian walls (specular strength 0) give pi Le sum rho^k exactly; the
+// default dielectric (GGX + Lambert) after one bounce pi Le (1 + A), A the cosine-weighted mean of the directional
+// albedo of core/shading's brdfCosine (the CPU mirror of brdf.glsl): the bake reflects with the path tracer's material.
+fs::path emissiveBox(const std::string& name, float Le, float base, float specular) {
+    SceneBuilder b(name);
     const uint32_t material = b.material("glow", glm::vec3(base), 0.0f, 0.0f);
+    b.s.materials[material].specular = specular;
     b.s.materials[material].emissiveFactor = glm::vec3(1.0f);
     b.s.materials[material].emissiveStrength = Le;
     // Five walls facing inwards, and the floor (y = -1) lightmapped on its own.
@@ -239,30 +250,57 @@ TEST_F(LightmapBake, ClosedEmissiveBoxFollowsTheGeometricSeries) {
     b.node("walls", static_cast<int32_t>(b.mesh("walls", walls, material)));
     b.camera({0.0f, 0.0f, 0.0f}, {0.0f, -1.0f, 1.0f}, 0.9f);
     b.sun({0.3f, 1.0f, 0.2f});
-    const fs::path glb = b.write();
+    return b.write();
+}
+
+// Mean and worst relative texel error of the floor's lightmap against `expected`.
+void expectEmissiveBox(const fs::path& glb, int bounces, double expected, double scale) {
     const bake::LightmapRegion r = floorRegion(glb);
-    const double rho = base + 0.04; // the bake's albedo-only material: diffuse + F0
-    const double scale = 2.0;       // emissive_scale multiplies every emitter the paths find
+    auto out = runGraph(bakeGraph(glb, uniformSky(glb, 1000.0),
+                                  {{"samples", 64}, {"max_bounces", bounces}, {"sun_scale", 0.0}, {"sky_scale", 0.0},
+                                   {"emissive_scale", scale}}));
+    double sum = 0.0, worst = 0.0;
+    for (uint32_t j = 0; j < r.size; ++j)
+        for (uint32_t i = 0; i < r.size; ++i) {
+            const double e = out.at("lightmap").at(int(r.x + i), int(r.y + j))[0];
+            sum += e;
+            worst = std::max(worst, std::abs(e / expected - 1.0));
+        }
+    const double mean = sum / (double(r.size) * r.size);
+    std::printf("emissive box %s, %d bounces: mean %.1f lux, expected %.1f (worst texel %.3f off)\n",
+                glb.stem().string().c_str(), bounces, mean, expected, worst);
+    EXPECT_NEAR(mean / expected, 1.0, 0.01) << bounces << " bounces";
+    EXPECT_LT(worst, 0.1);
+}
+
+TEST_F(LightmapBake, ClosedEmissiveBoxFollowsTheGeometricSeries) {
+    const float Le = 100.0f, base = 0.5f;
+    const double scale = 2.0; // emissive_scale multiplies every emitter the paths find
+    const fs::path glb = emissiveBox("bake_emissive_box", Le, base, 0.0f);
     for (int bounces : {1, 4}) {
-        auto out = runGraph(bakeGraph(glb, uniformSky(glb, 1000.0),
-                                      {{"samples", 64}, {"max_bounces", bounces}, {"sun_scale", 0.0}, {"sky_scale", 0.0},
-                                       {"emissive_scale", scale}}));
         double series = 0.0;
-        for (int k = 0; k <= bounces; ++k) series += std::pow(rho, k);
-        const double expected = kPi * scale * Le * series;
-        double sum = 0.0, worst = 0.0;
-        for (uint32_t j = 0; j < r.size; ++j)
-            for (uint32_t i = 0; i < r.size; ++i) {
-                const double e = out.at("lightmap").at(int(r.x + i), int(r.y + j))[0];
-                sum += e;
-                worst = std::max(worst, std::abs(e / expected - 1.0));
-            }
-        const double mean = sum / (double(r.size) * r.size);
-        std::printf("emissive box, %d bounces: mean %.1f lux, expected %.1f (worst texel %.3f off)\n", bounces, mean,
-                    expected, worst);
-        EXPECT_NEAR(mean / expected, 1.0, 0.01) << bounces << " bounces";
-        EXPECT_LT(worst, 0.1);
+        for (int k = 0; k <= bounces; ++k) series += std::pow(double(base), k);
+        expectEmissiveBox(glb, bounces, kPi * scale * Le * series, scale);
     }
+}
+
+TEST_F(LightmapBake, BouncesReflectWithTheFullMaterial) {
+    const float Le = 100.0f, base = 0.5f;
+    const double scale = 2.0;
+    const fs::path glb = emissiveBox("bake_emissive_box_ggx", Le, base, 1.0f);
+    // A = 2 int_0^1 albedo(mu) mu dmu, midpoint rule over mu.
+    const float roughness = shading::roughnessFromShininess(0.0f);
+    double A = 0.0;
+    const int steps = 64;
+    for (int i = 0; i < steps; ++i) {
+        const double mu = (i + 0.5) / steps;
+        A += 2.0 * mu / steps * directionalAlbedo(mu, 128, [&](glm::vec3 n, glm::vec3 v, glm::vec3 l) {
+                 return shading::brdfCosine(n, v, l, glm::vec3(base), 0.0f, roughness).g;
+             });
+    }
+    std::printf("cosine-weighted albedo of (0.5, roughness %.2f): %.4f (a Lambertian 0.5: 0.5)\n", roughness, A);
+    ASSERT_GT(std::abs(A - base), 0.015) << "the case must tell the full material from a Lambertian one";
+    expectEmissiveBox(glb, 1, kPi * scale * Le * (1.0 + A), scale);
 }
 
 // Builds the museum as scene.museum does with these params, and its lightmap texels as the bake saw them.
