@@ -261,6 +261,26 @@ TEST_F(Camera, GpuEyeAdaptationIsExponentialWithoutWaits) {
     for (int k = 1; k < 6; ++k)
         EXPECT_NEAR(gpuRun.states[k].meteredEv100, M + (I - M) * std::exp(-k / fps / tau), 2e-3) << "frame " << k;
     EXPECT_EQ(gpuRun.inFrameWaits, 0u);
+    // A second run of the same executor starts over at frame 0 (the state in the buffer is reset, not continued).
+    {
+        CompiledGraph graph =
+            compileGraph(validateGraph(cameraGraph(image, params, 3, true), "camera-test.json", NodeRegistry::global()));
+        std::shared_ptr<CameraStateObject> state;
+        for (const auto& r : graph.resources)
+            if (r.name == "camera.state") state = std::dynamic_pointer_cast<CameraStateObject>(r.object);
+        ASSERT_TRUE(state);
+        ShaderCompiler shaders;
+        Executor executor(gpu(), graph, shaders);
+        std::vector<float> first;
+        RunOptions options;
+        options.progress = false;
+        options.write = {0u, 1u, 2u};
+        options.onOutput = [&](uint32_t, const std::string&, const Image&) { first.push_back(state->resolved().meteredEv100); };
+        executor.run(options);
+        executor.run(options);
+        ASSERT_EQ(first.size(), 6u);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(first[3 + k], first[k], 1e-6) << "second run, frame " << k;
+    }
     params["readback"] = "same_frame";
     CameraRun cpuRun = run(cameraGraph(image, params, 6, true));
     EXPECT_EQ(cpuRun.inFrameWaits, 5u); // frames 1..5 meter (frame 0's @prev input is not valid)
@@ -274,15 +294,20 @@ TEST_F(Camera, GpuEyeAdaptationIsExponentialWithoutWaits) {
 TEST_F(Camera, GpuProgramMatchesTheCpuProgram) {
     const camera::LensData zoom = camera::loadLens(camera::findLens("canon_ef_24-70mm_f2.8l_ii", ".", dataDir()));
     EXPECT_GT(camera::evaluateLens(zoom, 25.0f, 5.0f, 2.8f).mechanicalVignetting, 0.01f); // something to fade
-    for (double ev : {-2.0, 4.0, 9.0, 13.0, 17.5, 22.0}) {
+    // (EV, program shift): shift +8 at EV -4 runs into the longest shutter (30 s) before the smallest aperture.
+    const std::vector<std::pair<double, double>> cases = {{-4.0, 8.0}, {-2.0, 1.0}, {4.0, 1.0}, {9.0, 1.0},
+                                                          {13.0, 1.0}, {17.5, 1.0}, {22.0, 1.0}};
+    for (const auto& [ev, shift] : cases) {
         const double L = std::exp2(ev) / 8.0;
         json params = kAverage;
         params["lens"] = "canon_ef_24-70mm_f2.8l_ii";
         params["focal_length"] = 25.0;
         params["auto_iso"] = true;
-        params["program_shift"] = 1.0;
+        params["program_shift"] = shift;
         params["exposure_compensation"] = -0.9;
-        const fs::path image = writeGrey("program" + std::to_string(int(ev * 10)), 32, 32, [&](int, int) { return L; });
+        const fs::path image =
+            writeGrey("program" + std::to_string(int(ev * 10)) + "_" + std::to_string(int(shift)), 32, 32,
+                      [&](int, int) { return L; });
         CameraRun r = run(cameraGraph(image, params));
         const CameraState& s = r.states[0];
         EXPECT_NEAR(s.meteredEv100, ev, 1e-3);
@@ -291,7 +316,9 @@ TEST_F(Camera, GpuProgramMatchesTheCpuProgram) {
         limits.minFNumber = s.minFNumber;
         limits.focalLengthMm = 25.0f;
         limits.autoIso = true;
-        const camera::ExposureSettings e = camera::programExposure(s.meteredEv100 + 0.9f, 1.0f, limits);
+        const camera::ExposureSettings e =
+            camera::programExposure(s.meteredEv100 + 0.9f, static_cast<float>(shift), limits);
+        EXPECT_LE(s.shutterSeconds, 30.0f * 1.0001f) << "EV " << ev;
         EXPECT_NEAR(s.fNumber / e.fNumber, 1.0, 1e-4) << "EV " << ev;
         EXPECT_NEAR(s.shutterSeconds / e.shutterSeconds, 1.0, 1e-4) << "EV " << ev;
         EXPECT_NEAR(s.iso / e.iso, 1.0, 1e-4) << "EV " << ev;

@@ -280,6 +280,8 @@ TEST_F(Dof, PointLightBokehHasTheApertureShapeAndThinLensDiameter) {
 TEST_F(Dof, CameraStateFNumberIsReadOnTheGpu) {
     const PointScene ps = pointScene(6.0, 1.0);
     const double focalMm = 0.5 * kSensorHeight * 1e3 / std::tan(0.5 * ps.yfov);
+    // Airy on a 0.3 mm-high sensor (2.3 um pixels): the first dark ring 1.2-2.7 px out, the kernel several rings wide.
+    const double kAirySensorMm = 0.3;
     const json outputs = {{"dof", "dof.color"}, {"coc", "dof.coc"}, {"airy", "airy.color"}};
     for (double fNumber : {2.0, 4.0}) {
         json params = {{"focus_distance", ps.zf}, {"max_coc", 64.0}, {"blades", 5}, {"blade_roundness", 0.5},
@@ -287,7 +289,7 @@ TEST_F(Dof, CameraStateFNumberIsReadOnTheGpu) {
         json nodes = {{"scene", sceneNode(ps.glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)},
                       {"airy", {{"type", "post.airy"},
                                 {"in", {{"color", "gbuffer.emissive"}}},
-                                {"params", {{"f_number", fNumber}, {"sensor_height", kSensorHeight * 1e3}}}}}};
+                                {"params", {{"f_number", fNumber}, {"sensor_height", kAirySensorMm}}}}}};
         const auto plain = runGraph(makeGraph(nodes, outputs, ps.size, ps.size));
         nodes["camera"] = {{"type", "test.camera_state"},
                            {"params", {{"f_number", fNumber}, {"wide_open", 1.4}, {"blades", 5},
@@ -295,7 +297,7 @@ TEST_F(Dof, CameraStateFNumberIsReadOnTheGpu) {
         nodes["dof"]["in"]["camera_state"] = "camera.state";
         nodes["dof"]["params"] = {{"max_coc", 64.0}, {"f_number", 0.0}, {"blade_roundness", 0.9}}; // the state's win
         nodes["airy"]["in"]["camera_state"] = "camera.state";
-        nodes["airy"]["params"] = json::object();
+        nodes["airy"]["params"] = {{"sensor_height", kAirySensorMm}}; // the f-number is the state's
         const auto withState = runGraph(makeGraph(nodes, outputs, ps.size, ps.size));
         double peak = 0.0;
         for (const char* name : {"dof", "airy"}) {
