@@ -16,8 +16,9 @@ gpu_types::CameraExposure exposureOf(const CameraState& s) {
     e.iso = s.iso;
     e.meteredEv100 = s.meteredEv100;
     e.stopsDown = gpu_types::cameraStopsDown(s.fNumber, s.wideOpenFNumber);
-    const scene::ApertureShape shape = scene::apertureAt(static_cast<uint32_t>(std::max(0, s.bladeCount)),
-                                                         s.bladeRoundness, s.bladeRotation, s.fNumber, s.wideOpenFNumber);
+    const scene::ApertureShape shape =
+        scene::apertureAt(static_cast<uint32_t>(std::max(0, s.bladeCount)), s.bladeRoundness, s.bladeRotation,
+                          s.fNumber, s.wideOpenFNumber);
     e.apertureRoundness = shape.roundness;
     e.apertureArea = scene::apertureArea(shape);
     e.mechanicalVignetting = s.mechanicalVignetting;

@@ -28,7 +28,7 @@ struct CameraExposure {
     float shutterSeconds;
     float iso;
     float meteredEv100;   // the scene's EV100 as metered and eye-adapted, before compensation
-    float stopsDown;      // log2(fNumber / wide-open f-number) ≥ 0: how far the blades are in
+    float stopsDown;      // log2(fNumber / wide-open f-number) ≥ 0 (half the stops of light): how far the blades are in
     float apertureRoundness; // core/scene/aperture.cpp's apertureAt(...).roundness at fNumber
     float apertureArea;   // area of that unit-circumradius aperture shape (post.dof's normalisation)
     float mechanicalVignetting; // nodes/camera/lens.cpp's mechanical vignetting at fNumber
@@ -129,7 +129,8 @@ CAMERA_FN CameraSettings cameraProgram(float targetEv100, float shift, float wid
     return s;
 }
 
-// Stops the aperture is closed from wide open (0 when at or wider than wide open).
+// log2(N / N_open), clamped at 0: how far the aperture is closed from wide open, in the unit of
+// core/scene/aperture.cpp's apertureAt (one unit = two stops of light).
 CAMERA_FN float cameraStopsDown(float fNumber, float wideOpenFNumber) {
     return max(0.0f, log2(max(fNumber, 1e-3f) / max(wideOpenFNumber, 1e-3f)));
 }
