@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cstring>
 
 namespace vitrine {
@@ -352,9 +353,14 @@ void Context::pollFences() {
 }
 
 void Context::waitSerial(uint64_t serial) {
-    while (mCompleted < serial && !mPending.empty()) {
-        VK_CHECK(vkWaitForFences(mDevice, 1, &mPending.front().fence, VK_TRUE, UINT64_MAX));
-        pollFences();
+    if (mCompleted < serial && !mPending.empty()) {
+        const auto start = std::chrono::steady_clock::now();
+        ++mWaitCount;
+        while (mCompleted < serial && !mPending.empty()) {
+            VK_CHECK(vkWaitForFences(mDevice, 1, &mPending.front().fence, VK_TRUE, UINT64_MAX));
+            pollFences();
+        }
+        mWaitMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     }
     collectGarbage();
 }

@@ -87,6 +87,10 @@ public:
     void waitSerial(uint64_t serial);
     void waitIdle();
     uint64_t lastSubmitted() const { return mSubmitted; }
+    // Every wait on a fence so far (waitSerial that had to block, waitIdle, immediate) and the time spent in them:
+    // the executor takes the difference over a frame's recording as the frame's in-frame waits (bench, tests).
+    uint64_t waitCount() const { return mWaitCount; }
+    double waitMs() const { return mWaitMs; }
 
     // Records with `record`, submits and waits. For uploads, read-backs and tests, not per-frame work.
     void immediate(const std::function<void(VkCommandBuffer)>& record);
@@ -129,6 +133,8 @@ private:
 
     uint64_t mSubmitted = 0;
     uint64_t mCompleted = 0;
+    uint64_t mWaitCount = 0;
+    double mWaitMs = 0.0;
     std::deque<Pending> mPending;
     std::vector<VkFence> mFreeFences;
     std::deque<Deferred> mDeferred;

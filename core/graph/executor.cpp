@@ -655,7 +655,10 @@ void Executor::recordFrame(VkCommandBuffer cmd) {
         mProfiler->beginScope(cmd, pi);
         PassContext ctx(*this, pi, cmd);
         ScopedProgressNode working(pass.id);
+        const auto start = Clock::now();
+        const double waitedBefore = mCtx.waitMs();
         pass.node->execute(ctx);
+        if (mPassCpuMs) (*mPassCpuMs)[pi] = msSince(start) - (mCtx.waitMs() - waitedBefore);
         mProfiler->endScope(cmd, pi);
     }
 }
@@ -677,10 +680,17 @@ uint32_t Executor::run(const RunOptions& options) {
         begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
         mDescriptorPools->reset();
-        recordFrame(cmd);
-        VK_CHECK(vkEndCommandBuffer(cmd));
         FrameTiming timing;
-        timing.cpuRecordMs = msSince(recordStart);
+        timing.passCpuMs.assign(mGraph.passes.size(), 0.0);
+        const uint64_t waitsBefore = mCtx.waitCount();
+        const double waitedBefore = mCtx.waitMs();
+        mPassCpuMs = &timing.passCpuMs;
+        recordFrame(cmd);
+        mPassCpuMs = nullptr;
+        VK_CHECK(vkEndCommandBuffer(cmd));
+        timing.cpuWaitMs = mCtx.waitMs() - waitedBefore;
+        timing.inFrameWaits = static_cast<uint32_t>(mCtx.waitCount() - waitsBefore);
+        timing.cpuRecordMs = msSince(recordStart) - timing.cpuWaitMs;
         auto gpuStart = Clock::now();
         mCtx.waitSerial(mCtx.submit(cmd));
         timing.frameMs = msSince(gpuStart);

@@ -30,7 +30,10 @@ class ShaderCompiler;
 
 struct FrameTiming {
     std::vector<double> passGpuMs; // per pass, from timestamp queries
-    double cpuRecordMs = 0.0;      // recording the command buffer
+    std::vector<double> passCpuMs; // per pass, the CPU time of its execute() (less its waits)
+    double cpuRecordMs = 0.0;      // recording the command buffer, less the waits below
+    double cpuWaitMs = 0.0;        // waiting for the GPU while recording (a node's splitSubmission, immediate, ...)
+    uint32_t inFrameWaits = 0;     // how many such waits (fence waits inside the frame's recording)
     double frameMs = 0.0;          // submit to completion, wall clock
 };
 
@@ -103,6 +106,7 @@ private:
     GpuImage mDummy; // bound to unconnected optional inputs
     std::unique_ptr<GpuProfiler> mProfiler;
     std::vector<FrameTiming> mTimings;
+    std::vector<double>* mPassCpuMs = nullptr; // the frame being recorded's FrameTiming::passCpuMs
     MemoryStats mMemory;
     double mPipelineMs = 0.0;
     uint32_t mFrame = 0;

@@ -1,5 +1,7 @@
 #include "core/scene/aperture.hpp"
 
+#include "shaders/camera/exposure.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -7,9 +9,8 @@
 namespace vitrine::scene {
 
 ApertureShape apertureAt(uint32_t blades, float bladeRoundness, float rotation, float fNumber, float wideOpenFNumber) {
-    const float stops = std::log2(std::max(fNumber, 1e-3f) / std::max(wideOpenFNumber, 1e-3f));
-    const float closed = std::clamp(stops, 0.0f, 1.0f);
-    return {blades, 1.0f - closed * (1.0f - std::clamp(bladeRoundness, 0.0f, 1.0f)), rotation};
+    const float stops = gpu_types::cameraStopsDown(fNumber, wideOpenFNumber);
+    return {blades, gpu_types::cameraApertureRoundness(stops, bladeRoundness), rotation};
 }
 
 float apertureBoundary(const ApertureShape& shape, float theta) {

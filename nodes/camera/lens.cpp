@@ -2,6 +2,7 @@
 
 #include "core/base/error.hpp"
 #include "core/graph/json_util.hpp"
+#include "shaders/camera/exposure.h"
 
 #include <algorithm>
 #include <cmath>
@@ -190,9 +191,9 @@ LensState evaluateLens(const LensData& lens, float focalMm, float focusM, float 
     const float cosTheta = focalMm / std::hypot(focalMm, halfDiagonal);
     const float naturalStops = -std::log2(std::pow(cosTheta, 4.0f));
     const float mechanicalStops = std::max(0.0f, column(&Aberrations::vignettingStops) - naturalStops);
-    const float stoppedDown = 2.0f * std::log2(std::max(fNumber, s.wideOpenFNumber) / s.wideOpenFNumber);
-    const float fade = std::clamp(1.0f - 0.5f * stoppedDown, 0.0f, 1.0f);
-    s.mechanicalVignetting = (1.0f - std::exp2(-mechanicalStops)) * lens.vignetting.residual() * fade;
+    s.mechanicalWideOpen = (1.0f - std::exp2(-mechanicalStops)) * lens.vignetting.residual();
+    s.mechanicalVignetting = gpu_types::cameraMechanicalVignetting(
+        s.mechanicalWideOpen, gpu_types::cameraStopsDown(fNumber, s.wideOpenFNumber));
     return s;
 }
 

@@ -59,6 +59,7 @@ struct LensState {
     float k1 = 0.0f, k2 = 0.0f;
     float caRed = 1.0f, caBlue = 1.0f;
     float mechanicalVignetting = 0.0f; // fraction of light the corner loses to mechanical vignetting
+    float mechanicalWideOpen = 0.0f;   // the same wide open (the GPU fades it with the chosen aperture)
 };
 
 // focalMm within the lens's range; focusM ≥ the closest focus (clamped); fNumber the chosen aperture.

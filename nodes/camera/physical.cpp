@@ -1,7 +1,9 @@
 // camera.physical: a DSLR's exposure and lens for the post stack. Meters the HDR image (a centre-weighted
-// histogram of log2 luminance on the GPU, read back), adapts to it over time, picks aperture, shutter and ISO
-// along a program line (or takes them from params in manual mode) and describes the lens at that setting from a
-// data/lenses/ file. Its `state` port carries the result (nodes/camera/camera_state.hpp).
+// histogram of log2 luminance), adapts to it over time, picks aperture, shutter and ISO along a program line (or
+// takes them from params in manual mode) and describes the lens at that setting from a data/lenses/ file. Its
+// `state` port carries the result (nodes/camera/camera_state.hpp). By default all of the exposure runs on the GPU
+// (shaders/camera/expose.comp) and stays there for the post nodes' shaders; `readback` same_frame / next_frame
+// read the histogram back and do it on the CPU instead (debugging; same_frame stalls the frame).
 #include "core/base/error.hpp"
 #include "core/base/log.hpp"
 #include "core/base/paths.hpp"
@@ -14,6 +16,7 @@
 #include "nodes/camera/lens.hpp"
 #include "nodes/camera/metering.hpp"
 #include "nodes/camera/program.hpp"
+#include "shaders/camera/exposure.h"
 #include "shaders/camera/meter.h"
 
 #include <array>
@@ -25,6 +28,7 @@
 namespace vitrine {
 namespace {
 
+using gpu_types::ExposePush;
 using gpu_types::MeterPush;
 
 NodeSchema schema() {
@@ -75,9 +79,10 @@ NodeSchema schema() {
          "Scene EV100 assumed until the first metering arrives (frame 0 of an @prev input), or always without `color`"},
         {"log_settings", ParamType::Bool, false, {}, {}, {},
          "Print the metered EV and the chosen settings every frame (info log)"},
-        {"readback", ParamType::Enum, "same_frame", {}, {}, {"same_frame", "next_frame"},
-         "same_frame: meter, wait for the GPU and use the result in this frame (the graph runs one frame in flight, so "
-         "this costs one small submission); next_frame: use it one frame later, no wait"},
+        {"readback", ParamType::Enum, "none", {}, {}, {"none", "same_frame", "next_frame"},
+         "none: metering, eye adaptation and the program run on the GPU and the post nodes read the result there (no "
+         "wait); for debugging, the same on the CPU from the histogram read back: same_frame waits for the GPU in the "
+         "middle of the frame, next_frame uses it one frame later"},
     };
     return s;
 }
@@ -113,16 +118,22 @@ public:
 
         // The input's size is read at the first frame: an `@prev` input's producer may be set up after this node.
         mMeter = ctx.hasInput("color");
+        mReadback = p.getString("readback") != "none";
         if (mMeter) {
             mTilesPipeline = ctx.computePipeline("camera/meter_tiles.comp", {}, 1);
             mReducePipeline = ctx.computePipeline("camera/meter_reduce.comp", {}, 1);
         }
+        if (!mReadback) mExposePipeline = ctx.computePipeline("camera/expose.comp", {}, 1);
         mOut = std::make_shared<CameraStateObject>();
+        mOut->cpuExposure = mReadback;
         ctx.setObject("state", mOut);
     }
 
     void execute(ExecuteContext& ctx) override {
         const Params& p = ctx.params();
+        mOut->ensureGpu(ctx.gpu());
+        ensureBuffers(ctx.gpu(), mMeter ? &ctx.input("color").desc() : nullptr);
+        if (!mReadback) return executeOnGpu(ctx, p);
         if (ctx.frameIndex() == 0) {
             mAdapted.reset();
             mPending = false;
@@ -130,7 +141,6 @@ public:
         const bool sameFrame = p.getString("readback") == "same_frame";
         std::optional<float> metered;
         if (mMeter) {
-            ensureBuffers(ctx.gpu(), ctx.input("color").desc());
             if (!sameFrame && mPending) metered = readMeter(p);
             mPending = false;
             if (ctx.inputValid("color")) {
@@ -151,21 +161,12 @@ public:
             mAdapted = metered ? *metered : p.getFloat("initial_ev100");
             if (!metered) mLastMetered = *mAdapted;
         } else {
-            const float keep = tau > 0.0f ? std::exp(-dt / tau) : 0.0f;
-            mAdapted = mLastMetered + (*mAdapted - mLastMetered) * keep;
+            mAdapted = gpu_types::cameraAdapt(*mAdapted, mLastMetered, dt, tau);
         }
         fillState(p, *mAdapted);
         mOut->frame = ctx.frameIndex();
-        if (p.getBool("log_settings")) {
-            const CameraState& st = mOut->state;
-            char line[256];
-            std::snprintf(line, sizeof line,
-                          "camera.physical frame %u: metered EV100 %.2f, exposed EV100 %.2f (%.2f stops): f/%.1f, "
-                          "shutter %.4g s, ISO %.0f, %.1f mm",
-                          ctx.frameIndex(), st.meteredEv100, st.ev100, std::log2(st.exposure), st.fNumber,
-                          st.shutterSeconds, st.iso, st.focalLengthMm);
-            logInfo(line);
-        }
+        mOut->writeExposureFromCpu();
+        if (p.getBool("log_settings")) logSettings(ctx.frameIndex(), mOut->state, "");
     }
 
     void releaseGpu() override {
@@ -176,6 +177,64 @@ public:
     }
 
 private:
+    static void logSettings(uint32_t frame, const CameraState& st, const char* note) {
+        char line[320];
+        std::snprintf(line, sizeof line,
+                      "camera.physical frame %u%s: metered EV100 %.2f, exposed EV100 %.2f (%.2f stops): f/%.1f, "
+                      "shutter %.4g s, ISO %.0f, %.1f mm",
+                      frame, note, st.meteredEv100, st.ev100, std::log2(st.exposure), st.fNumber, st.shutterSeconds,
+                      st.iso, st.focalLengthMm);
+        logInfo(line);
+    }
+
+    // The default path: meter, adapt and expose on the GPU; the CPU fills only the metering-independent fields.
+    void executeOnGpu(ExecuteContext& ctx, const Params& p) {
+        // Last frame's result, which the GPU has finished (one frame in flight): logged before it is overwritten.
+        if (p.getBool("log_settings") && ctx.frameIndex() > 0)
+            logSettings(ctx.frameIndex() - 1, mOut->resolved(), " (GPU, logged a frame late)");
+        const bool metered = mMeter && ctx.inputValid("color");
+        if (metered) {
+            recordMeter(ctx, p);
+        } else {
+            // Orders this frame's write of the exposure after last frame's reads of it.
+            ctx.computeBarrier();
+        }
+        ExposePush push{};
+        push.flags = (metered ? EXPOSE_METERED : 0u) | (ctx.frameIndex() == 0 ? EXPOSE_RESET : 0u) |
+                     (mManual ? EXPOSE_MANUAL : 0u) | (p.getBool("auto_iso") ? EXPOSE_AUTO_ISO : 0u);
+        push.meterLow = p.getFloat("meter_low");
+        push.meterHigh = p.getFloat("meter_high");
+        push.dt = 1.0f / p.getFloat("fps");
+        push.tau = p.getFloat("adaptation_time");
+        push.initialEv100 = p.getFloat("initial_ev100");
+        push.compensation = p.getFloat("exposure_compensation");
+        push.shift = p.getFloat("program_shift");
+        push.wideOpenFNumber = camera::interpolate(mLens.maxAperture, mFocal);
+        push.minFNumber = camera::interpolate(mLens.minAperture, mFocal);
+        push.shortestShutter = p.getFloat("shortest_shutter");
+        push.longestShutter = p.getFloat("longest_shutter");
+        push.focalLengthMm = mFocal;
+        push.iso = p.getFloat("iso");
+        push.maxIso = p.getFloat("max_iso");
+        push.manualFNumber = p.getFloat("f_number");
+        push.manualShutter = p.getFloat("shutter");
+        // The metering-independent fields (lens, sensor, blades); the metering-dependent ones it fills are
+        // placeholders (cpuExposure is false: consumers read them from the GPU buffer).
+        fillState(p, p.getFloat("initial_ev100"));
+        const CameraState& st = mOut->state;
+        push.blades = static_cast<uint32_t>(std::max(0, st.bladeCount));
+        push.bladeRoundness = st.bladeRoundness;
+        push.bladeRotation = st.bladeRotation;
+        push.mechanicalWideOpen = mMechanicalWideOpen;
+        ctx.dispatchWithSets(mExposePipeline, &push, sizeof(push), EXPOSE_GROUP, 1, layouts(), sets());
+        // The post nodes read the exposure in their shaders, later in this command buffer.
+        ctx.computeBarrier();
+        mOut->frame = ctx.frameIndex();
+    }
+
+    std::array<VkDescriptorSetLayout, 1> layouts() const { return {mSet.layout()}; }
+    std::array<VkDescriptorSet, 1> sets() const { return {mSet.set()}; }
+
     static std::string fmt(float v) {
         char b[32];
         std::snprintf(b, sizeof b, "%g", v);
@@ -183,15 +242,16 @@ private:
     }
     static std::string range(float a, float b) { return a == b ? fmt(a) : fmt(a) + "-" + fmt(b); }
 
-    void ensureBuffers(Context& gpu, const ImageDesc& in) {
+    // in: the metered image (null without `color`: the buffers only complete the set expose.comp binds).
+    void ensureBuffers(Context& gpu, const ImageDesc* in) {
         if (mSet) return;
-        mTilesX = (in.width + METER_TILE - 1) / METER_TILE;
-        mTileCount = mTilesX * ((in.height + METER_TILE - 1) / METER_TILE);
+        mTilesX = in ? (in->width + METER_TILE - 1) / METER_TILE : 1;
+        mTileCount = in ? mTilesX * ((in->height + METER_TILE - 1) / METER_TILE) : 1;
         mTiles = GpuBuffer(gpu, VkDeviceSize(mTileCount) * METER_BINS * sizeof(glm::vec2), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                            false, "camera.physical.tiles");
         mResult = GpuBuffer(gpu, METER_BINS * sizeof(glm::vec2), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
                             "camera.physical.histogram");
-        const std::array<VkBuffer, 2> buffers = {mTiles.buffer(), mResult.buffer()};
+        const std::array<VkBuffer, 3> buffers = {mTiles.buffer(), mResult.buffer(), mOut->buffer()};
         mSet = StorageBufferSet(gpu, buffers, VK_SHADER_STAGE_COMPUTE_BIT, "camera.physical.meter");
     }
 
@@ -209,6 +269,7 @@ private:
         ctx.dispatchWithSets(mTilesPipeline, &push, sizeof(push), in.width, in.height, layouts, sets);
         ctx.computeBarrier();
         ctx.dispatchWithSets(mReducePipeline, &push, sizeof(push), METER_BINS * METER_REDUCE_GROUP, 1, layouts, sets);
+        if (!mReadback) return ctx.computeBarrier(); // expose.comp reads the histogram next
         VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
         b.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
         b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
@@ -249,6 +310,7 @@ private:
             e = camera::programExposure(meteredEv - p.getFloat("exposure_compensation"), p.getFloat("program_shift"), limits);
         }
         const camera::LensState lens = camera::evaluateLens(mLens, mFocal, p.getFloat("focus_distance"), e.fNumber);
+        mMechanicalWideOpen = lens.mechanicalWideOpen;
         CameraState& s = mOut->state;
         s.ev100 = e.ev100;
         s.exposure = camera::exposureScale(e.ev100);
@@ -274,9 +336,10 @@ private:
 
     camera::LensData mLens;
     float mFocal = 50.0f, mSensorW = 36.0f, mSensorH = 24.0f;
-    bool mManual = false, mMeter = false;
+    bool mManual = false, mMeter = false, mReadback = false;
+    float mMechanicalWideOpen = 0.0f;
     uint32_t mTilesX = 0, mTileCount = 0;
-    PipelineId mTilesPipeline = 0, mReducePipeline = 0;
+    PipelineId mTilesPipeline = 0, mReducePipeline = 0, mExposePipeline = 0;
     GpuBuffer mTiles, mResult;
     StorageBufferSet mSet;
     bool mPending = false;

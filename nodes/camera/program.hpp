@@ -1,7 +1,8 @@
 #pragma once
-// The exposure maths of camera.physical, on the CPU (no GPU, unit-tested in tests/unit/camera): the reflected-light
-// meter's calibration, exposure value <-> linear exposure scale, and the program line that picks aperture, shutter
-// and (auto) ISO from a metered EV. The curve is documented in the README ("Physical camera").
+// The exposure maths of camera.physical on the CPU (unit-tested in tests/unit/camera): the reflected-light meter's
+// calibration, exposure value <-> linear exposure scale, and the program line that picks aperture, shutter and
+// (auto) ISO from a metered EV. Thin wrappers of shaders/camera/exposure.h, which the GPU path runs as well (one
+// source of truth). The curve is documented in the README ("Physical camera").
 
 namespace vitrine::camera {
 

@@ -72,15 +72,18 @@ public:
         const int maxRadius = p.getInt("max_radius");
         ImageDesc& psf = ctx.output("psf");
         psf.width = psf.height = static_cast<uint32_t>(2 * maxRadius + 1);
-        mPsf = ctx.computePipeline("post/airy_psf.comp");
-        mConvolve = ctx.computePipeline("post/airy.comp");
+        // The camera's f-number is read on the GPU, by both passes.
+        mGpuFNumber = mState && p.getFloat("f_number") <= 0.0f;
+        const ShaderDefines defines = cameraExposureDefines(mGpuFNumber);
+        mPsf = ctx.computePipeline("post/airy_psf.comp", defines, mGpuFNumber ? 1 : 0);
+        mConvolve = ctx.computePipeline("post/airy.comp", defines, mGpuFNumber ? 1 : 0);
     }
 
     void execute(ExecuteContext& ctx) override {
         const Params& p = ctx.params();
         float fNumber = p.getFloat("f_number"), sensorMm = p.getFloat("sensor_height");
         if (mState) {
-            fNumber = fNumber > 0.0f ? fNumber : mState->state.fNumber;
+            fNumber = fNumber > 0.0f ? fNumber : 1.0f; // mGpuFNumber: per unit f-number, the shader multiplies
             sensorMm = sensorMm > 0.0f ? sensorMm : mState->state.sensorHeightMm;
         }
         if (mCamera) {
@@ -94,17 +97,20 @@ public:
         push.firstZero = glm::vec4(1.21967f * lambda * fNumber / pitchNm * p.getFloat("scale"), 0.0f);
         push.maxRadius = p.getInt("max_radius");
         const float widest = std::max({push.firstZero.x, push.firstZero.y, push.firstZero.z});
-        push.radius = std::clamp(static_cast<int>(std::ceil(kRingsReach * widest)), 1, push.maxRadius);
+        push.radius = mGpuFNumber ? push.maxRadius
+                                  : std::clamp(static_cast<int>(std::ceil(kRingsReach * widest)), 1, push.maxRadius);
         push.supersample = static_cast<uint32_t>(p.getInt("supersample"));
         const uint32_t side = static_cast<uint32_t>(2 * push.maxRadius + 1);
-        ctx.dispatch(mPsf, push, side, side);
+        const CameraStateObject* camera = mGpuFNumber ? mState.get() : nullptr;
+        dispatchWithCamera(ctx, camera, mPsf, push, side, side);
         ctx.computeBarrier();
-        ctx.dispatch(mConvolve, push, out.width, out.height);
+        dispatchWithCamera(ctx, camera, mConvolve, push, out.width, out.height);
     }
 
 private:
     std::shared_ptr<CameraObject> mCamera;
     std::shared_ptr<CameraStateObject> mState;
+    bool mGpuFNumber = false;
     PipelineId mPsf = 0, mConvolve = 0;
 };
 

@@ -50,11 +50,11 @@ inline uint32_t sizeBrightPass(SetupContext& ctx, std::initializer_list<const ch
     return factor;
 }
 
-// Called from execute: the push constants' exposure (camera_state's when connected, else 2^exposure), threshold and
-// factor, fields that shaders/post/flare.h and streaks.h share.
+// Called from execute: the push constants' exposure (1 when camera_state is connected: the bright pass's shader,
+// made with cameraExposureDefines, multiplies by the camera's on the GPU; else 2^exposure), threshold and factor,
+// fields that shaders/post/flare.h and streaks.h share.
 template <class Push> void fillBrightPass(ExecuteContext& ctx, uint32_t factor, Push& push) {
-    push.exposure = ctx.hasInput("camera_state") ? ctx.objectAs<CameraStateObject>("camera_state").state.exposure
-                                                 : std::exp2(ctx.params().getFloat("exposure"));
+    push.exposure = ctx.hasInput("camera_state") ? 1.0f : std::exp2(ctx.params().getFloat("exposure"));
     push.threshold = ctx.params().getFloat("threshold");
     push.factor = static_cast<int>(factor);
 }

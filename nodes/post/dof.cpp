@@ -121,9 +121,11 @@ public:
         sprites.width = 2 * std::max(1, p.getInt("max_sprites"));
         sprites.height = 1;
         mClear = ctx.computePipeline("post/dof_clear.comp");
-        mCoc = ctx.computePipeline("post/dof_coc.comp");
+        // With camera_state the f-number, and the aperture's roundness and area at it, are read on the GPU.
+        const ShaderDefines defines = cameraExposureDefines(mState != nullptr);
+        mCoc = ctx.computePipeline("post/dof_coc.comp", defines, mState ? 1 : 0);
         mClassify = ctx.computePipeline("post/dof_classify.comp");
-        mGather = ctx.computePipeline("post/dof_gather.comp");
+        mGather = ctx.computePipeline("post/dof_gather.comp", defines, mState ? 1 : 0);
     }
 
     void execute(ExecuteContext& ctx) override {
@@ -139,7 +141,7 @@ public:
         float wideOpen = p.getFloat("wide_open_f_number");
         if (mState) {
             const CameraState& s = mState->state;
-            fNumber = s.fNumber;
+            fNumber = 1.0f; // cocScale per unit 1 / f-number: dof_coc.comp divides by the camera's
             focus = s.focusDistanceM;
             focalMm = s.focalLengthMm;
             sensorMm = s.sensorHeightMm;
@@ -165,7 +167,7 @@ public:
         push.blades = shape.blades;
         push.roundness = shape.roundness;
         push.rotation = shape.rotation;
-        push.apertureArea = scene::apertureArea(shape);
+        push.apertureArea = mState ? 0.0f : scene::apertureArea(shape); // the camera's, on the GPU
         push.layers = static_cast<uint32_t>(p.getInt("layers"));
         push.maxSprites = static_cast<uint32_t>(p.getInt("max_sprites"));
         push.scatterRatio = p.getFloat("scatter_ratio");
@@ -175,11 +177,11 @@ public:
         push.tilesX = (out.width + DOF_TILE - 1) / DOF_TILE;
         ctx.dispatch(mClear, push, 1, 1);
         ctx.computeBarrier();
-        ctx.dispatch(mCoc, push, out.width, out.height);
+        dispatchWithCamera(ctx, mState.get(), mCoc, push, out.width, out.height);
         ctx.computeBarrier();
         ctx.dispatch(mClassify, push, out.width, out.height);
         ctx.computeBarrier();
-        ctx.dispatch(mGather, push, out.width, out.height);
+        dispatchWithCamera(ctx, mState.get(), mGather, push, out.width, out.height);
     }
 
 private:

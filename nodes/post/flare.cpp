@@ -70,7 +70,8 @@ class Flare final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         mFactor = sizeBrightPass(ctx, {"bright", "flare"});
-        mBright = ctx.computePipeline("post/flare_bright.comp");
+        if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
+        mBright = ctx.computePipeline("post/flare_bright.comp", cameraExposureDefines(mCamera != nullptr), mCamera ? 1 : 0);
         mGhosts = ctx.computePipeline("post/flare_ghosts.comp");
         mComposite = ctx.computePipeline("post/flare.comp");
     }
@@ -90,7 +91,7 @@ public:
         push.haloRadius = p.getFloat("halo_radius");
         push.haloIntensity = p.getFloat("halo_intensity");
         push.haloTaps = static_cast<uint32_t>(p.getInt("halo_taps"));
-        ctx.dispatch(mBright, push, low.width, low.height);
+        dispatchWithCamera(ctx, mCamera.get(), mBright, push, low.width, low.height);
         ctx.computeBarrier();
         ctx.dispatch(mGhosts, push, low.width, low.height);
         ctx.computeBarrier();
@@ -99,6 +100,7 @@ public:
 
 private:
     uint32_t mFactor = 4;
+    std::shared_ptr<CameraStateObject> mCamera;
     PipelineId mBright = 0, mGhosts = 0, mComposite = 0;
 };
 

@@ -49,17 +49,23 @@ class Grain final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
-        mPipeline = ctx.computePipeline("post/grain.comp");
+        mPipeline = ctx.computePipeline("post/grain.comp", cameraExposureDefines(mCamera != nullptr), mCamera ? 1 : 0);
     }
     void execute(ExecuteContext& ctx) override {
         const Params& p = ctx.params();
         const ImageDesc& out = ctx.output("color").desc();
-        const float iso = mCamera ? mCamera->state.iso : p.getFloat("iso");
         gpu_types::GrainPush push{};
-        push.sigma = p.getFloat("strength") * std::sqrt(iso / 100.0f);
-        push.size = std::max(0.5f, p.getFloat("size") * std::pow(iso / 100.0f, 0.25f) * float(out.height) / 1080.0f);
+        if (mCamera) {
+            // The shader scales these by the camera's ISO, which it reads on the GPU.
+            push.sigma = p.getFloat("strength");
+            push.size = p.getFloat("size") * float(out.height) / 1080.0f;
+        } else {
+            const float iso = p.getFloat("iso");
+            push.sigma = p.getFloat("strength") * std::sqrt(iso / 100.0f);
+            push.size = std::max(0.5f, p.getFloat("size") * std::pow(iso / 100.0f, 0.25f) * float(out.height) / 1080.0f);
+        }
         push.seed = mix(ctx.frameIndex(), static_cast<uint32_t>(p.getInt("seed")));
-        ctx.dispatch(mPipeline, push, out.width, out.height);
+        dispatchWithCamera(ctx, mCamera.get(), mPipeline, push, out.width, out.height);
     }
 
 private:

@@ -79,7 +79,8 @@ public:
                               "k1 = " + std::to_string(k1) + ", k2 = " + std::to_string(k2) +
                                   " fold the image over itself (r (1 + k1 r^2 + k2 r^4) stops increasing at r = " +
                                   std::to_string(r) + " half-diagonals); expected a monotonic distortion");
-        mPipeline = ctx.computePipeline("post/lens.comp");
+        if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
+        mPipeline = ctx.computePipeline("post/lens.comp", cameraExposureDefines(mCamera != nullptr), mCamera ? 1 : 0);
     }
     void execute(ExecuteContext& ctx) override {
         const auto& p = ctx.params();
@@ -94,30 +95,32 @@ public:
         float focal = p.getFloat("focal_length"), sensor = p.getFloat("sensor_width");
         float fNumber = p.getFloat("f_number"), wideOpen = p.getFloat("wide_open");
         push.mechanical = p.getFloat("mechanical_vignetting");
-        if (ctx.hasInput("camera_state")) {
-            const CameraState& s = ctx.objectAs<CameraStateObject>("camera_state").state;
+        if (mCamera) {
+            const CameraState& s = mCamera->state;
             push.k1 = s.distortionK1;
             push.k2 = s.distortionK2;
             push.caRed = s.caRedScale;
             push.caBlue = s.caBlueScale;
             focal = s.focalLengthMm;
             sensor = s.sensorWidthMm;
-            fNumber = s.fNumber;
+            // The f-number and the mechanical vignetting at it are the camera's, which the shader reads on the GPU.
+            fNumber = 1.0f;
             wideOpen = s.wideOpenFNumber;
-            push.mechanical = s.mechanicalVignetting;
+            push.mechanical = 1.0f;
         }
         push.mmPerPixel = sensor / static_cast<float>(out.width);
         push.focalMm = focal;
-        push.pupil = std::clamp(wideOpen / std::max(fNumber, 1e-3f), 1e-3f, 1.0f);
+        push.pupil = mCamera ? wideOpen : std::clamp(wideOpen / std::max(fNumber, 1e-3f), 1e-3f, 1.0f);
         push.flags = (p.getBool("distortion") ? LENS_DISTORTION : 0u) |
                      (p.getBool("chromatic_aberration") ? LENS_CA : 0u) |
                      (p.getBool("vignetting") ? LENS_NATURAL_VIGNETTING : 0u) |
                      (push.mechanical > 0.0f ? LENS_MECHANICAL_VIGNETTING : 0u);
-        ctx.dispatch(mPipeline, push, out.width, out.height);
+        dispatchWithCamera(ctx, mCamera.get(), mPipeline, push, out.width, out.height);
     }
 
 private:
     PipelineId mPipeline = 0;
+    std::shared_ptr<CameraStateObject> mCamera;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<Lens>(); });

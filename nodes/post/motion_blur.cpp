@@ -113,17 +113,19 @@ public:
             t.width = (color.width + mTile - 1) / mTile;
             t.height = (color.height + mTile - 1) / mTile;
         }
-        mTilesPipeline = ctx.computePipeline("post/motion_blur_tiles.comp");
+        // Shutter-driven by a camera: the shutter is the camera's, which the shaders read on the GPU.
+        if (ctx.params().getBool("shutter_driven") && ctx.hasInput("camera_state"))
+            mCamera = ctx.objectAs<CameraStateObject>("camera_state");
+        const ShaderDefines defines = cameraExposureDefines(mCamera != nullptr);
+        mTilesPipeline = ctx.computePipeline("post/motion_blur_tiles.comp", defines, mCamera ? 1 : 0);
         mNeighborsPipeline = ctx.computePipeline("post/motion_blur_neighbors.comp");
-        mGatherPipeline = ctx.computePipeline("post/motion_blur.comp");
+        mGatherPipeline = ctx.computePipeline("post/motion_blur.comp", defines, mCamera ? 1 : 0);
     }
     void execute(ExecuteContext& ctx) override {
         const auto& p = ctx.params();
         float scale = p.getFloat("scale");
         if (p.getBool("shutter_driven")) {
-            float shutter = ctx.hasInput("camera_state")
-                                ? ctx.objectAs<CameraStateObject>("camera_state").state.shutterSeconds
-                                : p.getFloat("shutter");
+            float shutter = mCamera ? 1.0f : p.getFloat("shutter");
             scale = shutter * p.getFloat("fps");
         }
         gpu_types::MotionBlurPush push{};
@@ -135,15 +137,16 @@ public:
         push.dither = p.getBool("dither") ? 1.0f : 0.0f;
         push.frame = ctx.frameIndex();
         const ImageDesc& tiles = ctx.output("tile_max").desc();
-        ctx.dispatch(mTilesPipeline, push, tiles.width, tiles.height);
+        dispatchWithCamera(ctx, mCamera.get(), mTilesPipeline, push, tiles.width, tiles.height);
         ctx.computeBarrier();
         ctx.dispatch(mNeighborsPipeline, nullptr, 0, tiles.width, tiles.height); // no push constants
         ctx.computeBarrier();
         const ImageDesc& out = ctx.output("color").desc();
-        ctx.dispatch(mGatherPipeline, push, out.width, out.height);
+        dispatchWithCamera(ctx, mCamera.get(), mGatherPipeline, push, out.width, out.height);
     }
 
 private:
+    std::shared_ptr<CameraStateObject> mCamera;
     uint32_t mTile = 20;
     PipelineId mTilesPipeline = 0, mNeighborsPipeline = 0, mGatherPipeline = 0;
 };

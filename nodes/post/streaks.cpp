@@ -62,8 +62,10 @@ class Streaks final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         mFactor = sizeBrightPass(ctx, {"bright", "streaks"});
-        mBright = ctx.computePipeline("post/streaks_bright.comp");
-        mSpikes = ctx.computePipeline("post/streaks_spikes.comp");
+        if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
+        const ShaderDefines defines = cameraExposureDefines(mCamera != nullptr);
+        mBright = ctx.computePipeline("post/streaks_bright.comp", defines, mCamera ? 1 : 0);
+        mSpikes = ctx.computePipeline("post/streaks_spikes.comp", defines, mCamera ? 1 : 0);
         mComposite = ctx.computePipeline("post/streaks.comp");
     }
     void execute(ExecuteContext& ctx) override {
@@ -74,13 +76,13 @@ public:
         float rotation = p.getFloat("rotation") * static_cast<float>(std::numbers::pi / 180.0);
         float fNumber = p.getFloat("f_number");
         float gate = 1.0f;
-        if (ctx.hasInput("camera_state")) {
-            const CameraState& s = ctx.objectAs<CameraStateObject>("camera_state").state;
+        if (mCamera) {
+            // The f-number (and the gate that follows from it) is the camera's, which the spikes' shader reads on
+            // the GPU: length and strength go per unit f-number, the sample count as its cap.
+            const CameraState& s = mCamera->state;
             blades = s.bladeCount;
             rotation = s.bladeRotation;
-            fNumber = s.fNumber;
-            // Wide open the blades are out of the light path: a round pupil, no spikes; straight edges by a stop down.
-            gate = std::clamp(std::log2(fNumber / std::max(s.wideOpenFNumber, 1e-3f)), 0.0f, 1.0f);
+            fNumber = 1.0f;
         }
         gpu_types::StreaksPush push{};
         fillBrightPass(ctx, mFactor, push);
@@ -89,17 +91,19 @@ public:
         push.spikeLength =
             p.getFloat("length") * static_cast<float>(out.height) / static_cast<float>(mFactor) * fNumber / 8.0f;
         push.strength = p.getFloat("strength") * fNumber / 8.0f * gate;
-        push.samples = static_cast<uint32_t>(
-            std::clamp(static_cast<int>(std::ceil(push.spikeLength)), 1, p.getInt("max_samples")));
-        ctx.dispatch(mBright, push, low.width, low.height);
+        push.samples = mCamera ? static_cast<uint32_t>(p.getInt("max_samples"))
+                               : static_cast<uint32_t>(std::clamp(static_cast<int>(std::ceil(push.spikeLength)), 1,
+                                                                  p.getInt("max_samples")));
+        dispatchWithCamera(ctx, mCamera.get(), mBright, push, low.width, low.height);
         ctx.computeBarrier();
-        ctx.dispatch(mSpikes, push, low.width, low.height);
+        dispatchWithCamera(ctx, mCamera.get(), mSpikes, push, low.width, low.height);
         ctx.computeBarrier();
         ctx.dispatch(mComposite, push, out.width, out.height);
     }
 
 private:
     uint32_t mFactor = 4;
+    std::shared_ptr<CameraStateObject> mCamera;
     PipelineId mBright = 0, mSpikes = 0, mComposite = 0;
 };
 

@@ -45,16 +45,16 @@ public:
         if (p.getBool("inverse") && (op == "aces_fit" || op == "pbr_neutral"))
             ctx.failParam("inverse", op + " is not invertible here; use linear, reinhard or reinhard_max");
         if (ctx.hasInput("camera_state")) mCamera = ctx.objectAs<CameraStateObject>("camera_state");
-        mPipeline = ctx.computePipeline("post/tonemap.comp");
+        mPipeline = ctx.computePipeline("post/tonemap.comp", cameraExposureDefines(mCamera != nullptr), mCamera ? 1 : 0);
     }
     void execute(ExecuteContext& ctx) override {
         const auto& p = ctx.params();
         gpu_types::TonemapPush push{};
-        push.exposureScale = mCamera ? mCamera->state.exposure : std::exp2(p.getFloat("exposure"));
+        push.exposureScale = mCamera ? 1.0f : std::exp2(p.getFloat("exposure")); // the shader reads the camera's
         push.op = static_cast<uint32_t>(p.getEnumIndex("operator"));
         push.inverse = p.getBool("inverse") ? 1u : 0u;
         const ImageDesc& out = ctx.output("color").desc();
-        ctx.dispatch(mPipeline, push, out.width, out.height);
+        dispatchWithCamera(ctx, mCamera.get(), mPipeline, push, out.width, out.height);
     }
 
 private:

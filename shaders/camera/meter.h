@@ -19,14 +19,55 @@
 #ifdef __cplusplus
 namespace vitrine::gpu_types {
 #endif
+// One push-constant block per shader: expose.comp defines EXPOSE_SHADER before including this.
+#if defined(__cplusplus) || !defined(EXPOSE_SHADER)
 VITRINE_PUSH_BEGIN(MeterPush)
     float centreWeight; // 0: average metering; 1: the Gaussian alone
     float centreSigma;  // the Gaussian's σ, in units of half the image height
     uint tilesX;
     uint tileCount;
 VITRINE_PUSH_END(pc)
+#endif
+
+// expose.comp's flags.
+#define EXPOSE_METERED 1u  // the histogram holds this frame's metering
+#define EXPOSE_RESET 2u    // frame 0: eye adaptation starts over
+#define EXPOSE_MANUAL 4u   // manual mode: manualFNumber, manualShutter, iso
+#define EXPOSE_AUTO_ISO 8u
+#define EXPOSE_GROUP 64
+
+// expose.comp: the histogram's trimmed mean -> eye adaptation -> program line -> CameraExposure.
+#if defined(__cplusplus) || defined(EXPOSE_SHADER)
+VITRINE_PUSH_BEGIN(ExposePush)
+    uint flags;          // EXPOSE_*
+    float meterLow;      // fractions of the histogram's weight ignored at the dark end ...
+    float meterHigh;     // ... and above which metering stops
+    float dt;            // seconds per frame
+    float tau;           // adaptation time constant (s)
+    float initialEv100;  // until the first metering, or always without metering
+    float compensation;  // stops
+    float shift;         // program shift (stops)
+    float wideOpenFNumber;
+    float minFNumber;
+    float shortestShutter;
+    float longestShutter;
+    float focalLengthMm;
+    float iso;           // manual ISO, or the program's (base) ISO
+    float maxIso;
+    float manualFNumber;
+    float manualShutter;
+    uint blades;         // aperture shape for the area (0: circle)
+    float bladeRoundness;
+    float bladeRotation;
+    float mechanicalWideOpen; // mechanical vignetting wide open
+    float pad0;
+    float pad1;
+    float pad2;
+VITRINE_PUSH_END(pc)
+#endif
 #ifdef __cplusplus
 static_assert(sizeof(MeterPush) == 16);
+static_assert(sizeof(ExposePush) == 96);
 }
 #endif
 #endif

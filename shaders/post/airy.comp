@@ -14,8 +14,9 @@ void main() {
     ivec2 size = imageSize(out_color);
     if (any(greaterThanEqual(p, size))) return;
     vec3 sum = vec3(0.0), weight = vec3(0.0);
-    for (int y = -pc.radius; y <= pc.radius; ++y)
-        for (int x = -pc.radius; x <= pc.radius; ++x) {
+    int radius = airyRadius();
+    for (int y = -radius; y <= radius; ++y)
+        for (int x = -radius; x <= radius; ++x) {
             vec3 k = imageLoad(out_psf, ivec2(x, y) + ivec2(pc.maxRadius)).rgb;
             // The kernel is the pattern a point spreads into: a pixel receives from p - offset.
             ivec2 q = clamp(p - ivec2(x, y), ivec2(0), size - 1);

@@ -22,4 +22,28 @@ VITRINE_PUSH_END(pc)
 static_assert(sizeof(AiryPush) == 32);
 }
 #endif
+
+#ifndef __cplusplus
+#include "camera/exposure.glsl"
+// Rings the kernel reaches: its half-size is this many first-zero radii (nodes/post/airy.cpp's kRingsReach).
+#define AIRY_RINGS_REACH (16.4706 / AIRY_FIRST_ZERO)
+// The first dark ring's radius per channel (pixels) this frame: pc.firstZero, or with the camera's f-number on the
+// GPU (camera_state connected, f_number 0) pc.firstZero per unit f-number times it.
+vec3 airyFirstZero() {
+#ifdef CAMERA_EXPOSURE
+    return pc.firstZero.rgb * cameraExposure.fNumber;
+#else
+    return pc.firstZero.rgb;
+#endif
+}
+// The kernel half-size this frame: pc.radius, or with the camera's f-number derived here (pc.radius is the cap).
+int airyRadius() {
+#ifdef CAMERA_EXPOSURE
+    vec3 r0 = airyFirstZero();
+    return clamp(int(ceil(AIRY_RINGS_REACH * max(max(r0.r, r0.g), r0.b))), 1, pc.maxRadius);
+#else
+    return pc.radius;
+#endif
+}
+#endif
 #endif

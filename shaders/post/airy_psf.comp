@@ -32,13 +32,15 @@ void main() {
     if (any(greaterThanEqual(t, size))) return;
     vec2 offset = vec2(t - ivec2(pc.maxRadius));
     vec3 value = vec3(0.0);
-    if (max(abs(offset.x), abs(offset.y)) <= float(pc.radius)) {
+    vec3 firstZero = airyFirstZero();
+    int radius = airyRadius();
+    if (max(abs(offset.x), abs(offset.y)) <= float(radius)) {
         float n = float(pc.supersample);
         for (uint j = 0u; j < pc.supersample; ++j)
             for (uint i = 0u; i < pc.supersample; ++i) {
                 float r = length(offset + (vec2(i, j) + 0.5) / n - 0.5);
-                if (r > float(pc.radius)) continue;
-                value += vec3(airy(r, pc.firstZero.r), airy(r, pc.firstZero.g), airy(r, pc.firstZero.b));
+                if (r > float(radius)) continue;
+                value += vec3(airy(r, firstZero.r), airy(r, firstZero.g), airy(r, firstZero.b));
             }
         value /= n * n;
     }

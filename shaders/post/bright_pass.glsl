@@ -2,6 +2,17 @@
 // box-averaged over factor x factor input texels into one texel of a smaller image. HDR radiance in, HDR out:
 // a pixel of luminance L keeps the fraction max(0, L e - threshold) / (L e) of its colour (e: the exposure scale).
 #include "common/color.glsl"
+#include "camera/exposure.glsl"
+
+// The exposure scale: the push constant's, times the camera's on the GPU when camera_state is connected (the push
+// constant is 1 then).
+float brightPassExposure(float pushed) {
+#ifdef CAMERA_EXPOSURE
+    return pushed * cameraExposure.exposure;
+#else
+    return pushed;
+#endif
+}
 
 vec3 brightPass(sampler2D image, ivec2 texel, int factor, float exposure, float threshold) {
     ivec2 size = textureSize(image, 0);

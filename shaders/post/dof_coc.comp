@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "post/dof.h"
+#include "camera/exposure.glsl"
 
 // post.dof pass 1: the signed circle of confusion of every pixel from the thin-lens model, in pixels of diameter
 // (negative in front of the focus plane, positive behind it), clamped to +-maxCoc. With a CoC history (this node's
@@ -23,7 +24,12 @@ float viewDepth(float d) {
 float cocAt(ivec2 q, float focus) {
     ivec2 size = textureSize(in_depth, 0);
     float z = viewDepth(texelFetch(in_depth, clamp(q, ivec2(0), size - 1), 0).r);
-    float c = pc.cocScale / (focus - pc.focalLength) * (z - focus) / z;
+#ifdef CAMERA_EXPOSURE
+    float cocScale = pc.cocScale / cameraExposure.fNumber; // the camera's f-number, on the GPU
+#else
+    float cocScale = pc.cocScale;
+#endif
+    float c = cocScale / (focus - pc.focalLength) * (z - focus) / z;
     return clamp(c, -pc.maxCoc, pc.maxCoc);
 }
 

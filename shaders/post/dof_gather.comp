@@ -3,6 +3,16 @@
 #include "post/dof.h"
 #include "post/aperture.glsl"
 #include "post/dof_layers.glsl"
+#include "camera/exposure.glsl"
+
+// The aperture's roundness and area: the camera's at its f-number, on the GPU, or the push constants'.
+#ifdef CAMERA_EXPOSURE
+#define DOF_ROUNDNESS cameraExposure.apertureRoundness
+#define DOF_APERTURE_AREA cameraExposure.apertureArea
+#else
+#define DOF_ROUNDNESS pc.roundness
+#define DOF_APERTURE_AREA pc.apertureArea
+#endif
 
 // post.dof pass 3: the layers, gathered and composited, plus the scattered sprites.
 // The frame's signed CoC range [-span, span] is cut into `layers` layers (Kawase 2008/2012: the demo used up to 15;
@@ -27,7 +37,7 @@ layout(binding = 3, r32ui) readonly uniform uimage2D out_sprite_count;
 layout(binding = 4, rgba32f) readonly uniform image2D out_sprites;
 layout(binding = 5) writeonly uniform image2D out_color;
 
-float boundary(float theta) { return apertureBoundary(pc.blades, pc.roundness, pc.rotation, theta); }
+float boundary(float theta) { return apertureBoundary(pc.blades, DOF_ROUNDNESS, pc.rotation, theta); }
 
 shared vec4 sSprite[64];
 shared vec3 sColor[64];
@@ -89,7 +99,7 @@ void main() {
             vec2 up = vec2(d.x, -d.y) * (a.z < 0.0 ? -1.0 : 1.0); // y up; the near bokeh inverted
             float edge = r * boundary(atan(up.y, up.x));
             float cover = clamp(edge - dist + 0.5, 0.0, 1.0);
-            if (cover > 0.0) spriteAdd[layerOf(a.z, span)] += sColor[k] * cover / (pc.apertureArea * r * r);
+            if (cover > 0.0) spriteAdd[layerOf(a.z, span)] += sColor[k] * cover / (DOF_APERTURE_AREA * r * r);
         }
         barrier();
     }
@@ -112,7 +122,7 @@ void main() {
         float flip = centreCoc > 0.0 ? -1.0 : 1.0;
         int reachPx = int(ceil(r + 0.5));
         int side = 2 * reachPx + 1;
-        int taps = r <= 2.5 ? side * side : clamp(int(pc.apertureArea * r * r * 0.5), 24, 64);
+        int taps = r <= 2.5 ? side * side : clamp(int(DOF_APERTURE_AREA * r * r * 0.5), 24, 64);
         if (r >= 1.0) {
             barrier(); // the previous layer's taps are read
             int i = int(gl_LocalInvocationIndex);

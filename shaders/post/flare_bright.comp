@@ -11,5 +11,5 @@ layout(binding = 1, rgba16f) uniform image2D out_bright;
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(out_bright)))) return;
-    imageStore(out_bright, p, vec4(brightPass(in_color, p, pc.factor, pc.exposure, pc.threshold), 1.0));
+    imageStore(out_bright, p, vec4(brightPass(in_color, p, pc.factor, brightPassExposure(pc.exposure), pc.threshold), 1.0));
 }

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "post/grain.h"
+#include "camera/exposure.glsl"
 
 // Film grain in display-referred space: the display-linear colour is sRGB-encoded, a zero-mean Gaussian grain of
 // standard deviation pc.sigma added (the same to all three channels) and the result decoded again.
@@ -51,7 +52,14 @@ void main() {
     if (any(greaterThanEqual(p, imageSize(out_color)))) return;
     vec4 c = texelFetch(in_color, p, 0);
 
-    vec2 q = (vec2(p) + 0.5) / pc.size;
+    float sigma = pc.sigma, size = pc.size;
+#ifdef CAMERA_EXPOSURE
+    // The camera's ISO, on the GPU: pc.sigma and pc.size are the grain's at ISO 100 then.
+    float isoScale = cameraExposure.iso / 100.0;
+    sigma *= sqrt(isoScale);
+    size = max(0.5, size * pow(isoScale, 0.25));
+#endif
+    vec2 q = (vec2(p) + 0.5) / size;
     ivec2 base = ivec2(floor(q)) - 1;
     float wx[4], wy[4];
     float sx = 0.0, sy = 0.0;
@@ -67,6 +75,6 @@ void main() {
     g /= sqrt(sx * sy);
 
     vec3 rgb;
-    for (int k = 0; k < 3; ++k) rgb[k] = srgbDecode(max(srgbEncode(max(c[k], 0.0)) + pc.sigma * g, 0.0));
+    for (int k = 0; k < 3; ++k) rgb[k] = srgbDecode(max(srgbEncode(max(c[k], 0.0)) + sigma * g, 0.0));
     imageStore(out_color, p, vec4(rgb, c.a));
 }

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "post/lens.h"
+#include "camera/exposure.glsl"
 
 // Lens imperfections on the finished HDR image, each switchable: radial distortion (Brown's model in its two radial
 // terms), lateral chromatic aberration (a radial scale per channel), natural vignetting (cos^4 law) and mechanical
@@ -63,8 +64,14 @@ void main() {
         v *= cos2 * cos2;
     }
     if ((pc.flags & LENS_MECHANICAL_VIGNETTING) != 0u) {
-        float offset = pc.mechanical * length(d) / pc.halfDiagonal;
-        v *= discOverlap(pc.pupil, 1.0, offset) / (kPi * pc.pupil * pc.pupil);
+        float pupil = pc.pupil, mechanical = pc.mechanical;
+#ifdef CAMERA_EXPOSURE
+        // The camera's aperture, on the GPU: pc.pupil is the wide-open f-number and pc.mechanical 1 then.
+        pupil = clamp(pc.pupil / max(cameraExposure.fNumber, 1e-3), 1e-3, 1.0);
+        mechanical *= cameraExposure.mechanicalVignetting;
+#endif
+        float offset = mechanical * length(d) / pc.halfDiagonal;
+        v *= discOverlap(pupil, 1.0, offset) / (kPi * pupil * pupil);
     }
     imageStore(out_color, p, vec4(c * v, g.a));
 }

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "post/tonemap.h"
 #include "common/color.glsl"
+#include "camera/exposure.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_color;
@@ -12,8 +13,12 @@ void main() {
     if (any(greaterThanEqual(p, imageSize(out_color)))) return;
     vec4 c = texelFetch(in_color, p, 0);
     vec3 rgb = max(c.rgb, vec3(0.0));
+    float exposureScale = pc.exposureScale;
+#ifdef CAMERA_EXPOSURE
+    exposureScale *= cameraExposure.exposure; // the camera's, on the GPU (pc.exposureScale is 1 then)
+#endif
     if (pc.inverse == 0u) {
-        rgb *= pc.exposureScale;
+        rgb *= exposureScale;
         if (pc.op == TONEMAP_REINHARD) rgb = tonemapReinhard(rgb);
         else if (pc.op == TONEMAP_REINHARD_MAX) rgb = tonemapReinhardMax(rgb);
         else if (pc.op == TONEMAP_ACES_FIT) rgb = tonemapAcesFit(rgb);
@@ -21,7 +26,7 @@ void main() {
     } else {
         if (pc.op == TONEMAP_REINHARD) rgb = tonemapReinhardInverse(rgb);
         else if (pc.op == TONEMAP_REINHARD_MAX) rgb = tonemapReinhardMaxInverse(rgb);
-        rgb /= pc.exposureScale;
+        rgb /= exposureScale;
     }
     imageStore(out_color, p, vec4(rgb, c.a));
 }

@@ -1,11 +1,14 @@
-// camera.physical on the GPU: the metering histogram read back against CPU statistics of the same pixels (flat
-// images, a weighted gradient, a trimmed three-level image), doubling the luminance moving the EV by 1, the program
-// reacting to the light with the f-numbers and shutters of the documented curve (worked out by hand in
-// tests/unit/camera/program_test.cpp), eye adaptation's exponential, and post.tonemap taking its exposure from
-// the camera state.
+// camera.physical on the GPU (the default path: metering, adaptation and program all on the GPU, the result read
+// back from its buffer after the frame): the metered EV against CPU statistics of the same pixels (flat images, a
+// weighted gradient, a trimmed three-level image), doubling the luminance moving the EV by 1, the program reacting to
+// the light with the f-numbers and shutters of the documented curve (worked out by hand in
+// tests/unit/camera/program_test.cpp) and matching the CPU's program, eye adaptation's exponential without waits in
+// the frame, post.tonemap taking its exposure from the camera state, and the default path's image against the
+// `readback: same_frame` debug path's (CPU metering and program).
 #include "tests/gpu/gpu_test.hpp"
 
 #include "core/base/error.hpp"
+#include "core/base/paths.hpp"
 #include "core/graph/compiler.hpp"
 #include "core/graph/executor.hpp"
 #include "core/graph/loader.hpp"
@@ -13,6 +16,7 @@
 #include "core/image/io.hpp"
 #include "core/shader/compiler.hpp"
 #include "nodes/camera/camera_state.hpp"
+#include "nodes/camera/lens.hpp"
 #include "nodes/camera/program.hpp"
 
 #include <algorithm>
@@ -69,8 +73,12 @@ json cameraGraph(const fs::path& image, const json& cameraParams, int frames = 1
 }
 
 struct CameraRun {
-    std::vector<CameraState> states; // per frame
+    std::vector<CameraState> states; // per frame (the GPU buffer's fields read back after each frame)
+    std::vector<gpu_types::CameraExposure> exposures; // per frame, the buffer itself
+    std::vector<CameraState> cpuStates; // per frame, the CPU half as the producer left it
     Image final;                     // the last frame's output
+    uint32_t inFrameWaits = 0;       // fence waits while recording, all frames together
+    uint32_t inFrameWaitsAfterFirst = 0;
 };
 
 CameraRun run(const json& doc) {
@@ -86,12 +94,19 @@ CameraRun run(const json& doc) {
     options.progress = false;
     options.write.resize(graph.desc.frame.frames);
     std::iota(options.write.begin(), options.write.end(), 0u);
-    options.onOutput = [&](uint32_t frame, const std::string&, const Image& image) {
+    options.onOutput = [&](uint32_t frame, const std::string& name, const Image& image) {
+        if (name != "final") return;
         EXPECT_EQ(state->frame, frame);
-        out.states.push_back(state->state);
+        out.states.push_back(state->resolved());
+        out.exposures.push_back(state->gpuExposure());
+        out.cpuStates.push_back(state->state);
         out.final = image;
     };
     executor.run(options);
+    for (size_t f = 0; f < executor.timings().size(); ++f) {
+        out.inFrameWaits += executor.timings()[f].inFrameWaits;
+        if (f > 0) out.inFrameWaitsAfterFirst += executor.timings()[f].inFrameWaits;
+    }
     return out;
 }
 
@@ -211,9 +226,10 @@ TEST_F(Camera, TonemapTakesTheCameraExposure) {
     EXPECT_GT(maxAbsDiff(r.final, runGraph(plain).at("final")), 0.1); // the param alone is something else
 }
 
-// Eye adaptation: with the result read back a frame late, frame 0 has no metering and uses initial_ev100; from
-// frame 1 on the EV approaches the metered M as M + (I − M) exp(−k dt / τ). Metering last frame's image
-// (`copy.color@prev`) in the same frame gives the same curve (frame 0's input is not valid yet).
+// Eye adaptation on the CPU (the `readback` debug paths): with the result read back a frame late, frame 0 has no
+// metering and uses initial_ev100; from frame 1 on the EV approaches the metered M as M + (I − M) exp(−k dt / τ).
+// Metering last frame's image (`copy.color@prev`) in the same frame gives the same curve (frame 0's input is not
+// valid yet).
 TEST_F(Camera, EyeAdaptationIsExponentialInTime) {
     const double L = 1000.0, M = std::log2(8.0 * L), I = 6.0, tau = 0.25, fps = 24.0;
     const fs::path image = writeGrey("flat1000", 64, 64, [&](int, int) { return L; });
@@ -230,6 +246,137 @@ TEST_F(Camera, EyeAdaptationIsExponentialInTime) {
     params["adaptation_time"] = 0.0;
     CameraRun instant = run(cameraGraph(image, params, 2, true));
     EXPECT_NEAR(instant.states[1].meteredEv100, M, 1e-3);
+}
+
+// The default path (readback: none) keeps eye adaptation on the GPU across frames: metering last frame's image, the
+// EV follows the same exponential as the CPU debug paths, and no frame waits for the GPU while it is recorded; the
+// same_frame path does wait (once a frame that meters), so the counter can fail.
+TEST_F(Camera, GpuEyeAdaptationIsExponentialWithoutWaits) {
+    const double L = 1000.0, M = std::log2(8.0 * L), I = 6.0, tau = 0.25, fps = 24.0;
+    const fs::path image = writeGrey("flat1000gpu", 64, 64, [&](int, int) { return L; });
+    json params = {{"initial_ev100", I}, {"adaptation_time", tau}, {"fps", fps}};
+    CameraRun gpuRun = run(cameraGraph(image, params, 6, true));
+    ASSERT_EQ(gpuRun.states.size(), 6u);
+    EXPECT_NEAR(gpuRun.states[0].meteredEv100, I, 1e-6);
+    for (int k = 1; k < 6; ++k)
+        EXPECT_NEAR(gpuRun.states[k].meteredEv100, M + (I - M) * std::exp(-k / fps / tau), 2e-3) << "frame " << k;
+    EXPECT_EQ(gpuRun.inFrameWaits, 0u);
+    // A second run of the same executor starts over at frame 0 (the state in the buffer is reset, not continued).
+    {
+        CompiledGraph graph =
+            compileGraph(validateGraph(cameraGraph(image, params, 3, true), "camera-test.json", NodeRegistry::global()));
+        std::shared_ptr<CameraStateObject> state;
+        for (const auto& r : graph.resources)
+            if (r.name == "camera.state") state = std::dynamic_pointer_cast<CameraStateObject>(r.object);
+        ASSERT_TRUE(state);
+        ShaderCompiler shaders;
+        Executor executor(gpu(), graph, shaders);
+        std::vector<float> first;
+        RunOptions options;
+        options.progress = false;
+        options.write = {0u, 1u, 2u};
+        options.onOutput = [&](uint32_t, const std::string&, const Image&) { first.push_back(state->resolved().meteredEv100); };
+        executor.run(options);
+        executor.run(options);
+        ASSERT_EQ(first.size(), 6u);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(first[3 + k], first[k], 1e-6) << "second run, frame " << k;
+    }
+    params["readback"] = "same_frame";
+    CameraRun cpuRun = run(cameraGraph(image, params, 6, true));
+    EXPECT_EQ(cpuRun.inFrameWaits, 5u); // frames 1..5 meter (frame 0's @prev input is not valid)
+    for (int k = 0; k < 6; ++k) EXPECT_NEAR(gpuRun.states[k].meteredEv100, cpuRun.states[k].meteredEv100, 1e-4);
+}
+
+// The program line and what follows from the f-number (aperture roundness and area, mechanical vignetting) on the GPU
+// against the same shaders/camera/exposure.h functions compiled for the CPU (and core/scene/aperture.cpp's area):
+// scenes from EV -2 to EV 22 (the whole line: wide open with slow shutters, the diagonal, the smallest aperture, the
+// shutter limit) with auto ISO, a program shift, exposure compensation and a zoom with mechanical vignetting.
+TEST_F(Camera, GpuProgramMatchesTheCpuProgram) {
+    const camera::LensData zoom = camera::loadLens(camera::findLens("canon_ef_24-70mm_f2.8l_ii", ".", dataDir()));
+    EXPECT_GT(camera::evaluateLens(zoom, 25.0f, 5.0f, 2.8f).mechanicalVignetting, 0.01f); // something to fade
+    // (EV, program shift): shift +8 at EV -4 runs into the longest shutter (30 s) before the smallest aperture.
+    const std::vector<std::pair<double, double>> cases = {{-4.0, 8.0}, {-2.0, 1.0}, {4.0, 1.0}, {9.0, 1.0},
+                                                          {13.0, 1.0}, {17.5, 1.0}, {22.0, 1.0}};
+    for (const auto& [ev, shift] : cases) {
+        const double L = std::exp2(ev) / 8.0;
+        json params = kAverage;
+        params["lens"] = "canon_ef_24-70mm_f2.8l_ii";
+        params["focal_length"] = 25.0;
+        params["auto_iso"] = true;
+        params["program_shift"] = shift;
+        params["exposure_compensation"] = -0.9;
+        const fs::path image =
+            writeGrey("program" + std::to_string(int(ev * 10)) + "_" + std::to_string(int(shift)), 32, 32,
+                      [&](int, int) { return L; });
+        CameraRun r = run(cameraGraph(image, params));
+        const CameraState& s = r.states[0];
+        EXPECT_NEAR(s.meteredEv100, ev, 1e-3);
+        camera::ProgramLimits limits;
+        limits.wideOpenFNumber = s.wideOpenFNumber;
+        limits.minFNumber = s.minFNumber;
+        limits.focalLengthMm = 25.0f;
+        limits.autoIso = true;
+        const camera::ExposureSettings e =
+            camera::programExposure(s.meteredEv100 + 0.9f, static_cast<float>(shift), limits);
+        EXPECT_LE(s.shutterSeconds, 30.0f * 1.0001f) << "EV " << ev;
+        EXPECT_NEAR(s.fNumber / e.fNumber, 1.0, 1e-4) << "EV " << ev;
+        EXPECT_NEAR(s.shutterSeconds / e.shutterSeconds, 1.0, 1e-4) << "EV " << ev;
+        EXPECT_NEAR(s.iso / e.iso, 1.0, 1e-4) << "EV " << ev;
+        EXPECT_NEAR(s.ev100, e.ev100, 1e-4) << "EV " << ev;
+        EXPECT_NEAR(s.exposure / camera::exposureScale(e.ev100), 1.0, 1e-4) << "EV " << ev;
+        const gpu_types::CameraExposure cpu = exposureOf(s), gpuSide = r.exposures[0];
+        EXPECT_NEAR(gpuSide.stopsDown, cpu.stopsDown, 1e-4) << "EV " << ev;
+        EXPECT_NEAR(gpuSide.apertureRoundness, cpu.apertureRoundness, 1e-4) << "EV " << ev;
+        EXPECT_NEAR(gpuSide.apertureArea, cpu.apertureArea, 1e-4) << "EV " << ev;
+        // The CPU's evaluateLens at the GPU's f-number.
+        const camera::LensState lens = camera::evaluateLens(zoom, 25.0f, 5.0f, s.fNumber);
+        EXPECT_NEAR(gpuSide.mechanicalVignetting, lens.mechanicalVignetting, 1e-5) << "EV " << ev;
+        std::printf("EV %5.1f: f/%.3f 1/%.1f s ISO %.0f, roundness %.4f area %.5f mech %.4f\n", ev, s.fNumber,
+                    1.0 / s.shutterSeconds, s.iso, gpuSide.apertureRoundness, gpuSide.apertureArea,
+                    gpuSide.mechanicalVignetting);
+    }
+}
+
+// The default path's image equals the same_frame path's (CPU metering, adaptation and program, uploaded) through
+// every post node that reads the camera in its shaders and takes only an image and the camera: tone map, lens,
+// flare, streaks, Airy diffraction and grain, on a bright, uneven still image over a few frames of adaptation (last
+// frame's image metered, from an initial EV 12).
+TEST_F(Camera, DefaultPathImageEqualsSameFrame) {
+    const fs::path image = writeGrey("spots", 96, 64, [](int x, int y) {
+        double dx = x - 30.0, dy = y - 20.0;
+        return 40.0 + 5.0 * x + 2e5 * std::exp(-(dx * dx + dy * dy) / 6.0);
+    });
+    json doc = cameraGraph(image, {{"lens", "canon_ef_24-70mm_f2.8l_ii"}, {"focal_length", 24.0},
+                                   {"initial_ev100", 12.0}, {"adaptation_time", 0.2}}, 4, true);
+    json& nodes = doc["nodes"];
+    nodes["lens"] = {{"type", "post.lens"}, {"in", {{"color", "load.color"}, {"camera_state", "camera.state"}}}};
+    nodes["airy"] = {{"type", "post.airy"}, {"in", {{"color", "lens.color"}, {"camera_state", "camera.state"}}}};
+    nodes["flare"] = {{"type", "post.flare"}, {"params", {{"threshold", 0.5}}},
+                      {"in", {{"color", "airy.color"}, {"camera_state", "camera.state"}}}};
+    nodes["streaks"] = {{"type", "post.streaks"}, {"params", {{"threshold", 0.5}}},
+                        {"in", {{"color", "flare.color"}, {"camera_state", "camera.state"}}}};
+    nodes["tonemap"]["in"]["color"] = "streaks.color";
+    nodes["tonemap"]["params"]["operator"] = "aces_fit";
+    nodes["grain"] = {{"type", "post.grain"}, {"params", {{"strength", 0.05}}},
+                      {"in", {{"color", "tonemap.color"}, {"camera_state", "camera.state"}}}};
+    doc["outputs"] = {{"final", "grain.color"}};
+    CameraRun gpuRun = run(doc);
+    nodes["camera"]["params"]["readback"] = "same_frame";
+    CameraRun cpuRun = run(doc);
+    ASSERT_EQ(gpuRun.states.size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+        std::printf("frame %d: metered EV %.4f (same_frame %.4f), EV %.4f, f/%.3f, 1/%.1f s\n", k, gpuRun.states[k].meteredEv100,
+                    cpuRun.states[k].meteredEv100, gpuRun.states[k].ev100, gpuRun.states[k].fNumber, 1.0 / gpuRun.states[k].shutterSeconds);
+        EXPECT_NEAR(gpuRun.states[k].meteredEv100, cpuRun.states[k].meteredEv100, 1e-4) << "frame " << k;
+        EXPECT_NEAR(gpuRun.states[k].ev100, cpuRun.states[k].ev100, 1e-4) << "frame " << k;
+        EXPECT_NEAR(gpuRun.states[k].fNumber / cpuRun.states[k].fNumber, 1.0, 1e-4) << "frame " << k;
+    }
+    EXPECT_GT(std::abs(gpuRun.states[3].meteredEv100 - gpuRun.states[0].meteredEv100), 0.1); // it did adapt
+    EXPECT_GT(gpuRun.states[3].fNumber, gpuRun.states[3].wideOpenFNumber * 1.2f); // stopped down: streaks, no round pupil
+    const double diff = maxAbsDiff(gpuRun.final, cpuRun.final);
+    std::printf("default vs same_frame: max |diff| %.3g, RMSE %.3g\n", diff, rmse(gpuRun.final, cpuRun.final));
+    EXPECT_LT(diff, 1e-3);
+    EXPECT_EQ(gpuRun.inFrameWaits, 0u);
 }
 
 TEST(CameraParams, BadLensAndSettingsNameTheParam) {

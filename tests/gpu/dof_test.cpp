@@ -272,6 +272,51 @@ TEST_F(Dof, PointLightBokehHasTheApertureShapeAndThinLensDiameter) {
     }
 }
 
+// With camera_state connected, post.dof and post.airy read the f-number (and the aperture's roundness and area at
+// it) from the camera's GPU buffer in their shaders: the images equal those of the same lens given as params. Five
+// blades of roundness 0.5 (test.camera_state's, CameraState's default) on a lens open at f/1.4: at f/2 the aperture
+// is half way between round and that (roundness 0.74), at f/4 fully stopped down (0.5), so the shape, the CoC and
+// the Airy rings all move with the f-number.
+TEST_F(Dof, CameraStateFNumberIsReadOnTheGpu) {
+    const PointScene ps = pointScene(6.0, 1.0);
+    const double focalMm = 0.5 * kSensorHeight * 1e3 / std::tan(0.5 * ps.yfov);
+    // Airy on a 0.3 mm-high sensor (2.3 um pixels): the first dark ring 1.2-2.7 px out, the kernel several rings wide.
+    const double kAirySensorMm = 0.3;
+    const json outputs = {{"dof", "dof.color"}, {"coc", "dof.coc"}, {"airy", "airy.color"}};
+    for (double fNumber : {2.0, 4.0}) {
+        json params = {{"focus_distance", ps.zf}, {"max_coc", 64.0}, {"blades", 5}, {"blade_roundness", 0.5},
+                       {"blade_rotation", 0.0}, {"wide_open_f_number", 1.4}, {"f_number", fNumber}};
+        json nodes = {{"scene", sceneNode(ps.glb)}, {"gbuffer", gbufferNode()}, {"dof", dofNode(params)},
+                      {"airy", {{"type", "post.airy"},
+                                {"in", {{"color", "gbuffer.emissive"}}},
+                                {"params", {{"f_number", fNumber}, {"sensor_height", kAirySensorMm}}}}}};
+        const auto plain = runGraph(makeGraph(nodes, outputs, ps.size, ps.size));
+        nodes["camera"] = {{"type", "test.camera_state"},
+                           {"params", {{"f_number", fNumber}, {"wide_open", 1.4}, {"blades", 5},
+                                       {"focal_length", focalMm}, {"focus_distance", ps.zf}}}};
+        nodes["dof"]["in"]["camera_state"] = "camera.state";
+        nodes["dof"]["params"] = {{"max_coc", 64.0}, {"f_number", 0.0}, {"blade_roundness", 0.9}}; // the state's win
+        nodes["airy"]["in"]["camera_state"] = "camera.state";
+        nodes["airy"]["params"] = {{"sensor_height", kAirySensorMm}}; // the f-number is the state's
+        const auto withState = runGraph(makeGraph(nodes, outputs, ps.size, ps.size));
+        double peak = 0.0;
+        for (const char* name : {"dof", "airy"}) {
+            const Image& img = plain.at(name);
+            for (int y = 0; y < img.height; ++y)
+                for (int x = 0; x < img.width; ++x) peak = std::max(peak, static_cast<double>(img.at(x, y)[1]));
+        }
+        const double dDof = maxAbsDiff(plain.at("dof"), withState.at("dof"));
+        const double dCoc = maxAbsDiff(plain.at("coc"), withState.at("coc"));
+        const double dAiry = maxAbsDiff(plain.at("airy"), withState.at("airy"));
+        std::printf("f/%.0f: camera_state vs params: dof %.3g, coc %.3g px, airy %.3g (peak %.3g)\n", fNumber, dDof,
+                    dCoc, dAiry, peak);
+        EXPECT_GT(peak, 0.0);
+        EXPECT_LT(dCoc, 1e-4);
+        EXPECT_LT(dDof, 1e-4 * peak);
+        EXPECT_LT(dAiry, 1e-4 * peak);
+    }
+}
+
 // The thin-lens scene camera (256 aperture samples, accumulated) spreads the point over the aperture: every lit pixel
 // of the mean lies in the expected polygon (grown by 1.5 pixels: the sphere's own size), the spread's diameter is
 // the thin lens's within 10 %.

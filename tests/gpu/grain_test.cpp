@@ -176,6 +176,13 @@ TEST_F(Grain, CameraStateIsoReplacesTheParam) {
     doc["nodes"]["grain"]["in"]["camera_state"] = "camera.state";
     auto frames = runFrames(doc);
     EXPECT_NEAR(stats(frames[0]).sd / (0.02 * 4.0), 1.0, 0.04);
+    // The shader reads the camera's ISO on the GPU (camera.physical's default path, manual mode here): the grain, its
+    // size included, is the one of iso 1600 given as the param.
+    auto byParam = runFrames(grainGraph({{"iso", 1600.0}, {"strength", 0.02}, {"size", sizeFor(2.0)}}));
+    ASSERT_EQ(byParam[0].size(), frames[0].size());
+    double worst = 0.0;
+    for (size_t i = 0; i < frames[0].size(); ++i) worst = std::max(worst, std::abs(frames[0][i] - byParam[0][i]));
+    EXPECT_LT(worst, 1e-5);
 }
 
 } // namespace

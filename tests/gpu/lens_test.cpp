@@ -173,6 +173,15 @@ TEST_F(Lens, VignettingFollowsCos4AndThePupilClippedByTheBarrel) {
         std::printf("mechanical vignetting at f/%.2f: darkest sampled %.3f, worst error %.4f\n", fNumber, darkest, err);
         EXPECT_LT(darkest, 0.97);
         EXPECT_LT(err, 3e-3); // the grid count's own error
+        // The same from a camera state: f-number and mechanical vignetting read from its GPU buffer by the shader.
+        json mechState = {
+            {"in", loadNode(writeInput(white, "white_mech"))},
+            {"camera", {{"type", "test.camera_state"},
+                        {"params", {{"f_number", fNumber}, {"wide_open", 2.0}, {"mechanical", 0.8}}}}},
+            {"lens", {{"type", "post.lens"},
+                      {"params", {{"distortion", false}, {"chromatic_aberration", false}, {"vignetting", false}}},
+                      {"in", {{"color", "in.color"}, {"camera_state", "camera.state"}}}}}};
+        EXPECT_LT(maxAbsDiff(runGraph(graph(mechState, {{"out", "lens.color"}}, kW, kH)).at("out"), m), 1e-5);
     }
 }
 
@@ -374,6 +383,21 @@ TEST_F(Lens, StreakCountFollowsTheBladesAndLengthTheFNumber) {
         runStreaks(img, base, {{"blades", 7}, {"f_number", 1.8}, {"wide_open", 1.8}, {"exposure", 1.0}}).at("streaks"),
         1);
     EXPECT_EQ(wideOpen, 0.0);
+    // A camera state's f-number and exposure, which the shaders read on the GPU, act as the same params: f/8 with the
+    // blades in, exposure 1/2 (the param's -1 stop) moving the bright pass.
+    json plain = base;
+    plain["blades"] = 6;
+    plain["rotation"] = 0.0;
+    plain["f_number"] = 8.0;
+    plain["exposure"] = -1.0;
+    auto byParams = runStreaks(img, plain);
+    auto byState = runStreaks(img, base, {{"blades", 6}, {"f_number", 8.0}, {"wide_open", 1.8}, {"exposure", 0.5}});
+    for (const char* name : {"bright", "streaks", "out"}) {
+        const double d = maxAbsDiff(byParams.at(name), byState.at(name));
+        std::printf("streaks from a camera state vs params: %s max |diff| %.3g\n", name, d);
+        EXPECT_LT(d, 1e-3) << name;
+    }
+    EXPECT_GT(maxAbsDiff(byParams.at("bright"), run6.at("bright")), 0.1); // the exposure matters
 
     // Extent of a spike: its intensity-weighted mean distance from the source along it (rotation 0: along +x).
     auto extent = [&](double fNumber) {

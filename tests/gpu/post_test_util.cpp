@@ -72,6 +72,8 @@ NodeSchema schema() {
         {"k1", ParamType::Float, 0.0, -1.0, 1.0, {}, ""},
         {"focal_length", ParamType::Float, 50.0, 1.0, 2000.0, {}, ""},
         {"mechanical", ParamType::Float, 0.0, 0.0, 2.0, {}, ""},
+        {"focus_distance", ParamType::Float, 5.0, 0.01, 1e5, {}, ""},
+        {"iso", ParamType::Float, 100.0, 25.0, 409600.0, {}, ""},
     };
     return s;
 }
@@ -89,9 +91,20 @@ public:
         o->state.distortionK1 = p.getFloat("k1");
         o->state.focalLengthMm = p.getFloat("focal_length");
         o->state.mechanicalVignetting = p.getFloat("mechanical");
+        o->state.focusDistanceM = p.getFloat("focus_distance");
+        o->state.iso = p.getFloat("iso");
         ctx.setObject("state", o);
+        mState = o;
     }
-    void execute(ExecuteContext&) override {}
+    // The consumers' shaders read the metering-dependent fields from the GPU buffer: written from the CPU here.
+    void execute(ExecuteContext& ctx) override {
+        mState->ensureGpu(ctx.gpu());
+        mState->writeExposureFromCpu();
+        mState->frame = ctx.frameIndex();
+    }
+
+private:
+    std::shared_ptr<CameraStateObject> mState;
 };
 
 const NodeRegistration kRegistration(schema(), [] { return std::make_unique<TestCameraState>(); });

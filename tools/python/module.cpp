@@ -481,12 +481,14 @@ PYBIND11_MODULE(vitrine, m) {
                         passes[py::str(r.passIds[p])] = t.passGpuMs.at(p);
                     f["gpu_ms"] = passes;
                     f["cpu_record_ms"] = t.cpuRecordMs;
+                    f["cpu_wait_ms"] = t.cpuWaitMs;
                     f["frame_ms"] = t.frameMs;
                     out.push_back(f);
                 }
                 return out;
             },
-            "Per frame: GPU ms per node, CPU record ms, submit-to-completion ms.")
+            "Per frame: GPU ms per node, CPU record ms (less waits), CPU ms waiting for the GPU while recording, "
+            "submit-to-completion ms.")
         .def_readonly("frames", &RunResult::frames)
         .def_readonly("reused", &RunResult::reused,
                       "The compiled graph was kept from an earlier run of the same document (nothing compiled).")

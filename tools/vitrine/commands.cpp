@@ -222,24 +222,35 @@ int benchCommand(const Args& args) {
     j["memory_bytes"] = {{"transient_aliased", executor.memory().transientAliased},
                          {"transient_unaliased", executor.memory().transientUnaliased},
                          {"persistent", executor.memory().persistent}};
-    std::vector<double> total, record;
+    std::vector<double> total, record, wait;
+    uint64_t inFrameWaits = 0;
     j["passes"] = nlohmann::json::array();
     for (size_t p = 0; p < graph.passes.size(); ++p) {
-        std::vector<double> ms;
-        for (size_t f = warmup; f < timings.size(); ++f) ms.push_back(timings[f].passGpuMs[p]);
+        std::vector<double> ms, cpu;
+        for (size_t f = warmup; f < timings.size(); ++f) {
+            ms.push_back(timings[f].passGpuMs[p]);
+            cpu.push_back(timings[f].passCpuMs[p]);
+        }
         j["passes"].push_back({{"id", graph.passes[p].id}, {"type", graph.passes[p].schema->type},
                                {"setup_ms", graph.passes[p].setupMs}, {"gpu_ms_median", median(ms)},
                                {"gpu_ms_min", *std::min_element(ms.begin(), ms.end())},
-                               {"gpu_ms_max", *std::max_element(ms.begin(), ms.end())}});
+                               {"gpu_ms_max", *std::max_element(ms.begin(), ms.end())},
+                               {"cpu_execute_ms_median", median(cpu)}});
     }
     for (size_t f = warmup; f < timings.size(); ++f) {
         double sum = 0;
         for (double v : timings[f].passGpuMs) sum += v;
         total.push_back(sum);
         record.push_back(timings[f].cpuRecordMs);
+        wait.push_back(timings[f].cpuWaitMs);
+        inFrameWaits += timings[f].inFrameWaits;
     }
     j["gpu_ms_total_median"] = median(total);
+    // Recording the frame's commands, less the time nodes waited for the GPU inside it (cpu_wait_ms_median; a
+    // node that splits the submission to read a result back stalls the frame there).
     j["cpu_record_ms_median"] = median(record);
+    j["cpu_wait_ms_median"] = median(wait);
+    j["in_frame_waits"] = inFrameWaits; // fence waits inside the measured frames' recording, all together
     j["node_figures"] = figures;
     if (ctx.validationMessageCount() > 0) j["validation_messages"] = ctx.validationMessageCount();
     j["scenes"] = nlohmann::json::array();
@@ -272,13 +283,16 @@ int benchCommand(const Args& args) {
     if (!args.has("json") || args.get("json") != "-") {
         std::printf("%s on %s, %ux%u, median of %u frames (after %u warm-up)\n", graphArg(args).c_str(),
                     ctx.deviceInfo().name.c_str(), graph.desc.frame.width, graph.desc.frame.height, frames, warmup);
-        std::printf("  %-20s %-20s %10s\n", "pass", "type", "GPU ms");
+        std::printf("  %-20s %-20s %10s %10s\n", "pass", "type", "GPU ms", "CPU ms");
         for (const auto& p : j["passes"])
-            std::printf("  %-20s %-20s %10.3f\n", p["id"].get<std::string>().c_str(), p["type"].get<std::string>().c_str(),
-                        p["gpu_ms_median"].get<double>());
+            std::printf("  %-20s %-20s %10.3f %10.3f\n", p["id"].get<std::string>().c_str(),
+                        p["type"].get<std::string>().c_str(), p["gpu_ms_median"].get<double>(),
+                        p["cpu_execute_ms_median"].get<double>());
         std::printf("  %-41s %10.3f\n", "total GPU", median(total));
-        std::printf("  CPU record %.3f ms; compile: graph %.2f ms, pipelines %.1f ms; scene build %.1f ms\n",
-                    median(record), graphMs, executor.pipelineMs(), sceneMs);
+        std::printf("  CPU record %.3f ms, CPU wait in the frame %.3f ms (%llu waits in %u frames); compile: graph %.2f "
+                    "ms, pipelines %.1f ms; scene build %.1f ms\n",
+                    median(record), median(wait), static_cast<unsigned long long>(inFrameWaits), frames, graphMs,
+                    executor.pipelineMs(), sceneMs);
         for (const auto& [name, value] : figures.items()) std::printf("  %s: %.0f\n", name.c_str(), value.get<double>());
         const MemoryStats& m = executor.memory();
         std::printf("  transient memory: %s aliased, %s without aliasing (%.0f%%); persistent %s\n",
