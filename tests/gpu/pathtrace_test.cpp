@@ -563,7 +563,8 @@ PATHTRACE_TEST(SheenDirectSunMatchesItsClosedForm) {
     EXPECT_GT(sheenMatters, 1.5);
 }
 
-// Energy of the sheen's lobe in the tracers' sampling: a rough dielectric sphere of base colour 0.7 (shininess 0.35)
+// Energy of the sheen's lobe in the tracers' sampling: a rough metal sphere of base colour 0.7 (shininess 0.35; a
+// metal, so that the base's mixture is GGX alone and the sheen's cosine lobe has its own directions to account for)
 // under a white sheen of roughness 0.5, alone under a uniform sky C (the furnace above). Its radiance is C times the
 // layered BRDF's directional albedo at NoV, sheen E + (1 - E) base, integrated here on a fine grid from core/shading
 // brdfCosineSheen; a sheen lobe sampled with a pdf other than brdfPdf's, a base not scaled by 1 - E, or MIS weights
@@ -576,7 +577,7 @@ PATHTRACE_TEST(SheenFurnaceSphereReflectsItsAlbedo) {
     const glm::vec3 base(0.7f);
     const glm::vec4 sheen(1.0f, 1.0f, 1.0f, 0.5f);
     SceneBuilder b("furnace_sheen");
-    uint32_t m = b.material("white_sheen", base, 0.0f, shininess);
+    uint32_t m = b.material("metal_sheen", base, 1.0f, shininess);
     b.s.materials[m].sheenColor = glm::vec3(sheen);
     b.s.materials[m].sheenRoughness = sheen.a;
     b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(static_cast<float>(radius), 96, 48), m)));
@@ -588,7 +589,7 @@ PATHTRACE_TEST(SheenFurnaceSphereReflectsItsAlbedo) {
     const float roughness = shading::roughnessFromShininess(shininess);
     auto albedoAt = [&](double NoV, glm::vec4 sh) {
         return directionalAlbedo(NoV, 512, [&](glm::vec3 n, glm::vec3 v, glm::vec3 l) {
-            return shading::brdfCosineSheen(n, n, v, l, base, 0.0f, roughness, plain, glm::vec2(0.0f), sh).g;
+            return shading::brdfCosineSheen(n, n, v, l, base, 1.0f, roughness, plain, glm::vec2(0.0f), sh).g;
         });
     };
     std::vector<double> albedo;
