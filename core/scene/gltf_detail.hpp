@@ -32,6 +32,7 @@ inline constexpr const char* kTransmission = "KHR_materials_transmission";
 inline constexpr const char* kIor = "KHR_materials_ior";
 inline constexpr const char* kSpecular = "KHR_materials_specular";
 inline constexpr const char* kClearcoat = "KHR_materials_clearcoat";
+inline constexpr const char* kSheen = "KHR_materials_sheen";
 inline constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 inline constexpr const char* kVariants = "KHR_materials_variants";
 
@@ -42,7 +43,6 @@ struct IgnoredMaterialExtension {
     const char* ignored;
 };
 inline constexpr IgnoredMaterialExtension kIgnoredMaterialExtensions[] = {
-    {"KHR_materials_sheen", "the sheen lobe (sheenColorFactor, sheenRoughnessFactor and their textures)"},
     {"KHR_materials_iridescence", "the thin-film iridescence (iridescenceFactor, its ior, thickness and textures)"},
     {"KHR_materials_volume",
      "the volume (thicknessFactor, attenuationColor, attenuationDistance; transmission stays thin-walled)"},

@@ -383,6 +383,15 @@ Json Exporter::material(const Material& m) const {
         }
         j["extensions"][gltf::kClearcoat] = cc;
     }
+    if (m.hasSheen()) {
+        Json sh = {{"sheenColorFactor", {m.sheenColor.r, m.sheenColor.g, m.sheenColor.b}},
+                   {"sheenRoughnessFactor", m.sheenRoughness}};
+        if (m.sheenColorTexture.valid())
+            sh["sheenColorTexture"] = writeTextureInfo(m.sheenColorTexture, m.sheenColorTexture.texture);
+        if (m.sheenRoughnessTexture.valid())
+            sh["sheenRoughnessTexture"] = writeTextureInfo(m.sheenRoughnessTexture, m.sheenRoughnessTexture.texture);
+        j["extensions"][gltf::kSheen] = sh;
+    }
 
     if (m.layers.size() == 1 && base == core) return j; // the core material says it all
 
@@ -653,10 +662,11 @@ std::vector<uint8_t> Exporter::run() {
     if (transforms) used.push_back(gltf::kTextureTransform);
     if (strength) used.push_back(gltf::kEmissiveStrength);
     if (mScene.hasSun || !mScene.lights.empty()) used.push_back(gltf::kLightsPunctual);
-    bool unlit = false, transmission = false, ior = false, specular = false, clearcoat = false;
+    bool unlit = false, transmission = false, ior = false, specular = false, clearcoat = false, sheen = false;
     for (const Material& m : mScene.materials) {
         specular = specular || m.hasSpecular();
         clearcoat = clearcoat || m.hasClearcoat();
+        sheen = sheen || m.hasSheen();
         unlit = unlit || m.unlit;
         transmission = transmission || m.transmission != 0.0f;
         ior = ior || m.ior != 1.5f;
@@ -666,6 +676,7 @@ std::vector<uint8_t> Exporter::run() {
     if (ior) used.push_back(gltf::kIor);
     if (specular) used.push_back(gltf::kSpecular);
     if (clearcoat) used.push_back(gltf::kClearcoat);
+    if (sheen) used.push_back(gltf::kSheen);
     if (!mScene.probes.empty()) used.push_back(kProbesExtension);
     if (!used.empty()) mDoc["extensionsUsed"] = used; // glTF forbids an empty list
     while (mBin.size() % 4)

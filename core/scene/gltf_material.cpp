@@ -325,6 +325,22 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
                     static_cast<float>(number(ctx, *n, "scale", 1.0, ce + ".clearcoatNormalTexture"));
             }
         }
+        if (const Json* sh = object(ctx, *extensions, kSheen, e + ".extensions")) {
+            std::string she = e + ".extensions." + kSheen;
+            out.sheenColor = glm::vec3(numbers(ctx, *sh, "sheenColorFactor", 3, glm::vec4(0.0f), she));
+            for (int c = 0; c < 3; ++c) {
+                if (!(out.sheenColor[c] >= 0.0f && out.sheenColor[c] <= 1.0f))
+                    ctx.fail(she + ".sheenColorFactor[" + std::to_string(c) + "]", "expected a number in [0, 1]");
+            }
+            out.sheenRoughness = static_cast<float>(number(ctx, *sh, "sheenRoughnessFactor", 0.0, she));
+            if (!(out.sheenRoughness >= 0.0f && out.sheenRoughness <= 1.0f))
+                ctx.fail(she + ".sheenRoughnessFactor", "expected a number in [0, 1]");
+            if (const Json* t = member(*sh, "sheenColorTexture"))
+                out.sheenColorTexture = readTextureInfo(ctx, *t, TextureUsage::Color, she + ".sheenColorTexture");
+            if (const Json* t = member(*sh, "sheenRoughnessTexture"))
+                out.sheenRoughnessTexture =
+                    readTextureInfo(ctx, *t, TextureUsage::Data, she + ".sheenRoughnessTexture");
+        }
     }
     std::string mode = string(ctx, m, "alphaMode", "OPAQUE", e);
     if (mode == "OPAQUE")

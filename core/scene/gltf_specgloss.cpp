@@ -242,6 +242,8 @@ void dropSpecGlossSources(LoadContext& ctx) {
             f(m.clearcoatTexture);
             f(m.clearcoatRoughnessTexture);
             f(m.clearcoatNormal.texture);
+            f(m.sheenColorTexture);
+            f(m.sheenRoughnessTexture);
         }
     };
     std::vector<bool> used(scene.textures.size(), false);

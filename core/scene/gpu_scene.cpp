@@ -128,6 +128,9 @@ void packMaterials(const scene::Scene& scene, std::vector<GpuMaterial>& material
         g.clearcoatRef = texRef(m.clearcoatTexture, 0);
         g.clearcoatRoughnessRef = texRef(m.clearcoatRoughnessTexture, 1);
         g.clearcoatNormalRef = texRef(m.clearcoatNormal.texture);
+        g.sheen = glm::vec4(m.sheenColor, m.sheenRoughness);
+        g.sheenColorRef = texRef(m.sheenColorTexture);
+        g.sheenRoughnessRef = texRef(m.sheenRoughnessTexture, 3);
         materials.push_back(g);
         for (size_t li = 0; li < m.layers.size(); ++li) {
             const scene::MaterialLayer& l = m.layers[li];

@@ -188,6 +188,20 @@ struct Material {
                clearcoatRoughnessTexture.valid() || clearcoatNormal.texture.valid();
     }
 
+    // KHR_materials_sheen: a Charlie sheen lobe over the base (under the coat) of colour sheenColor ×
+    // sheenColorTexture.rgb and perceptual roughness sheenRoughness × sheenRoughnessTexture.a:
+    // f = sc·D·V + (1 − max(sc)·E(N·V)) · base (common/brdf.glsl brdfCosineSheen). A black colour (the default): none.
+    glm::vec3 sheenColor{0.0f};       // linear, in [0, 1]
+    TextureRef sheenColorTexture;     // sRGB
+    float sheenRoughness = 0.0f;      // in [0, 1]
+    TextureRef sheenRoughnessTexture; // data, alpha channel
+
+    // True when KHR_materials_sheen says anything.
+    bool hasSheen() const {
+        return sheenColor != glm::vec3(0.0f) || sheenRoughness != 0.0f || sheenColorTexture.valid() ||
+               sheenRoughnessTexture.valid();
+    }
+
     // Drawn by the transparent pass (alpha blending or transmission), not into the G-buffer.
     bool transparent() const { return alphaMode == AlphaMode::Blend || transmission > 0.0f; }
 

@@ -70,6 +70,12 @@ void hashMaterial(Hasher& h, const Material& m) {
         h.value(m.clearcoatNormal.scale);
         hashRef(h, m.clearcoatNormal.texture);
     }
+    if (m.hasSheen()) {
+        h.value(m.sheenColor);
+        hashRef(h, m.sheenColorTexture);
+        h.value(m.sheenRoughness);
+        hashRef(h, m.sheenRoughnessTexture);
+    }
 }
 
 void hashCamera(Hasher& h, const Camera& c) {
@@ -93,7 +99,8 @@ bool usesUvSet(const Material& m, uint32_t uvSet) {
         }
     }
     return uses(m.emissiveTexture) || uses(m.specularTexture) || uses(m.specularColorTexture) ||
-           uses(m.clearcoatTexture) || uses(m.clearcoatRoughnessTexture) || uses(m.clearcoatNormal.texture);
+           uses(m.clearcoatTexture) || uses(m.clearcoatRoughnessTexture) || uses(m.clearcoatNormal.texture) ||
+           uses(m.sheenColorTexture) || uses(m.sheenRoughnessTexture);
 }
 
 bool usesNormalMap(const Material& m) {
@@ -329,6 +336,8 @@ void Scene::validate() const {
         c.ref(e + ".clearcoatTexture", m.clearcoatTexture, TextureUsage::Data, 0);
         c.ref(e + ".clearcoatRoughnessTexture", m.clearcoatRoughnessTexture, TextureUsage::Data, 1);
         c.ref(e + ".clearcoatNormal", m.clearcoatNormal.texture, TextureUsage::Normal);
+        c.ref(e + ".sheenColorTexture", m.sheenColorTexture, TextureUsage::Color);
+        c.ref(e + ".sheenRoughnessTexture", m.sheenRoughnessTexture, TextureUsage::Data, 3);
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
         const Node& n = nodes[i];

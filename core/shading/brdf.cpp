@@ -1,4 +1,5 @@
 #include "core/shading/brdf.hpp"
+#include "shaders/common/sheen_albedo.h"
 
 #include <algorithm>
 #include <cmath>
@@ -122,6 +123,73 @@ glm::vec3 clearcoatLayer(glm::vec3 base, float clearcoat, float NcoV, glm::vec3 
 glm::vec3 brdfCosineClearcoat(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
                               float roughness, glm::vec4 dielectric, glm::vec2 coat) {
     glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+    return clearcoatLayer(base, coat.x, glm::dot(nc, v), glm::vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
+}
+
+float sheenAlpha(float roughness) {
+    return std::max(roughness * roughness, kMinSheenAlpha);
+}
+
+float sheenCharlieD(float NoH, float alpha) {
+    float invAlpha = 1.0f / alpha;
+    float sin2 = std::max(1.0f - NoH * NoH, 0.0f);
+    return (2.0f + invAlpha) * std::pow(sin2, 0.5f * invAlpha) / (2.0f * kPi);
+}
+
+namespace {
+float mixf(float a, float b, float t) {
+    return a * (1.0f - t) + b * t;
+}
+float sheenLambdaL(float x, float alpha) {
+    float t = (1.0f - alpha) * (1.0f - alpha);
+    float a = mixf(21.5473f, 25.3245f, t);
+    float b = mixf(3.82987f, 3.32435f, t);
+    float c = mixf(0.19823f, 0.16801f, t);
+    float d = mixf(-1.97760f, -1.27393f, t);
+    float e = mixf(-4.32054f, -4.85967f, t);
+    return a / (1.0f + b * std::pow(x, c)) + d * x + e;
+}
+} // namespace
+
+float sheenLambda(float cosTheta, float alpha) {
+    return cosTheta < 0.5f ? std::exp(sheenLambdaL(cosTheta, alpha))
+                           : std::exp(2.0f * sheenLambdaL(0.5f, alpha) - sheenLambdaL(1.0f - cosTheta, alpha));
+}
+
+float sheenVisibility(float NoV, float NoL, float alpha) {
+    return 1.0f / ((1.0f + sheenLambda(NoV, alpha) + sheenLambda(NoL, alpha)) * 4.0f * NoV * NoL);
+}
+
+glm::vec3 sheenCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 sheenColor, float roughness) {
+    float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
+    float NoH = std::clamp(glm::dot(n, glm::normalize(v + l)), 0.0f, 1.0f);
+    float alpha = sheenAlpha(roughness);
+    return sheenColor * (sheenCharlieD(NoH, alpha) * sheenVisibility(NoV, NoL, alpha) * NoL);
+}
+
+float sheenAlbedo(float NoV, float roughness) {
+    float x = 2.0f * std::sqrt(std::clamp(NoV, 0.0f, 1.0f)) - 1.0f;
+    float y = 2.0f * std::clamp(roughness, 0.1f, 1.0f) - 1.0f;
+    return std::exp(VITRINE_SHEEN_ALBEDO_LOG(x, y));
+}
+
+float sheenScaling(glm::vec3 sheenColor, float NoV, float roughness) {
+    float m = std::max(std::max(sheenColor.r, sheenColor.g), sheenColor.b);
+    return std::max(1.0f - m * sheenAlbedo(NoV, roughness), 0.0f);
+}
+
+glm::vec3 sheenLayer(glm::vec3 base, float scaling, glm::vec3 sheen) {
+    return base * scaling + sheen;
+}
+
+glm::vec3 brdfCosineSheen(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                          float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen) {
+    glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+    if (hasSheen(sheen)) {
+        glm::vec3 c(sheen);
+        base = sheenLayer(base, sheenScaling(c, glm::dot(n, v), sheen.a), sheenCosine(n, v, l, c, sheen.a));
+    }
     return clearcoatLayer(base, coat.x, glm::dot(nc, v), glm::vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
 }
 

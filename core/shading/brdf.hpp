@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+
 #include <glm/glm.hpp>
 
 // CPU mirror of shaders/common/brdf.glsl (same names, same maths, same units and pi
@@ -40,6 +42,24 @@ float clearcoatSpecularCosine(glm::vec3 nc, glm::vec3 v, glm::vec3 l, float roug
 glm::vec3 clearcoatLayer(glm::vec3 base, float clearcoat, float NcoV, glm::vec3 coat);
 glm::vec3 brdfCosineClearcoat(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
                               float roughness, glm::vec4 dielectric, glm::vec2 coat);
+// KHR_materials_sheen (shaders/common/brdf.glsl): the Charlie distribution and the spec's fitted Charlie visibility
+// of alpha = sheenAlpha(r), the lobe times the cosine (colour included), its directional albedo E from
+// common/sheen_albedo.h (tools/make_sheen_albedo.py), the base's scaling 1 - max(sc) E, the layering base * scaling +
+// sheen, and brdfCosineClearcoat with a sheen (rgb colour, a roughness) between the base and the coat.
+inline constexpr float kMinSheenAlpha = 0.01f;
+float sheenAlpha(float roughness);
+float sheenCharlieD(float NoH, float alpha);
+float sheenLambda(float cosTheta, float alpha);
+float sheenVisibility(float NoV, float NoL, float alpha);
+glm::vec3 sheenCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 sheenColor, float roughness);
+float sheenAlbedo(float NoV, float roughness);
+float sheenScaling(glm::vec3 sheenColor, float NoV, float roughness);
+inline bool hasSheen(glm::vec4 sheen) {
+    return std::max(std::max(sheen.r, sheen.g), sheen.b) > 0.0f;
+}
+glm::vec3 sheenLayer(glm::vec3 base, float scaling, glm::vec3 sheen);
+glm::vec3 brdfCosineSheen(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
+                          float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen);
 // brdfCosine with the diffuse colour and F0 given apart (shaders/common/brdf.glsl).
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness);
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness);

@@ -24,7 +24,7 @@ NodeSchema schema() {
         tex("normal", "G-buffer: octahedral normal, view depth, shininess"),
         tex("base_color", "G-buffer: base colour, metallic"),
         tex("material", "G-buffer: alpha, 1 − specular strength, vertex AO, cavity"),
-        tex("emissive", "G-buffer: emissive + baked diffuse (a: lightmapped flag + packed clear coat)"),
+        tex("emissive", "G-buffer: emissive + baked diffuse (a: lightmapped flag + packed clear coat or sheen)"),
         tex("depth", "G-buffer hardware depth (reverse Z)"),
         tex("shadow_map", "shadow.directional's atlas (without it the sun is unshadowed)", true),
         {"cascades", PortKind::Buffer, {}, true, Usage::Sampled, "shadow.directional's cascades"},

@@ -127,6 +127,7 @@ struct BrdfLobes {
     float coatProbability = 0.0f;
     float coatRoughness = 0.0f;
     vec3 coatNormal{0.0f};
+    float sheenProbability = 0.0f; // KHR_materials_sheen's cosine lobe, after the coat (0 without a sheen)
 };
 
 BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, glm::vec4 dielectric, float NoV) {
@@ -152,6 +153,14 @@ void addClearcoatLobe(BrdfLobes& b, vec2 coat, vec3 nc, vec3 v) {
     b.coatProbability = std::clamp(w / std::max(w + (1.0f - w) * base, 1e-6f), 0.05f, 0.95f);
 }
 
+void addSheenLobe(BrdfLobes& b, glm::vec4 sheen, float NoV) {
+    if (!hasSheen(sheen)) return;
+    float w = std::max(std::max(sheen.r, sheen.g), sheen.b) * sheenAlbedo(NoV, sheen.a);
+    float base = luminance(schlickFresnel(specularF0(b.baseColor, b.metallic), NoV)) +
+                 luminance(diffuseAlbedo(b.baseColor, b.metallic));
+    b.sheenProbability = std::clamp(w / std::max(w + std::max(1.0f - w, 0.0f) * base, 1e-6f), 0.05f, 0.95f);
+}
+
 float baseBrdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
     float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
     if (NoL <= 0.0f || NoV <= 0.0f) return 0.0f;
@@ -160,8 +169,16 @@ float baseBrdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
     return b.specularProbability * spec + (1.0f - b.specularProbability) * NoL / kPi;
 }
 
-float brdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
+float sheenBrdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
     float base = baseBrdfPdf(b, n, v, l);
+    if (b.sheenProbability <= 0.0f) return base;
+    float NoL = glm::dot(n, l);
+    float sheen = NoL > 0.0f && glm::dot(n, v) > 0.0f ? NoL / kPi : 0.0f;
+    return b.sheenProbability * sheen + (1.0f - b.sheenProbability) * base;
+}
+
+float brdfPdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 l) {
+    float base = sheenBrdfPdf(b, n, v, l);
     if (b.coatProbability <= 0.0f) return base;
     const vec3 nc = b.coatNormal;
     float NcoL = glm::dot(nc, l), NcoV = glm::dot(nc, v), coat = 0.0f;
@@ -181,6 +198,13 @@ bool sampleBrdf(const BrdfLobes& b, vec3 n, vec3 v, vec3 u, vec3& l) {
         u.x = (u.x - b.coatProbability) / (1.0f - b.coatProbability);
     }
     glm::mat3 frame = basisAround(n);
+    if (b.sheenProbability > 0.0f) {
+        if (u.x < b.sheenProbability) {
+            l = frame * sampleCosine(vec2(u.y, u.z));
+            return glm::dot(n, l) > 0.0f;
+        }
+        u.x = (u.x - b.sheenProbability) / (1.0f - b.sheenProbability);
+    }
     if (u.x < b.specularProbability) {
         vec3 vl = glm::transpose(frame) * v;
         vec3 h = frame * sampleGgxVndf(vl, ggxAlpha(b.roughness), vec2(u.y, u.z));
@@ -373,6 +397,19 @@ struct Materials {
         n.x *= m.clearcoat.z;
         n.y *= m.clearcoat.z;
         return n;
+    }
+
+    // scene.glsl materialSheen: KHR_materials_sheen's colour (rgb) and roughness (a).
+    glm::vec4 materialSheen(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
+        glm::vec4 s = m.sheen;
+        if (m.sheenColorRef.info.x >= 0) {
+            glm::vec4 t = sampleRef(m.sheenColorRef, uv0, uv1);
+            s.r *= t.r;
+            s.g *= t.g;
+            s.b *= t.b;
+        }
+        if (m.sheenRoughnessRef.info.x >= 0) s.a *= sampleRef(m.sheenRoughnessRef, uv0, uv1).a;
+        return glm::clamp(s, 0.0f, 1.0f);
     }
 
     // scene.glsl materialSpecular: KHR_materials_specular's colour (rgb) and strength (a).
@@ -616,6 +653,7 @@ struct CpuPathTracer::Impl {
         s.normal = N;
         s.coat = m.optics.z > 0.5f ? vec2(0.0f) : materials.materialClearcoat(m, uv0, uv1);
         s.coatNormal = N;
+        s.sheen = m.optics.z > 0.5f ? glm::vec4(0.0f) : materials.materialSheen(m, uv0, uv1);
         if (s.coat.x > 0.0f) { // the same frame about the coat's own tangent-space normal
             vec3 c = materials.materialClearcoatNormal(m, uv0, uv1);
             vec3 cts = glm::length(c) > 1e-6f ? glm::normalize(c) : vec3(0.0f, 0.0f, 1.0f);
@@ -680,11 +718,12 @@ struct CpuPathTracer::Impl {
             BrdfLobes lobes =
                 brdfLobes(s.baseColor, s.metallic, s.roughness, s.dielectric, std::clamp(glm::dot(n, v), 0.0f, 1.0f));
             addClearcoatLobe(lobes, s.coat, s.coatNormal, v);
+            addSheenLobe(lobes, s.sheen, std::clamp(glm::dot(n, v), 0.0f, 1.0f));
             vec3 weight = throughput * s.cavity;
 
             if (sun && glm::dot(ng, sunDir) > 0.0f) {
-                vec3 f = brdfCosineClearcoat(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness,
-                                             s.dielectric, s.coat);
+                vec3 f = brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                         s.coat, s.sheen);
                 if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) &&
                     !occluded(offsetRay(s.position, ng, sunDir), sunDir, rays))
                     radiance += weight * f * sunE;
@@ -695,8 +734,8 @@ struct CpuPathTracer::Impl {
                 vec3 l = env.sample(vec3(a, bc));
                 float pdf = env.pdf(l);
                 if (glm::dot(ng, l) > 0.0f && pdf > 0.0f) {
-                    vec3 f = brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness,
-                                                 s.dielectric, s.coat);
+                    vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                             s.coat, s.sheen);
                     if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, l), l, rays))
                         radiance += weight * f * env.radiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
                 }
@@ -708,10 +747,10 @@ struct CpuPathTracer::Impl {
             if (!sampleBrdf(lobes, n, v, vec3(a, bc), l) || glm::dot(ng, l) <= 0.0f) break;
             float pdf = brdfPdf(lobes, n, v, l);
             if (pdf <= 0.0f) break;
-            throughput =
-                weight *
-                brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat) /
-                pdf;
+            throughput = weight *
+                         brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                         s.coat, s.sheen) /
+                         pdf;
             brdfPdfPrev = pdf;
             if (bounce >= 2u) {
                 float q = std::min(std::max(std::max(throughput.r, throughput.g), throughput.b), 0.95f);

@@ -68,6 +68,8 @@ struct CpuSurface {
     // (its own normal map, else the vertex normal; `normal` without a coat).
     glm::vec2 coat{0.0f};
     glm::vec3 coatNormal{0.0f};
+    // KHR_materials_sheen: colour (rgb) and perceptual roughness (a); 0 without it.
+    glm::vec4 sheen{0.0f};
 };
 
 class CpuPathTracer;

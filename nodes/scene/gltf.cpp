@@ -11,8 +11,8 @@ NodeSchema schema() {
     NodeSchema s;
     s.type = "scene.gltf";
     s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
-            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, _specular, _clearcoat, "
-            "_variants, "
+            "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, _specular, "
+            "_clearcoat, _sheen, _variants, "
             "_pbrSpecularGlossiness (converted to metallic-roughness), KHR_lights_punctual, node and morph-weight "
             "animations, morph targets, skins.";
     s.pass = PassKind::Transfer;

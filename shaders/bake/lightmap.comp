@@ -54,21 +54,24 @@ vec3 incoming(vec3 origin, vec3 dir, inout uint rng, out bool inside) {
         PathSurface s = pathSurface(hit, origin, dir);
         radiance += throughput * s.emissive * push.scales.z;
         if (bounce >= push.counts.w) break;
-        // The surface reflects with its full material, as render.pathtrace's does (common/brdf.glsl).
+        // The surface reflects with its full material (base, clear coat, sheen), as render.pathtrace's does
+        // (common/brdf.glsl).
         vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
         BrdfLobes lobes = brdfLobes(s.baseColor, s.metallic, s.roughness, s.dielectric, clamp(dot(n, v), 0.0, 1.0));
         addClearcoatLobe(lobes, s.coat, s.coatNormal, v);
+        addSheenLobe(lobes, s.sheen, clamp(dot(n, v), 0.0, 1.0));
         vec3 weight = throughput * s.cavity;
         if (sun && dot(ng, sunDir) > 0.0 && !bvhTraceAny(offsetRay(s.position, ng, sunDir), sunDir, 0.0, kInfinity))
             radiance += weight * sunE *
-                        brdfCosineClearcoat(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
-                                            s.coat);
+                        brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                        s.coat, s.sheen);
         vec3 l;
         if (!sampleBrdf(lobes, n, v, vec3(rngNext(rng), rngNext(rng), rngNext(rng)), l) || dot(ng, l) <= 0.0) break;
         float pdf = brdfPdf(lobes, n, v, l);
         if (pdf <= 0.0) break;
         throughput = weight *
-                     brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat) /
+                     brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat,
+                                     s.sheen) /
                      pdf;
         if (bounce >= 1u) { // Russian roulette, unbiased
             float q = min(max(max(throughput.r, throughput.g), throughput.b), 0.95);

@@ -173,6 +173,85 @@ vec3 brdfCosineClearcoat(vec3 n, vec3 nc, vec3 v, vec3 l, vec3 baseColor, float 
     return clearcoatLayer(base, coat.x, dot(nc, v), vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
 }
 
+// KHR_materials_sheen [Khronos]: a retro-reflective dust / fibre lobe over the base (under a clear coat), of colour
+// sc (sheenColor, linear) and perceptual roughness r (sheenRoughness), about the base shading normal n:
+//     f = sc D V + (1 - max(sc) E(n.v, r)) f_base
+// D the Charlie distribution [Estevez & Kulla 2017] of alpha = r^2 (never below kMinSheenAlpha), V the spec's
+// fitted Charlie visibility (its lambda curve; Neubelt-Pettineo's 1 / (4 (NoL + NoV - NoL NoV)) reflects up to 2.7x
+// the light at grazing angles and was not taken), no Fresnel. E is the lobe's directional albedo for sc = 1, the
+// integral of D V (n.l) over the hemisphere, integrated and fitted by tools/make_sheen_albedo.py
+// (common/sheen_albedo.h, sheenAlbedo): the albedo scaling of the spec (its view-side term, as the Sample Viewer),
+// clamped at 0 where the fitted lobe reflects more than the light it gets (E > 1: r < 0.26 within 3 degrees of
+// grazing, NoV < 0.05).
+#include "common/sheen_albedo.h"
+const float kMinSheenAlpha = 0.01;
+float sheenAlpha(float roughness) { return max(roughness * roughness, kMinSheenAlpha); }
+
+// Charlie: D(h) = (2 + 1/alpha) sin(theta_h)^(1/alpha) / (2 pi); its integral of D NoH over the hemisphere is 1.
+float sheenCharlieD(float NoH, float alpha) {
+    float invAlpha = 1.0 / alpha;
+    float sin2 = max(1.0 - NoH * NoH, 0.0);
+    return (2.0 + invAlpha) * pow(sin2, 0.5 * invAlpha) / (2.0 * kPi);
+}
+
+// The spec's Charlie lambda: exp(L(x)) below x = 0.5, exp(2 L(0.5) - L(1 - x)) above, L(x) = a / (1 + b x^c) + d x + e
+// with a..e blended by (1 - alpha)^2 between its two fits.
+float sheenLambdaL(float x, float alpha) {
+    float t = (1.0 - alpha) * (1.0 - alpha);
+    float a = mix(21.5473, 25.3245, t);
+    float b = mix(3.82987, 3.32435, t);
+    float c = mix(0.19823, 0.16801, t);
+    float d = mix(-1.97760, -1.27393, t);
+    float e = mix(-4.32054, -4.85967, t);
+    return a / (1.0 + b * pow(x, c)) + d * x + e;
+}
+float sheenLambda(float cosTheta, float alpha) {
+    return cosTheta < 0.5 ? exp(sheenLambdaL(cosTheta, alpha))
+                          : exp(2.0 * sheenLambdaL(0.5, alpha) - sheenLambdaL(1.0 - cosTheta, alpha));
+}
+// V = 1 / ((1 + lambda(NoV) + lambda(NoL)) 4 NoV NoL).
+float sheenVisibility(float NoV, float NoL, float alpha) {
+    return 1.0 / ((1.0 + sheenLambda(NoV, alpha) + sheenLambda(NoL, alpha)) * 4.0 * NoV * NoL);
+}
+
+// The sheen lobe times the cosine, sc D V (n.l); zero when l or v is below the surface.
+vec3 sheenCosine(vec3 n, vec3 v, vec3 l, vec3 sheenColor, float roughness) {
+    float NoL = dot(n, l);
+    float NoV = dot(n, v);
+    if (NoL <= 0.0 || NoV <= 0.0) return vec3(0.0);
+    float NoH = clamp(dot(n, normalize(v + l)), 0.0, 1.0);
+    float alpha = sheenAlpha(roughness);
+    return sheenColor * (sheenCharlieD(NoH, alpha) * sheenVisibility(NoV, NoL, alpha) * NoL);
+}
+
+// E(NoV, r): common/sheen_albedo.h's fit, exp of a polynomial in 2 sqrt(NoV) - 1 and 2 max(r, 0.1) - 1.
+float sheenAlbedo(float NoV, float roughness) {
+    float x = 2.0 * sqrt(clamp(NoV, 0.0, 1.0)) - 1.0;
+    float y = 2.0 * clamp(roughness, 0.1, 1.0) - 1.0;
+    return exp(VITRINE_SHEEN_ALBEDO_LOG(x, y));
+}
+
+// The base's weight under the sheen, 1 - max(sc) E(n.v, r) (never negative).
+float sheenScaling(vec3 sheenColor, float NoV, float roughness) {
+    float m = max(max(sheenColor.r, sheenColor.g), sheenColor.b);
+    return max(1.0 - m * sheenAlbedo(NoV, roughness), 0.0);
+}
+bool hasSheen(vec4 sheen) { return max(max(sheen.r, sheen.g), sheen.b) > 0.0; }
+
+// The layering: `base` (the material's reflected light, or its BRDF) under a sheen of scaling `scaling`
+// (sheenScaling), plus `sheen` (the sheen's own reflected light, colour included).
+vec3 sheenLayer(vec3 base, float scaling, vec3 sheen) { return base * scaling + sheen; }
+
+// brdfCosineClearcoat with a sheen (rgb colour, a perceptual roughness) between the base and the coat; the default
+// path (sheen 0) is brdfCosineClearcoat's value to the bit.
+vec3 brdfCosineSheen(vec3 n, vec3 nc, vec3 v, vec3 l, vec3 baseColor, float metallic, float roughness, vec4 dielectric,
+                     vec2 coat, vec4 sheen) {
+    vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+    if (hasSheen(sheen))
+        base = sheenLayer(base, sheenScaling(sheen.rgb, dot(n, v), sheen.a), sheenCosine(n, v, l, sheen.rgb, sheen.a));
+    return clearcoatLayer(base, coat.x, dot(nc, v), vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
+}
+
 // Toksvig [Toksvig04]: a normal averaged over a footprint (mip-mapped without renormalising)
 // has length |Na| < 1; treat the spread as a Gaussian of angular variance (1 - |Na|) / |Na| and
 // widen the lobe. Mapping: GGX alpha to the Blinn-Phong exponent s = 2 / alpha^2 - 2,

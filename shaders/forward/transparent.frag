@@ -91,6 +91,19 @@ void main() {
     // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour
     // (no refraction offset, no blur by roughness).
     vec3 through = transmission * (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * baseColor;
+    // KHR_materials_sheen over the reflected light (as lighting.deferred: emission not scaled, the sky or volume
+    // through the lobe's albedo times the irradiance) and over what passes through.
+    vec4 sheen = materialSheen(m, vUv0, vUv1, grads);
+    if (hasSheen(sheen)) {
+        float NoV = dot(N, v);
+        float scaling = sheenScaling(sheen.rgb, NoV, sheen.a);
+        vec3 sheenLight = sheenCosine(N, v, l, sheen.rgb, sheen.a) * sunE * visibility * cavity;
+        sheenLight += shadePunctualSheen(world, N, v, sheen) * cavity;
+        sheenLight += skyDiffuse(baked ? volume : sh, N, sheen.rgb * sheenAlbedo(NoV, sheen.a)) * occlusion;
+        vec3 emitted = emissive * u.params.w;
+        lit = sheenLayer(lit - emitted, scaling, sheenLight) + emitted;
+        through *= scaling;
+    }
     // KHR_materials_clearcoat over all of it, with the coat's own normal: the base (and what passes through) seen
     // through the coat, 1 - c Fc(nc.v), plus the coat's reflection of the sun, the lights and the sky.
     vec2 coat = materialClearcoat(m, vUv0, vUv1, grads);

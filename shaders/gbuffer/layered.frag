@@ -6,6 +6,7 @@
 #include "common/octahedral.glsl"
 #include "gbuffer/unlit.glsl"
 #include "gbuffer/clearcoat_pack.glsl"
+#include "gbuffer/sheen_pack.glsl"
 
 // The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
 layout(location = 0) in vec3 vNormal;
@@ -86,4 +87,7 @@ void main() {
     // an unlit surface has no coat.
     vec2 coat = m.optics.z > 0.5 ? vec2(0.0) : materialClearcoat(m, vUv0, vUv1, grads);
     outEmissive = vec4(emissive, packClearcoatAlpha(lightmapped > 0.5, coat));
+    // KHR_materials_sheen in the coat's slot where there is no coat (gbuffer/sheen_pack.glsl); unlit has none.
+    vec4 sheen = m.optics.z > 0.5 ? vec4(0.0) : materialSheen(m, vUv0, vUv1, grads);
+    if (hasSheen(sheen) && sheenFits(outEmissive.a)) packSheen(sheen, lightmapped > 0.5, outEmissive.a, outMaterial.x);
 }

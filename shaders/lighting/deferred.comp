@@ -37,6 +37,7 @@ layout(binding = 15) writeonly uniform image2D out_diffuse_indirect;
 #include "lighting/sun_shadow.glsl"
 #include "lighting/punctual.glsl"
 #include "gbuffer/clearcoat_pack.glsl"
+#include "gbuffer/sheen_pack.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -65,7 +66,13 @@ void main() {
     vec3 emissive = emissiveLm.rgb;
     bool lightmapped;
     // KHR_materials_clearcoat (strength, roughness) packed with the flag; the coat shades with the base normal n.
-    vec2 coat = unpackClearcoatAlpha(emissiveLm.a, lightmapped);
+    // KHR_materials_sheen takes the slot where there is no coat (a < 0; gbuffer/sheen_pack.glsl).
+    vec2 coat = vec2(0.0);
+    vec4 sheen = vec4(0.0);
+    if (emissiveLm.a < 0.0)
+        sheen = unpackSheen(emissiveLm.a, g2.x, lightmapped);
+    else
+        coat = unpackClearcoatAlpha(emissiveLm.a, lightmapped);
     vec3 n = octDecode(g0.xy);
     float viewDepth = g0.z;
     float roughness = roughnessFromShininess(g0.w);
@@ -116,6 +123,21 @@ void main() {
     }
     // Lightmapped pixels carry emission and baked diffuse together: emissive_scale leaves them as baked.
     vec3 color = direct + diffuse + specular + emissive * (lightmapped ? 1.0 : u.params.w);
+    // The sheen over the reflected light (a lightmapped pixel's baked diffuse with it, emission not): the base
+    // scaled by 1 - max(sc) E(n.v), plus the sheen's reflection of the sun and the lights, and of the sky or the
+    // volume approximated as the lobe's albedo sc E times the irradiance (a Charlie-prefiltered sky is not made).
+    if (hasSheen(sheen)) {
+        float NoV = dot(n, v);
+        float scaling = sheenScaling(sheen.rgb, NoV, sheen.a);
+        vec3 sheenDirect = sheenCosine(n, v, l, sheen.rgb, sheen.a) * sunE * visibility * cavity;
+        sheenDirect += shadePunctualSheen(world, n, v, sheen) * cavity;
+        vec3 sheenAmbient = skyDiffuse(baked ? volume : sh, n, sheen.rgb * sheenAlbedo(NoV, sheen.a)) * occlusion;
+        vec3 emitted = lightmapped ? vec3(0.0) : emissive * u.params.w;
+        color = sheenLayer(color - emitted, scaling, sheenDirect + sheenAmbient) + emitted;
+        specular *= scaling;
+        diffuse = sheenLayer(diffuse, scaling, sheenAmbient);
+        if (lightmapped) emissive *= scaling;
+    }
     // The clear coat over all of it: the base seen through the coat, 1 - c Fc(n.v), plus the coat's own
     // reflection of the sun, the lights and the sky (F0 0.04), with the cavity and occlusion the base has.
     if (coat.x > 0.0) {

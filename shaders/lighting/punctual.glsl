@@ -48,4 +48,16 @@ vec3 shadePunctualClearcoat(vec3 p, vec3 nc, vec3 v, float roughness) {
     return sum;
 }
 
+// The sheen's share of every light (KHR_materials_sheen): its lobe about n, colour included, without the base's
+// scaling (common/brdf.glsl sheenCosine).
+vec3 shadePunctualSheen(vec3 p, vec3 n, vec3 v, vec4 sheen) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < VITRINE_LIGHTS.count.x; ++i) {
+        vec3 l;
+        vec3 e = punctualIlluminance(VITRINE_LIGHTS.lights[i], p, l);
+        sum += sheenCosine(n, v, l, sheen.rgb, sheen.a) * e;
+    }
+    return sum;
+}
+
 #endif

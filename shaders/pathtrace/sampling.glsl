@@ -72,6 +72,9 @@ float ggxVndfPdf(float NoV, float NoH, float alpha) {
 // mixture's (both lobes can produce every direction), so brdfCosine / pdf is the weight.
 // KHR_materials_clearcoat adds a third lobe, the coat's GGX about its own normal, chosen first with probability
 // coatProbability (0 without a coat: the two-lobe mixture as before, to the bit).
+// KHR_materials_sheen adds one more under the coat: cosine-weighted about n (the sheen is a low, broad lobe),
+// chosen with probability sheenProbability once the coat was not (0 without a sheen: the mixture as before). Every
+// lobe's density is in brdfPdf, and the weight is the whole layered BRDF over it: unbiased.
 struct BrdfLobes {
     vec3 baseColor;
     float metallic;
@@ -80,6 +83,7 @@ struct BrdfLobes {
     float coatProbability;
     float coatRoughness;
     vec3 coatNormal;
+    float sheenProbability;
 };
 
 // dielectric: the surface's dielectric Fresnel (dielectricSpecular; (0.04, 0.04, 0.04, 1) without
@@ -95,6 +99,7 @@ BrdfLobes brdfLobes(vec3 baseColor, float metallic, float roughness, vec4 dielec
     b.specularProbability = max(s / max(s + d, 1e-6), 0.1); // 1 for metals: no diffuse lobe
     b.coatProbability = 0.0;
     b.coatRoughness = 0.0;
+    b.sheenProbability = 0.0;
     return b;
 }
 
@@ -111,6 +116,16 @@ void addClearcoatLobe(inout BrdfLobes b, vec2 coat, vec3 nc, vec3 v) {
     b.coatProbability = clamp(w / max(w + (1.0 - w) * base, 1e-6), 0.05, 0.95);
 }
 
+// The sheen's lobe in the mixture, chosen in proportion to its albedo max(sc) E(n.v) against the base's share
+// (1 - max(sc) E) (s + d), clamped to [0.05, 0.95] as the coat's.
+void addSheenLobe(inout BrdfLobes b, vec4 sheen, float NoV) {
+    if (!hasSheen(sheen)) return;
+    float w = max(max(sheen.r, sheen.g), sheen.b) * sheenAlbedo(NoV, sheen.a);
+    float base = luminance(schlickFresnel(specularF0(b.baseColor, b.metallic), NoV)) +
+                 luminance(diffuseAlbedo(b.baseColor, b.metallic));
+    b.sheenProbability = clamp(w / max(w + max(1.0 - w, 0.0) * base, 1e-6), 0.05, 0.95);
+}
+
 float baseBrdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
     float NoL = dot(n, l), NoV = dot(n, v);
     if (NoL <= 0.0 || NoV <= 0.0) return 0.0;
@@ -119,8 +134,17 @@ float baseBrdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
     return b.specularProbability * spec + (1.0 - b.specularProbability) * NoL / kPi;
 }
 
-float brdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
+// The base's lobes and the sheen's (cosine about n).
+float sheenBrdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
     float base = baseBrdfPdf(b, n, v, l);
+    if (b.sheenProbability <= 0.0) return base;
+    float NoL = dot(n, l);
+    float sheen = NoL > 0.0 && dot(n, v) > 0.0 ? NoL / kPi : 0.0;
+    return b.sheenProbability * sheen + (1.0 - b.sheenProbability) * base;
+}
+
+float brdfPdf(BrdfLobes b, vec3 n, vec3 v, vec3 l) {
+    float base = sheenBrdfPdf(b, n, v, l);
     if (b.coatProbability <= 0.0) return base;
     vec3 nc = b.coatNormal;
     float NcoL = dot(nc, l), NcoV = dot(nc, v);
@@ -142,6 +166,13 @@ bool sampleBrdf(BrdfLobes b, vec3 n, vec3 v, vec3 u, out vec3 l) {
         u.x = (u.x - b.coatProbability) / (1.0 - b.coatProbability);
     }
     mat3 frame = basisAround(n);
+    if (b.sheenProbability > 0.0) {
+        if (u.x < b.sheenProbability) { // the sheen's lobe
+            l = frame * sampleCosine(u.yz);
+            return dot(n, l) > 0.0;
+        }
+        u.x = (u.x - b.sheenProbability) / (1.0 - b.sheenProbability);
+    }
     if (u.x < b.specularProbability) {
         vec3 vl = transpose(frame) * v;
         vec3 h = frame * sampleGgxVndf(vl, ggxAlpha(b.roughness), u.yz);

@@ -30,6 +30,7 @@ struct PathSurface {
     vec3 emissive;   // cd/m^2, before the node's emissive scale
     vec4 dielectric; // the dielectric's Fresnel F0 (rgb) and F90 (a): common/brdf.glsl dielectricSpecular
     vec2 coat;       // KHR_materials_clearcoat: strength, perceptual roughness (0, 0 without it)
+    vec4 sheen;      // KHR_materials_sheen: colour (rgb), perceptual roughness (a); 0 without it
     vec3 coatNormal; // the coat's shading normal (its own normal map, else the vertex normal); `normal` without a coat
 };
 
@@ -108,6 +109,7 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.normal = N;
     s.coat = m.optics.z > 0.5 ? vec2(0.0) : materialClearcoat(m, uv0, uv1, lod0);
     s.coatNormal = N;
+    s.sheen = m.optics.z > 0.5 ? vec4(0.0) : materialSheen(m, uv0, uv1, lod0);
     if (s.coat.x > 0.0) { // the same frame about the coat's own tangent-space normal
         vec3 c = materialClearcoatNormal(m, uv0, uv1, lod0);
         vec3 cts = length(c) > 1e-6 ? normalize(c) : vec3(0.0, 0.0, 1.0);

@@ -71,14 +71,15 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
         BrdfLobes lobes = brdfLobes(s.baseColor, s.metallic, s.roughness, s.dielectric, clamp(dot(n, v), 0.0, 1.0));
         addClearcoatLobe(lobes, s.coat, s.coatNormal, v);
+        addSheenLobe(lobes, s.sheen, clamp(dot(n, v), 0.0, 1.0));
         // Cavity darkens all light the surface reflects, as lighting.deferred does for the sun and the sky.
         vec3 weight = throughput * s.cavity;
 
         // Sun: a delta light, reached only by next-event estimation; lit exactly as lighting.deferred lights
         // it, brdfCosine x E (shadeDirectional with intensity E / pi).
         if (sun && dot(ng, sunDir) > 0.0) {
-            vec3 f = brdfCosineClearcoat(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
-                                         s.coat);
+            vec3 f = brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                         s.coat, s.sheen);
             if (any(greaterThan(f, vec3(0.0))) && !bvhTraceAny(offsetRay(s.position, ng, sunDir), sunDir, 0.0, kInfinity))
                 radiance += weight * f * sunE;
         }
@@ -87,8 +88,8 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
             vec3 l = sampleEnv(in_env_cdf, envSize, vec3(rngNext(rng), rngNext2(rng)));
             float pdf = envPdf(in_env_cdf, envSize, l);
             if (dot(ng, l) > 0.0 && pdf > 0.0) {
-                vec3 f =
-                    brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat);
+                vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
+                                         s.coat, s.sheen);
                 if (any(greaterThan(f, vec3(0.0))) && !bvhTraceAny(offsetRay(s.position, ng, l), l, 0.0, kInfinity))
                     radiance += weight * f * skyRadiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
@@ -99,7 +100,8 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         float pdf = brdfPdf(lobes, n, v, l);
         if (pdf <= 0.0) break;
         throughput = weight *
-                     brdfCosineClearcoat(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat) /
+                     brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric, s.coat,
+                                     s.sheen) /
                      pdf;
         brdfPdfPrev = pdf;
         // Russian roulette from the third surface on, unbiased: survivors carry 1 / q.

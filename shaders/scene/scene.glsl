@@ -150,6 +150,15 @@ vec3 materialClearcoatNormal(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
     return n;
 }
 
+// KHR_materials_sheen at a surface point: rgb the sheen colour (sheenColorFactor x sheenColorTexture), a its
+// perceptual roughness (sheenRoughnessFactor x sheenRoughnessTexture.a); 0 without the extension.
+vec4 materialSheen(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
+    vec4 s = m.sheen;
+    if (m.sheenColorRef.info.x >= 0) s.rgb *= sampleRef(m.sheenColorRef, uv0, uv1, g).rgb;
+    if (m.sheenRoughnessRef.info.x >= 0) s.a *= sampleRef(m.sheenRoughnessRef, uv0, uv1, g).a;
+    return clamp(s, 0.0, 1.0);
+}
+
 // The five blended parameters of a surface point. `normal` is tangent space and NOT normalised: its
 // length is below 1 where a mip averaged disagreeing normals (Toksvig).
 struct LayeredSurface {

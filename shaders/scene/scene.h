@@ -64,6 +64,11 @@ struct GpuMaterial {
     GpuTexRef clearcoatRef;
     GpuTexRef clearcoatRoughnessRef;
     GpuTexRef clearcoatNormalRef;
+    // KHR_materials_sheen (0 without it): rgb: sheenColorFactor (linear), a: sheenRoughnessFactor. The textures
+    // multiply them (sheenColorRef's sRGB colour, sheenRoughnessRef's alpha). scene.glsl materialSheen.
+    vec4 sheen;
+    GpuTexRef sheenColorRef;
+    GpuTexRef sheenRoughnessRef;
 };
 
 struct GpuInstance {
@@ -104,7 +109,7 @@ VITRINE_PUSH_END(draw)
 #ifdef __cplusplus
 static_assert(sizeof(GpuTexRef) == 48);
 static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
-static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48 + 16 + 3 * 48);
+static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48 + 16 + 3 * 48 + 16 + 2 * 48);
 static_assert(sizeof(GpuInstance) == 192);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
 static_assert(sizeof(SceneDrawPush) == 96);

@@ -209,6 +209,68 @@ TEST_F(LightingTerms, ClearcoatGroundMatchesTheCpuLayering) {
     EXPECT_GT(coatMatters, 2.0);
 }
 
+// KHR_materials_sheen in lighting.deferred: the grazing-sun ground of the coat test, dark grey and rough, under a
+// sheen of colour (1, 16/31, 10/15) and roughness 8/15, values the G-buffer's 5-5-4 + 4-bit packing keeps exactly.
+// Expected: core/shading's brdfCosineSheen (the lobe checked against the spec's formulas and its albedo table against
+// quadrature in shading.Brdf.Sheen*) x E. Low sun and a camera looking along the ground: the Charlie lobe's grazing
+// retro-reflection lights it several times the bare ground's. Bound 2 % as above; the sheen must matter.
+TEST_F(LightingTerms, SheenGroundMatchesTheCpuLayering) {
+    const int W = 64, H = 64;
+    const float shininess = 0.3f;
+    const glm::vec4 sheen(1.0f, 16.0f / 31.0f, 10.0f / 15.0f, 8.0f / 15.0f);
+    const glm::vec3 base(51.0f / 255.0f);
+    const double sunElevation = 12.0 * kPi / 180.0;
+    const double sunScale = 0.1;
+    const float groundHalf = 40.0f;
+
+    SceneBuilder b("grazing_sheen");
+    std::vector<Tri> quad;
+    addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
+    uint32_t m = b.material("velvet", base, 0.0f, shininess);
+    b.s.materials[m].sheenColor = glm::vec3(sheen); // written into the .glb as KHR_materials_sheen and read back
+    b.s.materials[m].sheenRoughness = sheen.a;
+    b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, m)));
+    b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
+    b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(std::cos(sunElevation))});
+    auto glb = b.write();
+
+    json nodes = baseNodes(glb);
+    nodes["direct"] = lightingNode({{"sky_ambient", 0.0}, {"sun_scale", sunScale}}, false);
+    auto out = runGraph(graph(nodes, {{"direct", "direct.color"}, {"sh", "sky.sh"}}, W, H));
+    const Image& direct = out.at("direct");
+    const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
+    const float roughness = shading::roughnessFromShininess(shininess);
+
+    Pinhole cam(b.s, W, H);
+    int checked = 0;
+    double worst = 0.0, sheenMatters = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= 0.0) continue;
+            glm::dvec3 p = cam.position - cam.position.y / d.y * d;
+            if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
+            const glm::vec3 n(0, 1, 0), v(-d), lf(l);
+            glm::dvec3 expected = glm::dvec3(shading::brdfCosineSheen(n, n, v, lf, base, 0.0f, roughness, plain,
+                                                                      glm::vec2(0.0f), sheen)) *
+                                  sunE;
+            if (expected.g < 1.0) continue;
+            ++checked;
+            glm::dvec3 got = rgb(direct, x, y);
+            double e = relErr(got, expected);
+            worst = std::max(worst, e);
+            glm::dvec3 bare = cpuSun({0, 1, 0}, v, l, base, 0.0f, shininess, sunE);
+            sheenMatters = std::max(sheenMatters, expected.r / std::max(bare.r, 1e-6));
+            EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << ": " << got.r << " vs " << expected.r;
+        }
+    std::printf("KHR_materials_sheen ground: %d pixels, max relative error %.2g, with / without sheen up to %.1f\n",
+                checked, worst, sheenMatters);
+    EXPECT_GE(checked, 300);
+    EXPECT_GT(sheenMatters, 1.5);
+}
+
 // ---------------------------------------------------------------------------------------------
 
 struct SphereMaterial {

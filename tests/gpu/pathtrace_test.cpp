@@ -528,6 +528,110 @@ PATHTRACE_TEST(ClearcoatFurnaceSphereReflectsItsAlbedo) {
     EXPECT_LT(worst, 0.25);
 }
 
+// KHR_materials_sheen in the tracers, direct sun: the ground of the tests above (grey 0.05, shininess 0.55) under a
+// sheen of colour (0.9, 0.5, 0.6) and roughness 0.5: the closed form is core/shading brdfCosineSheen (its lobe checked
+// against the spec's formulas in shading.Brdf.SheenLobeMatchesTheKhronosFormulas). Bound 1 % per channel where the
+// expected value is above 1 % of the brightest.
+PATHTRACE_TEST(SheenDirectSunMatchesItsClosedForm) {
+    const float shininess = 0.55f;
+    const glm::vec4 sheen(0.9f, 0.5f, 0.6f, 0.5f);
+    const glm::vec3 base(0.05f);
+    const SunlitGround g = traceSunlitGround("pt_sheen", 64, 64, [&](SceneBuilder& b) {
+        uint32_t m = b.material("velvet", base, 0.0f, shininess);
+        b.s.materials[m].sheenColor = glm::vec3(sheen);
+        b.s.materials[m].sheenRoughness = sheen.a;
+        return m;
+    });
+    const float roughness = shading::roughnessFromShininess(shininess);
+    const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    double sheenMatters = 0.0;
+    for (const auto& [px, d] : g.pixels) {
+        glm::vec3 n(0, 1, 0), v(-d), lf(g.toSun);
+        glm::dvec3 e =
+            glm::dvec3(shading::brdfCosineSheen(n, n, v, lf, base, 0.0f, roughness, plain, glm::vec2(0.0f), sheen)) *
+            g.sunE;
+        glm::dvec3 bare = glm::dvec3(shading::brdfCosine(n, v, lf, base, 0.0f, roughness)) * g.sunE;
+        sheenMatters = std::max(sheenMatters, e.b / std::max(bare.b, 1e-9));
+        expected.push_back({px, e});
+    }
+    const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
+    std::printf("%s tracer, KHR_materials_sheen ground: %d pixels, worst relative error %.4f, with / without sheen "
+                "up to %.1f\n",
+                gBackend, checked, worst, sheenMatters);
+    EXPECT_GE(checked, 300);
+    EXPECT_GT(sheenMatters, 1.5);
+}
+
+// Energy of the sheen's lobe in the tracers' sampling: a rough metal sphere of base colour 0.7 (shininess 0.35; a
+// metal, so that the base's mixture is GGX alone and the sheen's cosine lobe has its own directions to account for)
+// under a white sheen of roughness 0.5, alone under a uniform sky C (the furnace above). Its radiance is C times the
+// layered BRDF's directional albedo at NoV, sheen E + (1 - E) base, integrated here on a fine grid from core/shading
+// brdfCosineSheen; a sheen lobe sampled with a pdf other than brdfPdf's, a base not scaled by 1 - E, or MIS weights
+// that do not sum to 1, shows as a departure. The albedo must stay at most 1 (the sheen takes the energy it adds
+// from the base). Bounds as the furnace: mean within 1 %, each pixel within 25 % (64 samples per pixel).
+PATHTRACE_TEST(SheenFurnaceSphereReflectsItsAlbedo) {
+    const int W = 48, H = 48;
+    const double C = 100.0, radius = 1.0;
+    const float shininess = 0.35f;
+    const glm::vec3 base(0.7f);
+    const glm::vec4 sheen(1.0f, 1.0f, 1.0f, 0.5f);
+    SceneBuilder b("furnace_sheen");
+    uint32_t m = b.material("metal_sheen", base, 1.0f, shininess);
+    b.s.materials[m].sheenColor = glm::vec3(sheen);
+    b.s.materials[m].sheenRoughness = sheen.a;
+    b.node("sphere", static_cast<int32_t>(b.mesh("sphere", sphereTris(static_cast<float>(radius), 96, 48), m)));
+    b.camera({0.0f, 0.5f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+    auto glb = b.write();
+    auto out = runGraph(traceGraph(glb, uniformSky(glb, C), {{"spp", 64}, {"antialias", false}}, W, H));
+    const Image& img = out.at("color");
+    const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
+    const float roughness = shading::roughnessFromShininess(shininess);
+    auto albedoAt = [&](double NoV, glm::vec4 sh) {
+        return directionalAlbedo(NoV, 512, [&](glm::vec3 n, glm::vec3 v, glm::vec3 l) {
+            return shading::brdfCosineSheen(n, n, v, l, base, 1.0f, roughness, plain, glm::vec2(0.0f), sh).g;
+        });
+    };
+    std::vector<double> albedo;
+    double sheenShare = 0.0;
+    for (int i = 0; i <= 32; ++i) {
+        double NoV = 0.2 + 0.8 * i / 32.0;
+        albedo.push_back(albedoAt(NoV, sheen));
+        EXPECT_LE(albedo.back(), 1.0) << "NoV " << NoV;
+        sheenShare = std::max(sheenShare, albedo.back() - albedoAt(NoV, glm::vec4(0.0f)));
+    }
+    auto interp = [&](double NoV) {
+        double f = std::clamp((NoV - 0.2) / 0.8 * 32.0, 0.0, 31.999);
+        int i = static_cast<int>(f);
+        return albedo[i] + (albedo[i + 1] - albedo[i]) * (f - i);
+    };
+    Pinhole cam(b.s, W, H);
+    double sumRatio = 0.0, worst = 0.0;
+    int n = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            double t = hitSphere(cam.position, d, glm::dvec3(0.0), radius);
+            if (t < 0.0) continue;
+            glm::dvec3 nrm = glm::normalize(cam.position + t * d);
+            double NoV = glm::dot(nrm, -d);
+            if (NoV < 0.2) continue; // tessellated silhouette
+            glm::dvec3 got = rgb(img, x, y);
+            double ratio = (got.r + got.g + got.b) / (3.0 * C * interp(NoV));
+            sumRatio += ratio;
+            worst = std::max(worst, std::abs(ratio - 1.0));
+            ++n;
+        }
+    double mean = sumRatio / n;
+    std::printf("%s tracer, sheen furnace: %d pixels, albedo %.4f (NoV 1) .. %.4f (NoV 0.2), sheen adds up to %.4f, "
+                "mean ratio %.5f, worst pixel %.3f\n",
+                gBackend, n, albedo.back(), albedo.front(), sheenShare, mean, worst);
+    ASSERT_GT(n, 500);
+    EXPECT_GT(sheenShare, 0.02); // the sheen changes the albedo somewhere (a base not scaled would too, upwards)
+    EXPECT_LT(std::abs(mean - 1.0), 0.01);
+    EXPECT_LT(worst, 0.25);
+}
+
 // Textures as ray tracers sample them (the texel pool: one buffer for all textures, scene.glsl
 // VITRINE_SCENE_TEXEL_POOL) against the G-buffer's hardware samplers: two textured planes under the sun, direct
 // light only, path traced and deferred-lit. The textures are small and magnified (LOD 0 in both), sRGB colour, and

@@ -167,14 +167,14 @@ TEST_F(SceneCli, SceneShorthandErrorsNameWhatIsWrong) {
 // node's param strict) and on export-scene. A triangle that uses an extension vitrine does not implement.
 TEST_F(SceneCli, GltfWarningsArePrintedAndStrictRefuses) {
     const fs::path dir = freshDir("gltf_strict");
-    const fs::path file = dir / "sheen.gltf";
+    const fs::path file = dir / "anisotropy.gltf";
     {
         std::FILE* f = std::fopen(file.c_str(), "w");
         ASSERT_NE(f, nullptr);
-        std::fputs(R"({"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_sheen"],
+        std::fputs(R"({"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_materials_anisotropy"],
  "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
- "materials": [{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 0, 0]}}}],
+ "materials": [{"extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 1}}}],
  "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
  "bufferViews": [{"buffer": 0, "byteLength": 36}],
  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}]}
@@ -191,21 +191,22 @@ TEST_F(SceneCli, GltfWarningsArePrintedAndStrictRefuses) {
     const std::string graph = quote(kSource + "/graphs/gltf.json");
     const CliResult warned = vitrine("validate " + graph + " --scene " + quote(file.string()));
     EXPECT_EQ(warned.status, 0) << warned.output;
-    EXPECT_EQ(count(warned.output, "warning: " + file.string() + ": extensionsUsed[0]: extension 'KHR_materials_sheen'"),
-              1u)
+    EXPECT_EQ(
+        count(warned.output, "warning: " + file.string() + ": extensionsUsed[0]: extension 'KHR_materials_anisotropy'"),
+        1u)
         << warned.output;
     const CliResult strict = vitrine("validate " + graph + " --scene " + quote(file.string()) + " --strict");
     EXPECT_EQ(strict.status, 1) << strict.output;
     EXPECT_NE(strict.output.find("1 warning, which strict loading"), std::string::npos) << strict.output;
-    EXPECT_NE(strict.output.find("KHR_materials_sheen"), std::string::npos) << strict.output;
+    EXPECT_NE(strict.output.find("KHR_materials_anisotropy"), std::string::npos) << strict.output;
 
     const CliResult exported = vitrine("export-scene " + quote(file.string()) + " " + quote((dir / "a.glb").string()));
     EXPECT_EQ(exported.status, 0) << exported.output;
-    EXPECT_EQ(count(exported.output, "KHR_materials_sheen"), 1u) << exported.output;
+    EXPECT_EQ(count(exported.output, "KHR_materials_anisotropy"), 1u) << exported.output;
     const CliResult refused =
         vitrine("export-scene " + quote(file.string()) + " " + quote((dir / "b.glb").string()) + " --strict");
     EXPECT_EQ(refused.status, 1) << refused.output;
-    EXPECT_NE(refused.output.find("KHR_materials_sheen"), std::string::npos) << refused.output;
+    EXPECT_NE(refused.output.find("KHR_materials_anisotropy"), std::string::npos) << refused.output;
     EXPECT_FALSE(fs::exists(dir / "b.glb"));
 }
 

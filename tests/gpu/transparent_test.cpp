@@ -290,12 +290,15 @@ TEST_F(Transparent, ThinGlassReflectsByFresnelAndTintsWhatIsBehind) {
 // (octahedral RGBA16F normal, R11G11B10 emission, RGBA16F outputs). Coated: the same quad under a KHR_materials_clearcoat
 // of strength 1 and roughness 16/31 (values the G-buffer's 5-bit packing keeps exactly; the coat has no normal map, so
 // the deferred path's base normal is the coat's): the forward pass's coat, lit by the sun, the lights and the sky,
-// matches the deferred one within the same 1 %.
+// matches the deferred one within the same 1 %. Sheen: the same quad under a KHR_materials_sheen of colour
+// (1, 16/31, 10/15) and roughness 8/15 (kept exactly by the G-buffer's 5-5-4 + 4-bit packing), same bound.
 TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
     const int W = 64, H = 64;
     const glm::vec3 base(153.0f / 255.0f, 102.0f / 255.0f, 51.0f / 255.0f);
-    auto build = [&](bool transparent, bool coated) {
-        SceneBuilder b(std::string(transparent ? "same_light_blend" : "same_light_opaque") + (coated ? "_coated" : ""));
+    // layer: 0 none, 1 a clear coat, 2 a sheen.
+    const char* layerNames[] = {"", "_coated", "_sheen"};
+    auto build = [&](bool transparent, int layer) {
+        SceneBuilder b(std::string(transparent ? "same_light_blend" : "same_light_opaque") + layerNames[layer]);
         std::vector<Tri> quad;
         addQuad(quad, glm::vec3(0.0f), glm::vec3(1.0f, 0, 0), glm::vec3(0, 1.0f, 0), glm::vec3(0, 0, 1));
         for (Tri& t : quad)
@@ -305,7 +308,11 @@ TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
         b.s.materials[m].layers[0].cavity = {153.0f / 255.0f, 0.0f};
         b.s.materials[m].emissiveFactor = {0.0f, 0.05f, 0.1f};
         if (transparent) blend(b, m, 1.0f);
-        if (coated) {
+        if (layer == 2) {
+            b.s.materials[m].sheenColor = {1.0f, 16.0f / 31.0f, 10.0f / 15.0f};
+            b.s.materials[m].sheenRoughness = 8.0f / 15.0f;
+        }
+        if (layer == 1) {
             b.s.materials[m].clearcoat = 1.0f;
             b.s.materials[m].clearcoatRoughness = 16.0f / 31.0f;
         }
@@ -331,9 +338,10 @@ TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
         b.sun({0.5f, 0.2f, 1.0f});
         return b.write();
     };
-    for (bool coated : {false, true}) {
-    SCOPED_TRACE(coated ? "coated" : "uncoated");
-    const std::filesystem::path opaqueGlb = build(false, coated), blendGlb = build(true, coated);
+    for (int layer : {0, 1, 2}) {
+    const bool coated = layer != 0;
+    SCOPED_TRACE(layer == 2 ? "sheen" : coated ? "coated" : "uncoated");
+    const std::filesystem::path opaqueGlb = build(false, layer), blendGlb = build(true, layer);
     // gi: bake.lightmap's irradiance volume feeds both passes' ambient terms instead of the sky stand-in. Both
     // graphs bake the BLEND file (transparent primitives are not in the BVH), so both read the same volume.
     auto render = [&](bool transparent, bool gi) {
@@ -353,7 +361,7 @@ TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
         return runGraph(graph(nodes, {{"out", transparent ? "transparent.color" : "lighting.color"}}, W, H)).at("out");
     };
     for (bool gi : {false, true}) {
-    if (coated && gi) continue; // the coat's terms are the same functions under either ambient
+    if (coated && gi) continue; // the coat's and sheen's terms are the same functions under either ambient
     SCOPED_TRACE(gi ? "with the irradiance volume" : "with the sky stand-in");
     Image deferred = render(false, gi), forward = render(true, gi);
     Pinhole cam(SceneBuilder("probe").s, W, H);
@@ -372,7 +380,7 @@ TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
             ++n;
         }
     std::printf("BLEND alpha 1 vs deferred%s: %d pixels (%.3g to %.3g cd/m2), max relative error %.2g\n",
-                coated ? ", coated" : "", n, darkest, brightest, worst);
+                layer == 2 ? ", sheen" : coated ? ", coated" : "", n, darkest, brightest, worst);
     EXPECT_GE(n, 800);
     // The lights and the shadow make the quad far from uniform (less so under the volume's brighter ambient).
     EXPECT_GT(brightest, (gi ? 1.4 : 2.0) * darkest);

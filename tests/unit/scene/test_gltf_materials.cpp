@@ -1,9 +1,8 @@
 // glTF material extensions on the corpus tests/data/gltf/corpus/ (written by make_corpus.py, validated by ctest
 // gltf.validator; issue #29 item 4): KHR_materials_pbrSpecularGlossiness converted to metallic-roughness against the
 // values worked out by hand in the file's asset.extras.expect and against the specular-glossiness model itself,
-// KHR_materials_emissive_strength, KHR_materials_variants, KHR_materials_specular and KHR_materials_clearcoat (factors,
-// textures, errors, export),
-// and the material extensions vitrine ignores with a warning.
+// KHR_materials_emissive_strength, KHR_materials_variants, KHR_materials_specular, KHR_materials_clearcoat and
+// KHR_materials_sheen (factors, textures, errors, export), and the material extensions vitrine ignores with a warning.
 
 #include "core/scene/gltf.hpp"
 
@@ -218,10 +217,9 @@ TEST(GltfMaterials, MaterialVariantSelectsEachPrimitivesMapping) {
 TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
     std::vector<std::string> warnings;
     Scene s = loadGltf(corpus("ignored_material_extensions.gltf"), warnings);
-    const std::pair<const char*, const char*> expectations[] = {{"KHR_materials_sheen", "sheen"},
-                                                                {"KHR_materials_iridescence", "iridescence"},
+    const std::pair<const char*, const char*> expectations[] = {{"KHR_materials_iridescence", "iridescence"},
                                                                 {"KHR_materials_volume", "attenuationColor"}};
-    ASSERT_EQ(warnings.size(), 3u);
+    ASSERT_EQ(warnings.size(), 2u);
     for (const auto& [name, what] : expectations) {
         size_t n = std::count_if(warnings.begin(), warnings.end(),
                                  [&](const std::string& w) { return w.find(name) != std::string::npos; });
@@ -238,8 +236,7 @@ TEST(GltfMaterials, IgnoredMaterialExtensionsWarnOnceEachAndStrictRefuses) {
     // The transmission next to the volume is read.
     EXPECT_EQ(byName(s, "thick_glass").transmission, 1.0f);
     test::expectUserError([&] { loadGltfReporting(corpus("ignored_material_extensions.gltf"), true); },
-                          {"3 warnings, which strict loading", "KHR_materials_sheen", "KHR_materials_iridescence",
-                           "KHR_materials_volume"});
+                          {"2 warnings, which strict loading", "KHR_materials_iridescence", "KHR_materials_volume"});
 }
 
 // KHR_materials_specular is read, not warned about: factors, the two textures (alpha as data, rgb as sRGB colour),
@@ -388,6 +385,84 @@ TEST(GltfMaterials, ClearcoatExtensionSurvivesExport) {
         EXPECT_EQ(a.clearcoatNormal.texture.valid(), b.clearcoatNormal.texture.valid()) << name;
         EXPECT_EQ(a.clearcoatNormal.scale, b.clearcoatNormal.scale) << name;
     }
+}
+
+// KHR_materials_sheen is read, not warned about: the factors, the two textures (sRGB colour, roughness as data from
+// alpha, with their KHR_texture_transform), and a black sheen kept as authored.
+TEST(GltfMaterials, SheenExtensionIsReadWithoutWarnings) {
+    std::vector<std::string> warnings;
+    Scene s = loadGltf(corpus("sheen.gltf"), warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    test::Json want = expected("sheen.gltf");
+    const char* names[] = {"velvet", "satin", "black", "textured"};
+    for (int i = 0; i < 4; ++i) {
+        const Material& m = byName(s, names[i]);
+        SCOPED_TRACE(names[i]);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(m.sheenColor[c], want["sheen_color"][i][c].get<float>());
+        EXPECT_EQ(m.sheenRoughness, want["roughness"][i].get<float>());
+        EXPECT_EQ(m.sheenColorTexture.valid(), i == 3);
+        EXPECT_EQ(m.sheenRoughnessTexture.valid(), i == 3);
+        EXPECT_TRUE(m.hasSheen()); // the black one says a roughness
+    }
+    const Material& t = byName(s, "textured");
+    EXPECT_EQ(s.textures[t.sheenColorTexture.texture].usage, TextureUsage::Color);
+    EXPECT_EQ(s.textures[t.sheenRoughnessTexture.texture].usage, TextureUsage::Data);
+    EXPECT_EQ(t.sheenColorTexture.transform.scale, glm::vec2(1.0f));
+    EXPECT_FALSE(Material{}.hasSheen());
+    // Supported, so a file may require it.
+    test::Json doc = test::readJson(corpus("sheen.gltf"));
+    doc["extensionsRequired"] = {"KHR_materials_sheen"};
+    auto required = test::scratchDir() / "sheen_required.gltf";
+    test::writeText(required, doc.dump());
+    EXPECT_EQ(loadGltf(required, warnings).materials, s.materials);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+}
+
+TEST(GltfMaterials, SheenExtensionOutOfRangeIsAnErrorWithItsPath) {
+    auto file = test::scratchDir() / "sheen_bad.gltf";
+    for (double bad : {1.5, -0.25}) {
+        test::Json doc = test::readJson(corpus("sheen.gltf"));
+        doc["materials"][1]["extensions"]["KHR_materials_sheen"]["sheenRoughnessFactor"] = bad;
+        test::writeText(file, doc.dump());
+        test::expectUserError([&] { loadGltf(file); },
+                              {"sheen_bad.gltf", "materials[1].extensions.KHR_materials_sheen.sheenRoughnessFactor",
+                               "expected a number in [0, 1]"});
+        doc = test::readJson(corpus("sheen.gltf"));
+        doc["materials"][0]["extensions"]["KHR_materials_sheen"]["sheenColorFactor"][2] = bad;
+        test::writeText(file, doc.dump());
+        test::expectUserError(
+            [&] { loadGltf(file); },
+            {"materials[0].extensions.KHR_materials_sheen.sheenColorFactor[2]", "expected a number in [0, 1]"});
+    }
+    test::Json doc = test::readJson(corpus("sheen.gltf"));
+    doc["materials"][3]["extensions"]["KHR_materials_sheen"]["sheenRoughnessTexture"]["index"] = 7;
+    test::writeText(file, doc.dump());
+    test::expectUserError([&] { loadGltf(file); },
+                          {"materials[3].extensions.KHR_materials_sheen.sheenRoughnessTexture.index"});
+}
+
+// exportGlb writes the extension back: the materials survive a round trip, textures and their transforms included.
+TEST(GltfMaterials, SheenExtensionSurvivesExport) {
+    Scene s = loadGltf(corpus("sheen.gltf"));
+    auto file = test::scratchDir() / "sheen_roundtrip.glb";
+    exportGlb(s, file);
+    std::vector<std::string> warnings;
+    Scene back = loadGltf(file, warnings);
+    EXPECT_TRUE(warnings.empty()) << warnings[0];
+    for (const char* name : {"velvet", "satin", "black", "textured"}) {
+        const Material& a = byName(s, name);
+        const Material& b = byName(back, name);
+        EXPECT_EQ(a.sheenColor, b.sheenColor) << name;
+        EXPECT_EQ(a.sheenRoughness, b.sheenRoughness) << name;
+        EXPECT_EQ(a.sheenColorTexture.valid(), b.sheenColorTexture.valid()) << name;
+        EXPECT_EQ(a.sheenRoughnessTexture.valid(), b.sheenRoughnessTexture.valid()) << name;
+        EXPECT_EQ(a.sheenColorTexture.transform.scale, b.sheenColorTexture.transform.scale) << name;
+        EXPECT_TRUE(b.hasSheen()) << name;
+    }
+    const Material& t = byName(back, "textured");
+    EXPECT_EQ(back.textures[t.sheenColorTexture.texture].usage, TextureUsage::Color);
+    EXPECT_EQ(back.textures[t.sheenRoughnessTexture.texture].usage, TextureUsage::Data);
 }
 
 } // namespace vitrine::scene

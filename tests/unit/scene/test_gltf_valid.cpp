@@ -204,15 +204,16 @@ TEST_F(GltfValid, MissingRequiredPropertiesAreNamed) {
 // (one in extensionsRequired stays an error, see GltfErrors).
 TEST_F(GltfValid, UnsupportedUsedExtensionWarnsOnce) {
     Json doc = triangleDoc(base64Uri(triangleBytes()));
-    doc["extensionsUsed"] = {"KHR_materials_sheen", "KHR_texture_transform"};
-    doc["materials"] = {{{"extensions", {{"KHR_materials_sheen", {{"sheenColorFactor", {1, 0, 0}}}}}}}};
+    doc["extensionsUsed"] = {"KHR_materials_anisotropy", "KHR_texture_transform"};
+    doc["materials"] = {{{"extensions", {{"KHR_materials_anisotropy", {{"anisotropyStrength", 1}}}}}}};
     doc["meshes"][0]["primitives"][0]["material"] = 0;
     std::vector<std::string> warnings;
-    Scene scene = loadGltf(write("sheen.gltf", doc), warnings);
+    Scene scene = loadGltf(write("anisotropy.gltf", doc), warnings);
     expectTriangle(scene);
     ASSERT_EQ(warnings.size(), 1u);
-    EXPECT_NE(warnings[0].find("sheen.gltf: extensionsUsed[0]: extension 'KHR_materials_sheen' is not supported"),
-              std::string::npos)
+    EXPECT_NE(
+        warnings[0].find("anisotropy.gltf: extensionsUsed[0]: extension 'KHR_materials_anisotropy' is not supported"),
+        std::string::npos)
         << warnings[0];
     EXPECT_NE(warnings[0].find("ignored"), std::string::npos) << warnings[0];
     EXPECT_NE(warnings[0].find("(at /extensionsUsed/0)"), std::string::npos) << warnings[0];
@@ -222,7 +223,7 @@ TEST_F(GltfValid, UnsupportedUsedExtensionWarnsOnce) {
 // makes them an error that lists them.
 TEST_F(GltfValid, ReportingPrintsWarningsOnceAndStrictRefuses) {
     Json doc = triangleDoc(base64Uri(triangleBytes()));
-    doc["extensionsUsed"] = {"KHR_materials_sheen"};
+    doc["extensionsUsed"] = {"KHR_materials_anisotropy"};
     doc["nodes"].push_back({{"name", "second"}, {"mesh", 0}});
     doc["scenes"][0]["nodes"].push_back(1);
     doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_5"] = 0; // ignored attribute, met once
@@ -237,11 +238,11 @@ TEST_F(GltfValid, ReportingPrintsWarningsOnceAndStrictRefuses) {
         return n;
     };
     EXPECT_EQ(count("warning: "), 2u) << err;
-    EXPECT_EQ(count("KHR_materials_sheen"), 1u) << err;
+    EXPECT_EQ(count("KHR_materials_anisotropy"), 1u) << err;
     EXPECT_EQ(count("(at /meshes/0/primitives/0/attributes/TEXCOORD_5)"), 1u) << err;
 
     expectUserError([&] { loadGltfReporting(file, true); },
-                    {"report.gltf: 2 warnings, which strict loading", "KHR_materials_sheen", "TEXCOORD_5"});
+                    {"report.gltf: 2 warnings, which strict loading", "KHR_materials_anisotropy", "TEXCOORD_5"});
     // Without warnings strict changes nothing.
     loadGltfReporting(write("clean.gltf", triangleDoc(base64Uri(triangleBytes()))), true);
 }

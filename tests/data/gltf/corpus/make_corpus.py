@@ -27,7 +27,7 @@ hand, written in the file's asset.extras.expect:
                        KHR_materials_emissive_strength 4, the right one without (G-buffer emissive 4x the right's).
   variants.gltf        KHR_materials_variants "red" and "blue" remapping the left quad's white material; the right quad
                        has no mapping and stays white whatever the variant.
-  ignored_material_extensions.gltf  KHR_materials_sheen, _iridescence (material 0) and
+  ignored_material_extensions.gltf  KHR_materials_iridescence (material 0) and
                        _volume with _transmission (material 1): vitrine warns once per ignored extension.
   specular.gltf        KHR_materials_specular: strength 0.4, strength 0, a tint alone, and a 2x2 texture read both as
                        specularTexture (alpha) and specularColorTexture (sRGB rgb), one quadrant each; the G-buffer's
@@ -35,6 +35,10 @@ hand, written in the file's asset.extras.expect:
   clearcoat.gltf       KHR_materials_clearcoat: a full smooth coat, a half coat of roughness 0.3, a factor 0, and a
                        coat textured by a 2x2 image (red: strength, green: roughness, with KHR_texture_transform) and a
                        coat normal map; the G-buffer's emissive alpha packs them (tests/gpu/gltf_materials_test.cpp).
+  sheen.gltf           KHR_materials_sheen: spheres of velvet (red base, pink sheen, roughness 0.5), satin (blue, pale
+                       blue sheen, 0.3) and a black sheen (none), and a quad whose sheen colour (sRGB rgb) and roughness
+                       (alpha) come from a 2x2 image through KHR_texture_transform; the G-buffer packs them
+                       (tests/gpu/gltf_materials_test.cpp). Rendered by graphs/gltf.json, the spheres' rims glow.
 Regenerate after editing: python3 tests/data/gltf/corpus/make_corpus.py
 """
 import base64
@@ -386,11 +390,10 @@ def variants_file():
 
 def ignored_material_extensions_file():
     b = Builder()
-    names = ["KHR_materials_sheen", "KHR_materials_iridescence", "KHR_materials_transmission", "KHR_materials_volume"]
+    names = ["KHR_materials_iridescence", "KHR_materials_transmission", "KHR_materials_volume"]
     b.doc["extensionsUsed"] = names
     b.doc["materials"] = [
         {"name": "coated", "extensions": {
-            "KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5], "sheenRoughnessFactor": 0.5},
             "KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 400.0}}},
         {"name": "thick_glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
          "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
@@ -478,6 +481,70 @@ def clearcoat_file():
     b.write("clearcoat.gltf")
 
 
+def sphere_mesh(b, center, r, material, name, seg=48, rings=24):
+    """A UV sphere (normals outward, counter-clockwise from outside) of radius r around center."""
+    pos, nrm, idx = [], [], []
+    for i in range(rings + 1):
+        th = math.pi * i / rings
+        for j in range(seg + 1):
+            ph = 2 * math.pi * j / seg
+            n = [math.sin(th) * math.cos(ph), math.cos(th), -math.sin(th) * math.sin(ph)]
+            pos.append([center[k] + r * n[k] for k in range(3)])
+            nrm.append(n)
+    for i in range(rings):
+        for j in range(seg):
+            a, c = i * (seg + 1) + j, (i + 1) * (seg + 1) + j
+            if i > 0:
+                idx += [a, c, a + 1]
+            if i < rings - 1:
+                idx += [a + 1, c, c + 1]
+    attributes = {"POSITION": b.floats(pos, "VEC3", True, 34962), "NORMAL": b.floats(nrm, "VEC3", False, 34962)}
+    prim = {"attributes": attributes, "indices": b.indices(idx), "material": material}
+    b.doc.setdefault("meshes", []).append({"name": name, "primitives": [prim]})
+    return len(b.doc["meshes"]) - 1
+
+
+def sheen_file():
+    """Quadrants (top-left, top-right, bottom-left, bottom-right): spheres of radius 0.9 of velvet (dark red base,
+    sheenColorFactor (0.9, 0.5, 0.6), roughness 0.5), satin (dark blue, (0.6, 0.7, 1.0), 0.3) and a black sheen
+    ((0, 0, 0), 0.5: no sheen), and a grey quad whose sheen is sheenColorFactor 1 x the sRGB colour and
+    sheenRoughnessFactor 0.8 x the alpha of a 2x2 image (nearest), read through KHR_texture_transform (the identity)."""
+    b = Builder()
+    sh = "KHR_materials_sheen"
+    b.doc["extensionsUsed"] = [sh, "KHR_texture_transform"]
+    tt = {"KHR_texture_transform": {"offset": [0, 0], "scale": [1, 1]}}
+
+    def pbr(c):
+        return {"baseColorFactor": c + [1], "metallicFactor": 0, "roughnessFactor": 0.8}
+    b.doc["materials"] = [
+        {"name": "velvet", "pbrMetallicRoughness": pbr([0.2, 0.01, 0.03]),
+         "extensions": {sh: {"sheenColorFactor": [0.9, 0.5, 0.6], "sheenRoughnessFactor": 0.5}}},
+        {"name": "satin", "pbrMetallicRoughness": pbr([0.02, 0.04, 0.2]),
+         "extensions": {sh: {"sheenColorFactor": [0.6, 0.7, 1.0], "sheenRoughnessFactor": 0.3}}},
+        {"name": "black", "pbrMetallicRoughness": pbr([0.5, 0.5, 0.5]),
+         "extensions": {sh: {"sheenColorFactor": [0.0, 0.0, 0.0], "sheenRoughnessFactor": 0.5}}},
+        {"name": "textured", "pbrMetallicRoughness": pbr([0.5, 0.5, 0.5]),
+         "extensions": {sh: {"sheenColorFactor": [1.0, 1.0, 1.0], "sheenRoughnessFactor": 0.8,
+                             "sheenColorTexture": {"index": 0, "extensions": tt},
+                             "sheenRoughnessTexture": {"index": 0, "extensions": tt}}}}]
+    # rgb (sRGB 255 and 0 decode exactly): red, green, blue, white; alpha 255, 128, 64, 0.
+    image = png_rgba(2, 2, [[255, 0, 0, 255], [0, 255, 0, 128], [0, 0, 255, 64], [255, 255, 255, 0]])
+    b.doc["images"] = [{"name": "sheen", "mimeType": "image/png", "bufferView": b.view(image)}]
+    b.doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"sampler": 0, "source": 0}]
+    meshes = [sphere_mesh(b, c, 0.9, m, b.doc["materials"][m]["name"])
+              for m, c in enumerate([[-1, 1, 0], [1, 1, 0], [-1, -1, 0]])]
+    meshes.append(quad_mesh(b, [1, -1, 0], 1.0, 3, uvs=True, name="textured"))
+    ortho_view(b, meshes)
+    b.doc["asset"]["extras"] = {"expect": {
+        "quadrants": ["top_left", "top_right", "bottom_left", "bottom_right"],
+        "sheen_color": [[0.9, 0.5, 0.6], [0.6, 0.7, 1.0], [0.0, 0.0, 0.0], [1.0, 1.0, 1.0]],
+        "roughness": [0.5, 0.3, 0.5, 0.8],
+        "texels_color": [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]],
+        "texels_roughness": [0.8, 0.8 * 128 / 255, 0.8 * 64 / 255, 0.0]}}
+    b.write("sheen.gltf")
+
+
 def main():
     # Perspective: the marker sits at 60 % of the half-height to the right and 40 % up at depth 5, so in a square
     # frame it lands at NDC (0.6, -0.4) (Vulkan y down) when the vertical field of view is kept, and at x = 0.4
@@ -501,6 +568,7 @@ def main():
     ignored_material_extensions_file()
     specular_file()
     clearcoat_file()
+    sheen_file()
 
 
 if __name__ == "__main__":
