@@ -472,6 +472,41 @@ PATHTRACE_TEST(ClearcoatDirectSunMatchesItsClosedForm) {
 // directional albedo at NoV, integrated here on a fine grid from core/shading brdfCosineClearcoat; a coat lobe sampled
 // with a pdf other than brdfPdf's, or MIS weights that do not sum to 1, shows as a departure. Bounds as the furnace:
 // mean within 1 %, each pixel within 25 % (64 samples per pixel).
+// A furnace sphere (centre at the origin) under a uniform sky C: per pixel, the traced radiance over C times the
+// directional albedo at its NoV, interpolated in `albedo` (33 samples from NoV 0.2 to 1); pixels nearer the
+// silhouette than NoV 0.2 are left out (the tessellation). The mean and worst |ratio - 1| over n pixels.
+struct FurnaceRatio {
+    double mean = 0.0, worst = 0.0;
+    int n = 0;
+};
+
+FurnaceRatio furnaceSphereRatio(const Image& img, const Pinhole& cam, double radius, double C,
+                                const std::vector<double>& albedo) {
+    auto interp = [&](double NoV) {
+        double f = std::clamp((NoV - 0.2) / 0.8 * 32.0, 0.0, 31.999);
+        int i = static_cast<int>(f);
+        return albedo[i] + (albedo[i + 1] - albedo[i]) * (f - i);
+    };
+    FurnaceRatio r;
+    double sumRatio = 0.0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            double t = hitSphere(cam.position, d, glm::dvec3(0.0), radius);
+            if (t < 0.0) continue;
+            glm::dvec3 nrm = glm::normalize(cam.position + t * d);
+            double NoV = glm::dot(nrm, -d);
+            if (NoV < 0.2) continue; // tessellated silhouette
+            glm::dvec3 got = rgb(img, x, y);
+            double ratio = (got.r + got.g + got.b) / (3.0 * C * interp(NoV));
+            sumRatio += ratio;
+            r.worst = std::max(r.worst, std::abs(ratio - 1.0));
+            ++r.n;
+        }
+    r.mean = sumRatio / r.n;
+    return r;
+}
+
 PATHTRACE_TEST(ClearcoatFurnaceSphereReflectsItsAlbedo) {
     const int W = 48, H = 48;
     const double C = 100.0, radius = 1.0;
@@ -497,29 +532,7 @@ PATHTRACE_TEST(ClearcoatFurnaceSphereReflectsItsAlbedo) {
     std::vector<double> albedo;
     for (int i = 0; i <= 32; ++i)
         albedo.push_back(albedoAt(0.2 + 0.8 * i / 32.0));
-    auto interp = [&](double NoV) {
-        double f = std::clamp((NoV - 0.2) / 0.8 * 32.0, 0.0, 31.999);
-        int i = static_cast<int>(f);
-        return albedo[i] + (albedo[i + 1] - albedo[i]) * (f - i);
-    };
-    Pinhole cam(b.s, W, H);
-    double sumRatio = 0.0, worst = 0.0;
-    int n = 0;
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            glm::dvec3 d = cam.ray(x, y);
-            double t = hitSphere(cam.position, d, glm::dvec3(0.0), radius);
-            if (t < 0.0) continue;
-            glm::dvec3 nrm = glm::normalize(cam.position + t * d);
-            double NoV = glm::dot(nrm, -d);
-            if (NoV < 0.2) continue; // tessellated silhouette
-            glm::dvec3 got = rgb(img, x, y);
-            double ratio = (got.r + got.g + got.b) / (3.0 * C * interp(NoV));
-            sumRatio += ratio;
-            worst = std::max(worst, std::abs(ratio - 1.0));
-            ++n;
-        }
-    double mean = sumRatio / n;
+    const auto [mean, worst, n] = furnaceSphereRatio(img, Pinhole(b.s, W, H), radius, C, albedo);
     std::printf("%s tracer, clearcoat furnace: %d pixels, albedo %.4f (NoV 1) .. %.4f (NoV 0.2), mean ratio %.5f, "
                 "worst pixel %.3f\n",
                 gBackend, n, albedo.back(), albedo.front(), mean, worst);
@@ -600,29 +613,7 @@ PATHTRACE_TEST(SheenFurnaceSphereReflectsItsAlbedo) {
         EXPECT_LE(albedo.back(), 1.0) << "NoV " << NoV;
         sheenShare = std::max(sheenShare, albedo.back() - albedoAt(NoV, glm::vec4(0.0f)));
     }
-    auto interp = [&](double NoV) {
-        double f = std::clamp((NoV - 0.2) / 0.8 * 32.0, 0.0, 31.999);
-        int i = static_cast<int>(f);
-        return albedo[i] + (albedo[i + 1] - albedo[i]) * (f - i);
-    };
-    Pinhole cam(b.s, W, H);
-    double sumRatio = 0.0, worst = 0.0;
-    int n = 0;
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            glm::dvec3 d = cam.ray(x, y);
-            double t = hitSphere(cam.position, d, glm::dvec3(0.0), radius);
-            if (t < 0.0) continue;
-            glm::dvec3 nrm = glm::normalize(cam.position + t * d);
-            double NoV = glm::dot(nrm, -d);
-            if (NoV < 0.2) continue; // tessellated silhouette
-            glm::dvec3 got = rgb(img, x, y);
-            double ratio = (got.r + got.g + got.b) / (3.0 * C * interp(NoV));
-            sumRatio += ratio;
-            worst = std::max(worst, std::abs(ratio - 1.0));
-            ++n;
-        }
-    double mean = sumRatio / n;
+    const auto [mean, worst, n] = furnaceSphereRatio(img, Pinhole(b.s, W, H), radius, C, albedo);
     std::printf("%s tracer, sheen furnace: %d pixels, albedo %.4f (NoV 1) .. %.4f (NoV 0.2), sheen adds up to %.4f, "
                 "mean ratio %.5f, worst pixel %.3f\n",
                 gBackend, n, albedo.back(), albedo.front(), sheenShare, mean, worst);
