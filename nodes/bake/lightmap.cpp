@@ -70,7 +70,7 @@ NodeSchema schema() {
     s.outputs = {lightmap, volume, layout};
     s.params = {
         {"texels_per_meter", ParamType::Float, 4.0, 0.25, 64.0, {}, "Lightmap texel density (the demo's look: 8 to 16)"},
-        {"samples", ParamType::Int, 16, 2.0, 65536.0, {}, "Paths per texel and per probe ray"},
+        {"samples", ParamType::Int, 32, 2.0, 65536.0, {}, "Paths per texel and per probe ray"},
         {"max_bounces", ParamType::Int, 8, 1.0, 16.0, {}, "Surfaces that reflect light along a path (8, as museum_reference traces)"},
         {"probe_spacing", ParamType::Float, 3.0, 0.1, 100.0, {}, "Metres between irradiance-volume probes"},
         {"probe_rays", ParamType::Int, 32, 16.0, 4096.0, {}, "Directions per probe"},

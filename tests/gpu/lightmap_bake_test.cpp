@@ -158,8 +158,8 @@ TEST_F(LightmapBake, SkyLightBesideABlackWallFollowsTheViewFactor) {
     const double C = 1000.0;
     const fs::path glb = floorAndWall("bake_sky_wall", glm::vec3(0.5f), 0.0f, glm::vec3(0.0f), 1.0f, {0.3f, 1.0f, 0.2f});
     const bake::LightmapRegion r = floorRegion(glb);
-    // Raw with many samples (the integrator), then the node's defaults: few samples and the filter, which
-    // must remove the noise without flattening the contact gradient near the wall.
+    // Raw with many samples (the integrator), then few samples (16, half the node's default) and the filter,
+    // which must remove the noise without flattening the contact gradient near the wall.
     for (auto [samples, iterations, tolerance, totalTolerance] :
          {std::tuple{256, 0, 0.02, 0.01}, std::tuple{16, 4, 0.05, 0.03}}) {
         SCOPED_TRACE("filter iterations " + std::to_string(iterations));
