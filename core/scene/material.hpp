@@ -205,9 +205,10 @@ struct Material {
     }
 
     // KHR_materials_volume: the medium behind a transmissive surface. forward.transparent multiplies the light passing
-    // through by Beer's law T = attenuationColor^(d / attenuationDistance), d = thickness × the node's scale, with
-    // thickness = thicknessFactor × thicknessTexture.g in the mesh's own units (the Sample Viewer's thin-slab
-    // approximation; no refraction offset). thickness 0 (the default) is thin-walled: nothing is attenuated.
+    // through by Beer's law T = attenuationColor^(d / attenuationDistance), d = |refracted direction × thickness × the
+    // node's scale| (thickness × scale for a uniform scale), thickness = thicknessFactor × thicknessTexture.g in the
+    // mesh's own units (the Sample Viewer's approximation; no refraction offset here). thickness 0 (the default) is
+    // thin-walled: nothing is attenuated.
     float thickness = 0.0f;                                              // ≥ 0
     TextureRef thicknessTexture;                                         // data, green channel
     float attenuationDistance = std::numeric_limits<float>::infinity(); // > 0; +∞: no attenuation
