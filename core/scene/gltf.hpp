@@ -13,18 +13,19 @@
 // nodes), KHR_materials_unlit, KHR_materials_transmission (the factor; its texture is ignored with a warning),
 // KHR_materials_ior, KHR_materials_specular (strength and colour of the dielectric's Fresnel: material.hpp),
 // KHR_materials_clearcoat (strength, roughness, their textures and the coat normal map: material.hpp),
-// KHR_materials_sheen (colour, roughness and their textures: material.hpp),
+// KHR_materials_sheen (colour, roughness and their textures: material.hpp), KHR_materials_volume (thickness, its
+// texture and the attenuation: material.hpp),
 // KHR_materials_pbrSpecularGlossiness (converted to metallic-roughness at load: factors, and
 // textures texel by texel into new textures; gltf_specgloss.cpp), KHR_materials_variants (one variant chosen by name at
 // load), KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's reflection probes
 // in VITRINE_reflection_probes (VITRINE_reflection_probes.md), morph targets (POSITION, NORMAL, TANGENT displacements;
 // mesh or node `weights` make the rest pose, animated weights are an animation channel). Any other extension in
 // extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning
-// (KHR_materials_iridescence, _volume: one each, naming what of which materials is
-// lost). Skins (JOINTS_0/WEIGHTS_0, inverse bind matrices): the rest pose is skinned at load, animated joints re-skin
-// on the CPU every frame (GpuScene::update). Point/line primitives are ignored with a warning. Accessors without a
-// bufferView are zeros (plus their sparse substitutions), as glTF says, indices included. Data URIs may be base64 or
-// percent-encoded (RFC 2397). Embedded (data: URI, GLB) and external buffers and images both work.
+// (KHR_materials_iridescence: one, naming what of which materials is lost). Skins (JOINTS_0/WEIGHTS_0, inverse bind
+// matrices): the rest pose is skinned at load, animated joints re-skin on the CPU every frame (GpuScene::update).
+// Point/line primitives are ignored with a warning. Accessors without a bufferView are zeros (plus their sparse
+// substitutions), as glTF says, indices included. Data URIs may be base64 or percent-encoded (RFC 2397). Embedded
+// (data: URI, GLB) and external buffers and images both work.
 //
 // How glTF maps onto the scene model:
 // - A metallic-roughness material is a one-layer stack: shininess = 1 − roughnessFactor × texel.g,

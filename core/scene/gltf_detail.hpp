@@ -33,6 +33,7 @@ inline constexpr const char* kIor = "KHR_materials_ior";
 inline constexpr const char* kSpecular = "KHR_materials_specular";
 inline constexpr const char* kClearcoat = "KHR_materials_clearcoat";
 inline constexpr const char* kSheen = "KHR_materials_sheen";
+inline constexpr const char* kVolume = "KHR_materials_volume";
 inline constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 inline constexpr const char* kVariants = "KHR_materials_variants";
 
@@ -44,8 +45,6 @@ struct IgnoredMaterialExtension {
 };
 inline constexpr IgnoredMaterialExtension kIgnoredMaterialExtensions[] = {
     {"KHR_materials_iridescence", "the thin-film iridescence (iridescenceFactor, its ior, thickness and textures)"},
-    {"KHR_materials_volume",
-     "the volume (thicknessFactor, attenuationColor, attenuationDistance; transmission stays thin-walled)"},
 };
 // Our key inside `extras` for what glTF has no place for (physical camera, rooms, camera paths).
 inline constexpr const char* kExtrasKey = "vitrine";

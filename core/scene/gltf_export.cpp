@@ -392,6 +392,14 @@ Json Exporter::material(const Material& m) const {
             sh["sheenRoughnessTexture"] = writeTextureInfo(m.sheenRoughnessTexture, m.sheenRoughnessTexture.texture);
         j["extensions"][gltf::kSheen] = sh;
     }
+    if (m.hasVolume()) {
+        Json vo = {{"thicknessFactor", m.thickness},
+                   {"attenuationColor", {m.attenuationColor.r, m.attenuationColor.g, m.attenuationColor.b}}};
+        if (std::isfinite(m.attenuationDistance)) vo["attenuationDistance"] = m.attenuationDistance; // absent: +inf
+        if (m.thicknessTexture.valid())
+            vo["thicknessTexture"] = writeTextureInfo(m.thicknessTexture, m.thicknessTexture.texture);
+        j["extensions"][gltf::kVolume] = vo;
+    }
 
     if (m.layers.size() == 1 && base == core) return j; // the core material says it all
 
@@ -662,11 +670,13 @@ std::vector<uint8_t> Exporter::run() {
     if (transforms) used.push_back(gltf::kTextureTransform);
     if (strength) used.push_back(gltf::kEmissiveStrength);
     if (mScene.hasSun || !mScene.lights.empty()) used.push_back(gltf::kLightsPunctual);
-    bool unlit = false, transmission = false, ior = false, specular = false, clearcoat = false, sheen = false;
+    bool unlit = false, transmission = false, ior = false, specular = false, clearcoat = false, sheen = false,
+         volume = false;
     for (const Material& m : mScene.materials) {
         specular = specular || m.hasSpecular();
         clearcoat = clearcoat || m.hasClearcoat();
         sheen = sheen || m.hasSheen();
+        volume = volume || m.hasVolume();
         unlit = unlit || m.unlit;
         transmission = transmission || m.transmission != 0.0f;
         ior = ior || m.ior != 1.5f;
@@ -677,6 +687,7 @@ std::vector<uint8_t> Exporter::run() {
     if (specular) used.push_back(gltf::kSpecular);
     if (clearcoat) used.push_back(gltf::kClearcoat);
     if (sheen) used.push_back(gltf::kSheen);
+    if (volume) used.push_back(gltf::kVolume);
     if (!mScene.probes.empty()) used.push_back(kProbesExtension);
     if (!used.empty()) mDoc["extensionsUsed"] = used; // glTF forbids an empty list
     while (mBin.size() % 4)

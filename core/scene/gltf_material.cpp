@@ -3,6 +3,8 @@
 #include "core/scene/gltf.hpp"
 #include "core/scene/gltf_detail.hpp"
 
+#include <cmath>
+#include <limits>
 #include <set>
 
 #include <tiny_gltf.h>
@@ -340,6 +342,24 @@ Material readMaterial(LoadContext& ctx, const Json& m, const std::string& e) {
             if (const Json* t = member(*sh, "sheenRoughnessTexture"))
                 out.sheenRoughnessTexture =
                     readTextureInfo(ctx, *t, TextureUsage::Data, she + ".sheenRoughnessTexture");
+        }
+        if (const Json* v = object(ctx, *extensions, kVolume, e + ".extensions")) {
+            std::string ve = e + ".extensions." + kVolume;
+            out.thickness = static_cast<float>(number(ctx, *v, "thicknessFactor", 0.0, ve));
+            if (!(out.thickness >= 0.0f && std::isfinite(out.thickness)))
+                ctx.fail(ve + ".thicknessFactor", "expected a number >= 0");
+            if (const Json* t = member(*v, "thicknessTexture"))
+                out.thicknessTexture = readTextureInfo(ctx, *t, TextureUsage::Data, ve + ".thicknessTexture");
+            // JSON has no infinity: the default (+inf, no attenuation) is the property's absence.
+            out.attenuationDistance = static_cast<float>(
+                number(ctx, *v, "attenuationDistance", std::numeric_limits<double>::infinity(), ve));
+            if (!(out.attenuationDistance > 0.0f))
+                ctx.fail(ve + ".attenuationDistance", "expected a number > 0");
+            out.attenuationColor = glm::vec3(numbers(ctx, *v, "attenuationColor", 3, glm::vec4(1.0f), ve));
+            for (int c = 0; c < 3; ++c) {
+                if (!(out.attenuationColor[c] >= 0.0f && out.attenuationColor[c] <= 1.0f))
+                    ctx.fail(ve + ".attenuationColor[" + std::to_string(c) + "]", "expected a number in [0, 1]");
+            }
         }
     }
     std::string mode = string(ctx, m, "alphaMode", "OPAQUE", e);

@@ -348,7 +348,8 @@ const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength,
                                           kTransmission,     kIor,
                                           kProbesExtension,  kSpecGloss,
                                           kVariants,         kSpecular,
-                                          kClearcoat,        kSheen};
+                                          kClearcoat,        kSheen,
+                                          kVolume};
 
 // An extension the file uses but does not require may be ignored (glTF 2.0, 3.12): a warning per extension.
 void checkUsedExtensions(const LoadContext& ctx) {

@@ -244,6 +244,7 @@ void dropSpecGlossSources(LoadContext& ctx) {
             f(m.clearcoatNormal.texture);
             f(m.sheenColorTexture);
             f(m.sheenRoughnessTexture);
+            f(m.thicknessTexture);
         }
     };
     std::vector<bool> used(scene.textures.size(), false);

@@ -120,7 +120,7 @@ void packMaterials(const scene::Scene& scene, std::vector<GpuMaterial>& material
         g.emissive = glm::vec4(m.emissiveFactor * m.emissiveStrength, m.alphaCutoff);
         g.emissiveRef = texRef(m.emissiveTexture);
         float r = m.ior == 0.0f ? 1.0f : (m.ior - 1.0f) / (m.ior + 1.0f); // KHR_materials_ior: 0 means F0 = 1
-        g.optics = {m.transmission, r * r, m.unlit ? 1.0f : 0.0f, 0.0f};
+        g.optics = {m.transmission, r * r, m.unlit ? 1.0f : 0.0f, m.thickness};
         g.specular = glm::vec4(m.specularColor, m.specular);
         g.specularRef = texRef(m.specularTexture, 3);
         g.specularColorRef = texRef(m.specularColorTexture);
@@ -131,6 +131,8 @@ void packMaterials(const scene::Scene& scene, std::vector<GpuMaterial>& material
         g.sheen = glm::vec4(m.sheenColor, m.sheenRoughness);
         g.sheenColorRef = texRef(m.sheenColorTexture);
         g.sheenRoughnessRef = texRef(m.sheenRoughnessTexture, 3);
+        g.volume = glm::vec4(m.attenuationColor, std::isinf(m.attenuationDistance) ? 0.0f : m.attenuationDistance);
+        g.thicknessRef = texRef(m.thicknessTexture, 1);
         materials.push_back(g);
         for (size_t li = 0; li < m.layers.size(); ++li) {
             const scene::MaterialLayer& l = m.layers[li];

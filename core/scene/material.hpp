@@ -6,7 +6,9 @@
 // blend over the result below them by a mask, one parameter at a time. The on-disk form is the glTF
 // extension described in VITRINE_material_layers.md.
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -200,6 +202,22 @@ struct Material {
     bool hasSheen() const {
         return sheenColor != glm::vec3(0.0f) || sheenRoughness != 0.0f || sheenColorTexture.valid() ||
                sheenRoughnessTexture.valid();
+    }
+
+    // KHR_materials_volume: the medium behind a transmissive surface. forward.transparent multiplies the light passing
+    // through by Beer's law T = attenuationColor^(d / attenuationDistance), d = |refracted direction × thickness × the
+    // node's scale| (thickness × scale for a uniform scale), thickness = thicknessFactor × thicknessTexture.g in the
+    // mesh's own units (the Sample Viewer's approximation; no refraction offset here). thickness 0 (the default) is
+    // thin-walled: nothing is attenuated.
+    float thickness = 0.0f;                                              // ≥ 0
+    TextureRef thicknessTexture;                                         // data, green channel
+    float attenuationDistance = std::numeric_limits<float>::infinity(); // > 0; +∞: no attenuation
+    glm::vec3 attenuationColor{1.0f};                                    // linear, in [0, 1]
+
+    // True when KHR_materials_volume says anything (its defaults leave a thin-walled surface).
+    bool hasVolume() const {
+        return thickness != 0.0f || thicknessTexture.valid() || !std::isinf(attenuationDistance) ||
+               attenuationColor != glm::vec3(1.0f);
     }
 
     // Drawn by the transparent pass (alpha blending or transmission), not into the G-buffer.

@@ -76,6 +76,12 @@ void hashMaterial(Hasher& h, const Material& m) {
         h.value(m.sheenRoughness);
         hashRef(h, m.sheenRoughnessTexture);
     }
+    if (m.hasVolume()) {
+        h.value(m.thickness);
+        hashRef(h, m.thicknessTexture);
+        h.value(m.attenuationDistance);
+        h.value(m.attenuationColor);
+    }
 }
 
 void hashCamera(Hasher& h, const Camera& c) {
@@ -100,7 +106,7 @@ bool usesUvSet(const Material& m, uint32_t uvSet) {
     }
     return uses(m.emissiveTexture) || uses(m.specularTexture) || uses(m.specularColorTexture) ||
            uses(m.clearcoatTexture) || uses(m.clearcoatRoughnessTexture) || uses(m.clearcoatNormal.texture) ||
-           uses(m.sheenColorTexture) || uses(m.sheenRoughnessTexture);
+           uses(m.sheenColorTexture) || uses(m.sheenRoughnessTexture) || uses(m.thicknessTexture);
 }
 
 bool usesNormalMap(const Material& m) {
@@ -338,6 +344,7 @@ void Scene::validate() const {
         c.ref(e + ".clearcoatNormal", m.clearcoatNormal.texture, TextureUsage::Normal);
         c.ref(e + ".sheenColorTexture", m.sheenColorTexture, TextureUsage::Color);
         c.ref(e + ".sheenRoughnessTexture", m.sheenRoughnessTexture, TextureUsage::Data, 3);
+        c.ref(e + ".thicknessTexture", m.thicknessTexture, TextureUsage::Data, 1);
     }
     for (size_t i = 0; i < nodes.size(); ++i) {
         const Node& n = nodes[i];

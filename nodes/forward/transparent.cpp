@@ -30,7 +30,8 @@ NodeSchema schema() {
         "Transparent surfaces (glTF alphaMode BLEND, KHR_materials_transmission as thin glass) over the lit opaque "
         "colour: sorted back to front per primitive, depth-tested against the G-buffer without writing depth, lit by "
         "lighting.deferred's terms (sun with cascaded shadows, point and spot lights, sky ambient and Fresnel "
-        "reflection, emissive); glass tints what lies behind it (dual-source blending).";
+        "reflection, emissive); glass tints what lies behind it (dual-source blending), attenuated through a "
+        "KHR_materials_volume by Beer's law (no refraction offset).";
     s.pass = PassKind::Raster;
     auto tex = [](const char* name, const char* doc, std::vector<VkFormat> formats = {}) {
         return InputPort{name, PortKind::Texture, std::move(formats), false, Usage::Sampled, doc};

@@ -12,7 +12,7 @@ NodeSchema schema() {
     s.type = "scene.gltf";
     s.doc = "A glTF 2.0 file: meshes, metallic-roughness or VITRINE_material_layers materials, cameras, animations, "
             "KHR_texture_transform, KHR_materials_emissive_strength, _unlit, _transmission, _ior, _specular, "
-            "_clearcoat, _sheen, _variants, "
+            "_clearcoat, _sheen, _volume, _variants, "
             "_pbrSpecularGlossiness (converted to metallic-roughness), KHR_lights_punctual, node and morph-weight "
             "animations, morph targets, skins.";
     s.pass = PassKind::Transfer;

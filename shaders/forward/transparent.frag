@@ -17,7 +17,7 @@
 // and Fresnel-weighted reflection, emissive). Dual-source blending: dst' = outColor + dst × outTransmit, so a
 // pane can tint what lies behind it per channel:
 //   outColor    = alpha × lit colour (reflection, the diffuse left by transmission, emission)
-//   outTransmit = (1 − alpha) + alpha × transmission × (1 − F(NoV)) × base colour
+//   outTransmit = (1 − alpha) + alpha × transmission × (1 − F(NoV)) × base colour × volume attenuation
 // With no transmission this is the usual "over" of the lit colour with its coverage alpha.
 layout(set = 0, binding = 0) uniform Uniforms { TransparentUniforms u; };
 #define VITRINE_LIGHTS u.lights
@@ -91,6 +91,20 @@ void main() {
     // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour
     // (no refraction offset, no blur by roughness).
     vec3 through = transmission * (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * baseColor;
+    // KHR_materials_volume as the Sample Viewer: the light has crossed d = |refracted direction x thickness x the
+    // node's scale| (getVolumeTransmissionRay; thickness x scale for a uniform scale) of a medium that keeps
+    // attenuationColor^(d / attenuationDistance) of it (Beer's law, applyVolumeAttenuation). Not refracted: the blend
+    // multiplies the pixel behind, with no background image to offset. Thickness 0 (thin-walled) or an infinite
+    // distance (volume.a 0) leave `through` untouched.
+    float thickness = materialThickness(m, vUv0, vUv1, grads);
+    if (thickness > 0.0 && m.volume.a > 0.0) {
+        mat4 model = instances[draw.instance].world;
+        vec3 modelScale = vec3(length(model[0].xyz), length(model[1].xyz), length(model[2].xyz));
+        float s = sqrt(m.optics.y); // 1/ior = (1 - sqrt(F0)) / (1 + sqrt(F0)), and 0 for KHR_materials_ior's 0
+        vec3 refracted = normalize(refract(-v, N, (1.0 - s) / (1.0 + s)));
+        float d = length(refracted * thickness * modelScale);
+        through *= pow(m.volume.rgb, vec3(d / m.volume.a));
+    }
     // KHR_materials_sheen over the reflected light (as lighting.deferred: emission not scaled, the sky or volume
     // through the lobe's albedo times the irradiance) and over what passes through.
     vec4 sheen = materialSheen(m, vUv0, vUv1, grads);

@@ -159,6 +159,14 @@ vec4 materialSheen(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
     return clamp(s, 0.0, 1.0);
 }
 
+// KHR_materials_volume's thickness at a surface point, in the mesh's own units: thicknessFactor x
+// thicknessTexture.g; 0 (thin-walled) without the extension.
+float materialThickness(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
+    float t = m.optics.w;
+    if (m.thicknessRef.info.x >= 0) t *= sampleRef(m.thicknessRef, uv0, uv1, g).g;
+    return max(t, 0.0);
+}
+
 // The five blended parameters of a surface point. `normal` is tangent space and NOT normalised: its
 // length is below 1 where a mip averaged disagreeing normals (Toksvig).
 struct LayeredSurface {

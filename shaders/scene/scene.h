@@ -51,7 +51,9 @@ struct GpuMaterial {
     uvec4 info;    // x: first layer, y: layer count, z: alpha mode (0 opaque, 1 mask, 2 blend), w: double sided
     vec4 emissive; // rgb: factor x strength (linear), a: alpha cutoff
     GpuTexRef emissiveRef;
-    vec4 optics;   // x: transmission, y: dielectric F0 from the IOR, z: unlit (1/0), w: 0
+    // x: transmission, y: dielectric F0 from the IOR, z: unlit (1/0), w: KHR_materials_volume's thicknessFactor (0:
+    // thin-walled, as without the extension)
+    vec4 optics;
     // KHR_materials_specular (1, 1, 1, 1 without it): rgb: specularColorFactor (linear), a: specularFactor; the
     // textures multiply them (specularRef's alpha, specularColorRef's sRGB colour). scene.glsl materialSpecular.
     vec4 specular;
@@ -69,6 +71,10 @@ struct GpuMaterial {
     vec4 sheen;
     GpuTexRef sheenColorRef;
     GpuTexRef sheenRoughnessRef;
+    // KHR_materials_volume ((1, 1, 1, 0) without it): rgb: attenuationColor (linear), a: attenuationDistance, 0 for
+    // +inf (the Sample Viewer's convention). thicknessRef's green multiplies optics.w. scene.glsl materialThickness.
+    vec4 volume;
+    GpuTexRef thicknessRef;
 };
 
 struct GpuInstance {
@@ -109,7 +115,7 @@ VITRINE_PUSH_END(draw)
 #ifdef __cplusplus
 static_assert(sizeof(GpuTexRef) == 48);
 static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
-static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48 + 16 + 3 * 48 + 16 + 2 * 48);
+static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48 + 16 + 3 * 48 + 16 + 2 * 48 + 16 + 48);
 static_assert(sizeof(GpuInstance) == 192);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
 static_assert(sizeof(SceneDrawPush) == 96);

@@ -1,8 +1,9 @@
 // forward.transparent against CPU references: a half-transparent quad is the alpha blend of its lit colour
 // (core/shading's BRDF) over the lit background; two overlapping quads give the sorted "over" whatever order the file
 // lists them in; thin glass (KHR_materials_transmission, KHR_materials_ior) reflects by Schlick's Fresnel and tints
-// what lies behind it; a BLEND quad of alpha 1 is lit exactly as lighting.deferred lights the same quad opaque (sun,
-// shadows, sky ambient, point and spot lights). Scenes go through exportGlb() and scene.gltf, as in lighting_test.cpp.
+// what lies behind it, and a volume behind it (KHR_materials_volume) attenuates that by Beer's law; a BLEND quad of
+// alpha 1 is lit exactly as lighting.deferred lights the same quad opaque (sun, shadows, sky ambient, point and spot
+// lights). Scenes go through exportGlb() and scene.gltf, as in lighting_test.cpp.
 #include "tests/gpu/lighting_scene.hpp"
 
 #include "core/shading/brdf.hpp"
@@ -282,6 +283,146 @@ TEST_F(Transparent, ThinGlassReflectsByFresnelAndTintsWhatIsBehind) {
         std::printf("glass, KHR_materials_specular k 0.5: %d pixels, max relative error %.2g\n", n, worst);
         EXPECT_GE(n, 300);
     }
+}
+
+// KHR_materials_volume on the thin glass: what passes is also multiplied by Beer's law T = c^(d / D), c the
+// attenuationColor, D the attenuationDistance, d = |r × thickness × s| as the Sample Viewer's getVolumeTransmissionRay
+// has it: r the unit refracted direction (Snell's law into IOR 1.5 through the pane's normal +Z), s the node's scale
+// (the lengths of its model matrix's columns), multiplied component by component; for a uniform scale d is thickness
+// × scale whatever the direction. The pane's quad is authored at its size divided by the scale. Sun only (sky_ambient
+// 0): out = the GGX reflection with F0 0.04 (core/shading) + background × T × (1 − F(NoV)) × tint, 1 % per channel.
+// (a) thickness 0.5, scale 2, D = 2, c = (0.5, 0.8, 0.3): d = 1, T = c^0.5. (b) thickness 0.6 × a 1×1 thickness
+// texture's green 128/255 (red 255, blue 0, alpha 64: another channel gives another T), scale 2, D = 0.5,
+// c = (0.2, 0.6, 0.9): T = c^(2 × 0.6 × 128/255 / 0.5). (c) thickness 0.5, scale (2, 2, 0.5), D = 0.25, c as (a): d
+// per pixel from r. (d) thicknessFactor 0 with c = (0.2, 0.3, 0.4), D = 0.1: thin-walled, T = 1, and the very pixels
+// of the same pane without the extension.
+TEST_F(Transparent, VolumeAttenuatesWhatPassesByBeersLaw) {
+    const int W = 64, H = 64;
+    const glm::vec3 tint(0.9f, 0.7f, 0.5f);
+    const float shininess = 0.8f;
+    struct Volume {
+        float thickness;
+        float distance;
+        glm::vec3 color;
+        glm::vec3 scale;
+        bool textured;
+    };
+    auto scene = [&](const std::string& name, const Volume* volume) {
+        SceneBuilder b(name);
+        const glm::vec3 scale = volume ? volume->scale : glm::vec3(2.0f);
+        std::vector<Tri> wall, pane;
+        addQuad(wall, glm::vec3(0, 0, -1), glm::vec3(3, 0, 0), glm::vec3(0, 3, 0), glm::vec3(0, 0, 1));
+        addQuad(pane, glm::vec3(0.0f), glm::vec3(0.7f / scale.x, 0, 0), glm::vec3(0, 0.7f / scale.y, 0),
+                glm::vec3(0, 0, 1));
+        b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, b.material("wall", {0.6f, 0.5f, 0.4f}, 0.0f, 0.3f))));
+        uint32_t m = b.material("pane", tint, 0.0f, shininess);
+        scene::Material& glass = b.s.materials[m];
+        glass.transmission = 1.0f;
+        if (volume) {
+            glass.thickness = volume->thickness;
+            glass.attenuationDistance = volume->distance;
+            glass.attenuationColor = volume->color;
+        }
+        if (volume && volume->textured) {
+            scene::TextureImage image;
+            image.name = "thickness";
+            image.width = image.height = 1;
+            image.pixels = {255, 128, 0, 64};
+            b.s.images.push_back(image);
+            scene::Texture texture;
+            texture.name = "thickness";
+            texture.usage = scene::TextureUsage::Data;
+            b.s.textures.push_back(texture);
+            glass.thicknessTexture.texture = 0;
+        }
+        b.node("pane", static_cast<int32_t>(b.mesh("pane", pane, m)), glm::vec3(0, 0, 0.5f));
+        b.s.nodes.back().local.scale = scale;
+        b.camera({0.3f, 0.2f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+        b.sun({0.5f, 0.3f, 1.0f});
+        return b;
+    };
+    Pinhole cam(scene("volume_probe", nullptr).s, W, H);
+    auto render = [&](const std::string& name, const Volume* volume) {
+        SceneBuilder b = scene(name, volume);
+        return runGraph(graph(pipeline(b.write(), {{"sky_ambient", 0.0}}, {{"sky_ambient", 0.0}}),
+                              {{"out", "transparent.color"}, {"bg", "lighting.color"}, {"sh", "sky.sh"}}, W, H));
+    };
+    // Beer's law for the camera ray d through the pane (normal +Z), the thickness already multiplied by the texture.
+    auto beer = [](const Volume& v, double thickness, glm::dvec3 d) {
+        const double eta = 1.0 / 1.5, cosi = -d.z; // the ray enters from +Z
+        const double cost = std::sqrt(1.0 - eta * eta * (1.0 - cosi * cosi));
+        const glm::dvec3 r = glm::normalize(eta * d + (eta * cosi - cost) * glm::dvec3(0, 0, 1)); // Snell's law
+        const double length = thickness * glm::length(r * glm::dvec3(v.scale));
+        return glm::pow(glm::dvec3(v.color), glm::dvec3(length / v.distance));
+    };
+    auto check = [&](const char* what, std::map<std::string, Image>& out, auto transmittance) {
+        const glm::dvec3 l = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+        const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
+        const double f0 = 0.04;
+        int n = 0;
+        double worst = 0.0;
+        glm::dvec3 centre(0.0), centreT(0.0), centreBg(0.0);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                if (!hitsQuad(cam.position, d, 0.5, 0.0, 0.7, 0.03)) continue;
+                double NoV = -d.z;
+                double fresnel = f0 + (1.0 - f0) * std::pow(1.0 - NoV, 5.0);
+                glm::dvec3 reflection =
+                    glm::dvec3(shading::brdfCosineF0(glm::vec3(0, 0, 1), glm::vec3(-d), glm::vec3(l), glm::vec3(0.0f),
+                                                     glm::vec3(static_cast<float>(f0)),
+                                                     shading::roughnessFromShininess(shininess))) *
+                    sunE;
+                glm::dvec3 T = transmittance(d);
+                glm::dvec3 expected = reflection + rgb(out.at("bg"), x, y) * T * (1.0 - fresnel) * glm::dvec3(tint);
+                double e = relErr(rgb(out.at("out"), x, y), expected);
+                worst = std::max(worst, e);
+                EXPECT_LT(e, 0.01) << what << ", pixel " << x << "," << y << ": " << rgb(out.at("out"), x, y).r
+                                   << " vs " << expected.r;
+                if (x == W / 2 && y == H / 2) {
+                    centre = rgb(out.at("out"), x, y);
+                    centreT = T;
+                    centreBg = rgb(out.at("bg"), x, y);
+                }
+                ++n;
+            }
+        std::printf("volume, %s: %d pixels, max relative error %.2g; centre pixel T = (%.4f, %.4f, %.4f), background "
+                    "(%.4f, %.4f, %.4f), out (%.4f, %.4f, %.4f)\n",
+                    what, n, worst, centreT.r, centreT.g, centreT.b, centreBg.r, centreBg.g, centreBg.b, centre.r,
+                    centre.g, centre.b);
+        EXPECT_GE(n, 300);
+    };
+
+    const Volume tinted{0.5f, 2.0f, {0.5f, 0.8f, 0.3f}, glm::vec3(2.0f), false};
+    auto a = render("volume_tinted", &tinted);
+    check("(a) thickness 0.5, scale 2, D 2", a, [&](glm::dvec3 d) {
+        const glm::dvec3 T = glm::pow(glm::dvec3(tinted.color), glm::dvec3(0.5 * 2.0 / 2.0));
+        EXPECT_LT(relErr(T, beer(tinted, tinted.thickness, d)), 1e-9); // uniform scale: d = thickness × scale
+        return T;
+    });
+
+    const Volume textured{0.6f, 0.5f, {0.2f, 0.6f, 0.9f}, glm::vec3(2.0f), true};
+    auto b = render("volume_textured", &textured);
+    check("(b) thickness 0.6 x green 128/255, scale 2, D 0.5", b, [&](glm::dvec3) {
+        return glm::pow(glm::dvec3(textured.color), glm::dvec3(0.6 * 128.0 / 255.0 * 2.0 / 0.5));
+    });
+
+    const Volume squashed{0.5f, 0.25f, {0.5f, 0.8f, 0.3f}, glm::vec3(2.0f, 2.0f, 0.5f), false};
+    auto c = render("volume_squashed", &squashed);
+    check("(c) thickness 0.5, scale (2, 2, 0.5), D 0.25", c,
+          [&](glm::dvec3 d) { return beer(squashed, squashed.thickness, d); });
+
+    const Volume thin{0.0f, 0.1f, {0.2f, 0.3f, 0.4f}, glm::vec3(2.0f), false};
+    auto t = render("volume_thin", &thin);
+    check("(d) thickness 0 (thin-walled)", t, [](glm::dvec3) { return glm::dvec3(1.0); });
+    auto plain = render("volume_none", nullptr);
+    check("no KHR_materials_volume", plain, [](glm::dvec3) { return glm::dvec3(1.0); });
+    double diff = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+            for (int ch = 0; ch < 3; ++ch)
+                diff = std::max(diff, std::abs(rgb(t.at("out"), x, y)[ch] - rgb(plain.at("out"), x, y)[ch]));
+    EXPECT_EQ(diff, 0.0) << "thicknessFactor 0 differs from the pane without the extension";
 }
 
 // A BLEND quad of alpha 1 is lit as lighting.deferred lights the same quad opaque: sun with shadows (half the quad

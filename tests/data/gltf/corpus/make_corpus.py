@@ -27,8 +27,8 @@ hand, written in the file's asset.extras.expect:
                        KHR_materials_emissive_strength 4, the right one without (G-buffer emissive 4x the right's).
   variants.gltf        KHR_materials_variants "red" and "blue" remapping the left quad's white material; the right quad
                        has no mapping and stays white whatever the variant.
-  ignored_material_extensions.gltf  KHR_materials_iridescence (material 0) and
-                       _volume with _transmission (material 1): vitrine warns once per ignored extension.
+  ignored_material_extensions.gltf  KHR_materials_iridescence (material 0) next to a plain _transmission (material
+                       1): vitrine warns once, for the iridescence.
   specular.gltf        KHR_materials_specular: strength 0.4, strength 0, a tint alone, and a 2x2 texture read both as
                        specularTexture (alpha) and specularColorTexture (sRGB rgb), one quadrant each; the G-buffer's
                        material.y is 1 - strength (tests/gpu/gltf_materials_test.cpp).
@@ -39,6 +39,11 @@ hand, written in the file's asset.extras.expect:
                        blue sheen, 0.3) and a black sheen (none), and a quad whose sheen colour (sRGB rgb) and roughness
                        (alpha) come from a 2x2 image through KHR_texture_transform; the G-buffer packs them
                        (tests/gpu/gltf_materials_test.cpp). Rendered by graphs/gltf.json, the spheres' rims glow.
+  volume.gltf          KHR_materials_volume on thin glass (_transmission 1) over a white backdrop: thickness 0.5 at
+                       attenuationDistance 2 of colour (0.5, 0.8, 1); thickness 0 (thin-walled) with a colour; thickness
+                       1 with no distance (infinite: no attenuation); and thicknessFactor 0.6 x the green of a 2x2
+                       image through KHR_texture_transform at distance 0.5 of colour (0.2, 0.6, 0.9); the first on a
+                       node of scale 2 (tests/unit/scene/test_gltf_materials.cpp reads them back).
 Regenerate after editing: python3 tests/data/gltf/corpus/make_corpus.py
 """
 import base64
@@ -390,16 +395,14 @@ def variants_file():
 
 def ignored_material_extensions_file():
     b = Builder()
-    names = ["KHR_materials_iridescence", "KHR_materials_transmission", "KHR_materials_volume"]
+    names = ["KHR_materials_iridescence", "KHR_materials_transmission"]
     b.doc["extensionsUsed"] = names
     b.doc["materials"] = [
         {"name": "coated", "extensions": {
             "KHR_materials_iridescence": {"iridescenceFactor": 1.0, "iridescenceThicknessMaximum": 400.0}}},
-        {"name": "thick_glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
-         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0},
-                        "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationDistance": 1.0,
-                                                 "attenuationColor": [1.0, 0.5, 0.5]}}}]
-    meshes = [quad_mesh(b, [-1, 0, 0], 1.0, 0, name="coated"), quad_mesh(b, [1, 0, 0], 1.0, 1, name="thick_glass")]
+        {"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}}}]
+    meshes = [quad_mesh(b, [-1, 0, 0], 1.0, 0, name="coated"), quad_mesh(b, [1, 0, 0], 1.0, 1, name="glass")]
     ortho_view(b, meshes)
     b.write("ignored_material_extensions.gltf")
 
@@ -545,6 +548,52 @@ def sheen_file():
     b.write("sheen.gltf")
 
 
+def volume_file():
+    """Quadrants (top-left, top-right, bottom-left, bottom-right) of clear glass (transmissionFactor 1, white, smooth)
+    with KHR_materials_volume, 0.5 in front of a white backdrop: thicknessFactor 0.5, attenuationDistance 2, colour
+    (0.5, 0.8, 1.0), on a node of scale 2 (its quad authored at half size: d = 0.5 x 2 = 1, T = colour^0.5); thickness
+    0 (thin-walled: the colour and distance change nothing); thickness 1 without attenuationDistance (+infinity: T = 1);
+    and thicknessFactor 0.6 x the green channel of a 2x2 image (nearest; green 255, 128, 64, 0, the other channels
+    different) through KHR_texture_transform (the identity), attenuationDistance 0.5, colour (0.2, 0.6, 0.9)."""
+    b = Builder()
+    vo, tr = "KHR_materials_volume", "KHR_materials_transmission"
+    b.doc["extensionsUsed"] = [tr, vo, "KHR_texture_transform"]
+    glass = {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0, "roughnessFactor": 0}
+    tt = {"KHR_texture_transform": {"offset": [0, 0], "scale": [1, 1]}}
+    b.doc["materials"] = [
+        {"name": "tinted", "pbrMetallicRoughness": glass, "extensions": {
+            tr: {"transmissionFactor": 1.0},
+            vo: {"thicknessFactor": 0.5, "attenuationDistance": 2.0, "attenuationColor": [0.5, 0.8, 1.0]}}},
+        {"name": "thin", "pbrMetallicRoughness": glass, "extensions": {
+            tr: {"transmissionFactor": 1.0},
+            vo: {"thicknessFactor": 0.0, "attenuationDistance": 0.1, "attenuationColor": [0.2, 0.3, 0.4]}}},
+        {"name": "clear", "pbrMetallicRoughness": glass, "extensions": {
+            tr: {"transmissionFactor": 1.0}, vo: {"thicknessFactor": 1.0, "attenuationColor": [0.5, 0.5, 0.5]}}},
+        {"name": "textured", "pbrMetallicRoughness": glass, "extensions": {
+            tr: {"transmissionFactor": 1.0},
+            vo: {"thicknessFactor": 0.6, "thicknessTexture": {"index": 0, "extensions": tt},
+                 "attenuationDistance": 0.5, "attenuationColor": [0.2, 0.6, 0.9]}}},
+        {"name": "backdrop", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0,
+                                                      "roughnessFactor": 1}}]
+    image = png_rgba(2, 2, [[0, 255, 0, 255], [255, 128, 255, 0], [128, 64, 0, 255], [255, 0, 255, 255]])
+    b.doc["images"] = [{"name": "thickness", "mimeType": "image/png", "bufferView": b.view(image)}]
+    b.doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"sampler": 0, "source": 0}]
+    meshes = [quad_mesh(b, [-0.5, 0.5, 0.25], 0.45, 0, name="tinted")]
+    meshes += [quad_mesh(b, c, 0.9, m, uvs=(m == 3), name=b.doc["materials"][m]["name"])
+               for m, c in [(1, [1, 1, 0.5]), (2, [-1, -1, 0.5]), (3, [1, -1, 0.5])]]
+    meshes.append(quad_mesh(b, [0, 0, 0], 2.0, 4, name="backdrop"))
+    ortho_view(b, meshes)
+    b.doc["nodes"][1]["scale"] = [2, 2, 2]
+    b.doc["asset"]["extras"] = {"expect": {
+        "materials": ["tinted", "thin", "clear", "textured"],
+        "thickness": [0.5, 0.0, 1.0, 0.6], "attenuation_distance": [2.0, 0.1, None, 0.5],
+        "attenuation_color": [[0.5, 0.8, 1.0], [0.2, 0.3, 0.4], [0.5, 0.5, 0.5], [0.2, 0.6, 0.9]],
+        "node_scale": [2.0, 1.0, 1.0, 1.0],
+        "texels_thickness": [0.6, 0.6 * 128 / 255, 0.6 * 64 / 255, 0.0]}}
+    b.write("volume.gltf")
+
+
 def main():
     # Perspective: the marker sits at 60 % of the half-height to the right and 40 % up at depth 5, so in a square
     # frame it lands at NDC (0.6, -0.4) (Vulkan y down) when the vertical field of view is kept, and at x = 0.4
@@ -569,6 +618,7 @@ def main():
     specular_file()
     clearcoat_file()
     sheen_file()
+    volume_file()
 
 
 if __name__ == "__main__":
