@@ -323,11 +323,16 @@ void GpuScene::uploadTextures(ShaderCompiler& shaders) {
     }
 
     // Level 0 of every texture by copy; the other levels by blits (colour and data: box filter, sRGB
-    // decoded by the blit) or, for normal maps, by the Toksvig compute pass.
+    // decoded by the blit) or, for normal maps, by the Toksvig compute pass. A normal map's alpha is the Toksvig
+    // chain's (shaders/scene/toksvig_mip.comp): sqrt(1 - length of the mean unit normal), 0 on level 0, whose
+    // normals are unit whatever their bytes decode to (glTF gives a normal texture's alpha no meaning).
     for (uint32_t t = 0; t < scene.textures.size(); ++t) {
         const scene::TextureImage& img = scene.images[scene.textures[t].image];
         staging.emplace_back(mCtx, img.pixels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, "texture.staging");
-        std::memcpy(staging.back().mapped(), img.pixels.data(), img.pixels.size());
+        auto* dst = static_cast<uint8_t*>(staging.back().mapped());
+        std::memcpy(dst, img.pixels.data(), img.pixels.size());
+        if (scene.textures[t].usage == scene::TextureUsage::Normal)
+            for (size_t i = 3; i < img.pixels.size(); i += 4) dst[i] = 0;
     }
     mCtx.immediate([&](VkCommandBuffer cmd) {
         if (mFallback) {
@@ -379,8 +384,9 @@ void GpuScene::uploadTextures(ShaderCompiler& shaders) {
 }
 
 // Normal-map mips for Toksvig (MUSEUM_SPEC §2): each texel of level m+1 is the plain average of the 2x2
-// decoded normals below it, re-encoded WITHOUT renormalising, so the vector shortens where the normals
-// disagree and the G-buffer pass reads that shortening as extra roughness.
+// decoded normals below it, re-encoded WITHOUT renormalising, and in alpha how much the unit normals of level 0
+// under it disagree (sqrt(1 - length of their mean)), which the G-buffer pass reads as extra roughness
+// (shaders/scene/toksvig_mip.comp).
 void GpuScene::buildToksvigMips(ShaderCompiler& shaders, VkCommandBuffer cmd, const std::vector<uint32_t>& normalMaps) {
     if (normalMaps.empty()) return;
     CompiledShader shader = shaders.compile("scene/toksvig_mip.comp");

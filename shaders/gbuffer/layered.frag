@@ -50,8 +50,10 @@ void main() {
 
     float shininess = clamp(s.shininess, 0.0, 1.0);
     if ((draw.flags & FLAG_TOKSVIG) != 0u) {
-        // Toksvig [Toksvig04]: the averaged normal's shortening widens the lobe (common/brdf.glsl).
-        shininess = 1.0 - toksvigRoughness(roughnessFromShininess(shininess), min(len, 1.0));
+        // Toksvig [Toksvig04]: the averaged normal's shortening widens the lobe (common/brdf.glsl). The shortening
+        // is the mip chain's (scene.glsl's normalLength), not the decoded vector's length, which 8-bit rounding
+        // moves by up to 0.8 % on a flat map.
+        shininess = 1.0 - toksvigRoughness(roughnessFromShininess(shininess), s.normalLength);
     }
 
     vec2 ndc = vClip.xy / vClip.w;

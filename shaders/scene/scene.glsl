@@ -167,11 +167,16 @@ float materialThickness(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) {
     return max(t, 0.0);
 }
 
-// The five blended parameters of a surface point. `normal` is tangent space and NOT normalised: its
-// length is below 1 where a mip averaged disagreeing normals (Toksvig).
+// The blended parameters of a surface point. `normal` is tangent space and NOT normalised (only its direction
+// counts). `normalLength` is what Toksvig reads: the length of the mean of the unit normals the sampled
+// footprint of the normal map covers (1 on level 0 and where the normals agree), which the normal-map mip chain
+// keeps in alpha as a = sqrt(1 - length) (core/scene/gpu_scene.cpp, shaders/scene/toksvig_mip.comp). It is not
+// the length of the decoded vector: 8-bit bytes put a flat normal's length anywhere in 1 +- 0.008, which Toksvig
+// would read as roughness 0.35 on a polished surface.
 struct LayeredSurface {
     vec4 albedo; // linear rgb, a = coverage
     vec3 normal;
+    float normalLength;
     float shininess;
     float metallic;
     float cavity;
@@ -183,6 +188,7 @@ LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) 
     LayeredSurface s;
     s.albedo = vec4(1.0);
     s.normal = vec3(0.0, 0.0, 1.0);
+    s.normalLength = 1.0;
     s.shininess = 0.5;
     s.metallic = 0.0;
     s.cavity = 1.0;
@@ -200,12 +206,17 @@ LayeredSurface evaluateLayers(GpuMaterial m, vec2 uv0, vec2 uv1, UvGradients g) 
             s.albedo = mix(s.albedo, l.albedo * sampleRef(l.refs[VITRINE_REF_ALBEDO], uv0, uv1, g), w);
         if ((bits & VITRINE_LAYER_NORMAL) != 0u) {
             vec3 n = vec3(0.0, 0.0, 1.0);
+            float len = 1.0;
             GpuTexRef nr = l.refs[VITRINE_REF_NORMAL];
             if (nr.info.x >= 0) {
-                n = sampleRef(nr, uv0, uv1, g).xyz * 2.0 - 1.0;
+                vec4 t = sampleRef(nr, uv0, uv1, g);
+                n = t.xyz * 2.0 - 1.0;
                 n.xy *= l.scalars0.x;
+                // 1 - length grows as the slopes' variance, so as the square of the normal scale.
+                len = clamp(1.0 - t.a * t.a * l.scalars0.x * l.scalars0.x, 0.0, 1.0);
             }
             s.normal = mix(s.normal, n, w);
+            s.normalLength = mix(s.normalLength, len, w);
         }
         if ((bits & VITRINE_LAYER_SHININESS) != 0u) {
             GpuTexRef r = l.refs[VITRINE_REF_SHININESS];

@@ -1,7 +1,15 @@
 #version 460
-// One level of a Toksvig normal-map mip chain (MUSEUM_SPEC §2, [Toksvig04]): the texel of level m+1 is
-// the plain average of the 2x2 decoded tangent-space normals of level m, re-encoded WITHOUT
-// renormalising. |average| < 1 where the normals disagree; the G-buffer pass turns that into roughness.
+// One level of a Toksvig normal-map mip chain (MUSEUM_SPEC §2, [Toksvig04]): the texel of level m+1 holds
+//   rgb: the plain average of the 2x2 decoded tangent-space normals of level m, re-encoded WITHOUT renormalising
+//        (its direction is what the G-buffer shades with);
+//   a:   sqrt(1 - L), L the length of the mean of the UNIT normals of level 0 under the texel: how much the
+//        normals disagree, which the G-buffer turns into roughness (shaders/scene/scene.glsl, normalLength).
+// L is carried from level to level: a texel of level m stands for the vector normalize(rgb) x L_m, and the
+// texel of level m+1 for the mean of four of those. Level 0's alpha is 0 (core/scene/gpu_scene.cpp): its
+// normals are unit whatever length their bytes decode to. Keeping L apart from the bytes is the point: an
+// 8-bit flat normal decodes to a length anywhere in 1 +- 0.008 (z = 254 instead of 255), and Toksvig reads
+// 1 - L = 0.008 on a polished surface (roughness 0.05) as roughness 0.35. The square root spends alpha's
+// 8 bits where Toksvig is sensitive: the first step is 1 - L = 1.5e-5.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba8) readonly uniform image2D src;
 layout(binding = 1, rgba8) writeonly uniform image2D dst;
@@ -11,12 +19,16 @@ void main() {
     ivec2 size = imageSize(dst);
     if (any(greaterThanEqual(p, size))) return;
     ivec2 srcSize = imageSize(src);
-    vec4 sum = vec4(0.0);
+    vec3 sum = vec3(0.0), mean = vec3(0.0);
     for (int y = 0; y < 2; ++y)
         for (int x = 0; x < 2; ++x) {
             vec4 t = imageLoad(src, min(2 * p + ivec2(x, y), srcSize - 1));
-            sum += vec4(t.xyz * 2.0 - 1.0, t.w);
+            vec3 n = t.xyz * 2.0 - 1.0;
+            sum += n;
+            float len = length(n);
+            if (len > 1e-6) mean += n / len * (1.0 - t.w * t.w);
         }
-    vec4 avg = sum * 0.25;
-    imageStore(dst, p, vec4(avg.xyz * 0.5 + 0.5, avg.w));
+    vec3 avg = sum * 0.25;
+    float shortening = clamp(1.0 - length(mean * 0.25), 0.0, 1.0);
+    imageStore(dst, p, vec4(avg * 0.5 + 0.5, sqrt(shortening)));
 }
