@@ -32,6 +32,13 @@ std::vector<uint8_t> bytes(size_t n, uint8_t seed) {
     return v;
 }
 
+// What BakeCache::map hands out, copied (nullopt on a miss): it must agree with get() in every case below.
+std::optional<std::vector<uint8_t>> mapped(const BakeCache& cache, const BakeKey& key) {
+    std::optional<BakeView> view = cache.map(key);
+    if (!view) return std::nullopt;
+    return std::vector<uint8_t>(view->bytes().begin(), view->bytes().end());
+}
+
 TEST_F(BakeCacheTest, StoresAndLoadsBytes) {
     BakeCache cache(mRoot);
     const BakeKey key{"bvh", 0x1234abcdull};
@@ -40,12 +47,25 @@ TEST_F(BakeCacheTest, StoresAndLoadsBytes) {
     auto back = cache.get(key);
     ASSERT_TRUE(back);
     EXPECT_EQ(*back, bytes(100000, 7));
+    EXPECT_EQ(mapped(cache, key), bytes(100000, 7));
+    {
+        // A view outlives a move and unmaps once.
+        std::optional<BakeView> a = cache.map(key);
+        ASSERT_TRUE(a);
+        BakeView b = std::move(*a);
+        EXPECT_TRUE(a->bytes().empty());
+        EXPECT_EQ(b.bytes().size(), 100000u);
+        EXPECT_EQ(b.bytes()[99999], bytes(100000, 7)[99999]);
+    }
     EXPECT_EQ(cache.pathOf(key), mRoot / "bake" / "bvh" / "000000001234abcd.bin");
     // Another cache object on the same directory (a later run) sees it too; empty payloads are fine.
     EXPECT_EQ(*BakeCache(mRoot).get(key), bytes(100000, 7));
     ASSERT_TRUE(cache.put({"bvh", 1}, {}));
     ASSERT_TRUE(cache.get({"bvh", 1}));
     EXPECT_TRUE(cache.get({"bvh", 1})->empty());
+    ASSERT_TRUE(mapped(cache, {"bvh", 1}));
+    EXPECT_TRUE(mapped(cache, {"bvh", 1})->empty());
+    EXPECT_FALSE(mapped(cache, {"bvh", 2}));
 }
 
 TEST_F(BakeCacheTest, KeysAndKindsAreSeparate) {
@@ -86,23 +106,28 @@ TEST_F(BakeCacheTest, DamagedOrForeignFilesAreMisses) {
         f.put(static_cast<char>(0x5a));
     }
     EXPECT_FALSE(cache.get(key));
+    EXPECT_FALSE(mapped(cache, key));
 
     // Truncated.
     ASSERT_TRUE(cache.put(key, bytes(4096, 3)));
     fs::resize_file(file, fs::file_size(file) - 1);
     EXPECT_FALSE(cache.get(key));
+    EXPECT_FALSE(mapped(cache, key));
 
     // Another key's file under this key's name.
     ASSERT_TRUE(cache.put({"bvh", 100}, bytes(4096, 3)));
     fs::copy_file(cache.pathOf({"bvh", 100}), file, fs::copy_options::overwrite_existing);
     EXPECT_FALSE(cache.get(key));
+    EXPECT_FALSE(mapped(cache, key));
 
     // Not a cache file at all.
     std::ofstream(file, std::ios::binary | std::ios::trunc) << "hello";
     EXPECT_FALSE(cache.get(key));
+    EXPECT_FALSE(mapped(cache, key));
     // And a put repairs it.
     ASSERT_TRUE(cache.put(key, bytes(64, 9)));
     EXPECT_EQ(*cache.get(key), bytes(64, 9));
+    EXPECT_EQ(mapped(cache, key), bytes(64, 9));
 }
 
 TEST_F(BakeCacheTest, UnwritableCacheIsReportedNotThrown) {
