@@ -739,6 +739,13 @@ double cpuToksvigShininess(double shininess, double normalLength) {
     return 1.0 - std::pow(alpha2, 0.25);
 }
 
+// The Toksvig tests' scene: the builder's material 0 on a quad that fills the 90-degree camera looking down -Z.
+std::filesystem::path writeFacingQuad(SceneBuilder& b, const char* name) {
+    b.node("quad", b.mesh("quad", quadVertices(2.0f, {-0.5f, -0.5f}, {1.5f, 1.5f}), kQuadIndices, 0), at({0, 0, -1}));
+    b.cameraPath("front", 1.57079632679f, {{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 1.57079632679f}});
+    return b.write(name);
+}
+
 TEST_F(Gbuffer, ToksvigLowersShininessOfHighMipsByTheFormula) {
     SceneBuilder b;
     // Columns alternate between normals tilted about ±45° around the bitangent. The bytes are chosen so
@@ -755,9 +762,7 @@ TEST_F(Gbuffer, ToksvigLowersShininessOfHighMipsByTheFormula) {
     // same as a quad far away, without shrinking it to a few pixels).
     m.layers[0].normal.texture.transform.scale = glm::vec2(64.0f);
     b.s.materials.push_back(m);
-    b.node("quad", b.mesh("quad", quadVertices(2.0f, {-0.5f, -0.5f}, {1.5f, 1.5f}), kQuadIndices, 0), at({0, 0, -1}));
-    b.cameraPath("front", 1.57079632679f, {{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 1.57079632679f}});
-    auto glb = b.write("toksvig");
+    auto glb = writeFacingQuad(b, "toksvig");
     const int size = 64;
     auto on = runGraph(gbufferGraph(glb, size, size, json::object(), {{"toksvig", true}}));
     auto off = runGraph(gbufferGraph(glb, size, size, json::object(), {{"toksvig", false}}));
@@ -807,9 +812,7 @@ TEST_F(Gbuffer, ToksvigIgnoresTheRoundingOfFlatNormals) {
     m.layers[0].normal.texture.texture = tex;
     m.layers[0].normal.texture.transform.scale = glm::vec2(64.0f); // level 4 sampled, as above
     b.s.materials.push_back(m);
-    b.node("quad", b.mesh("quad", quadVertices(2.0f, {-0.5f, -0.5f}, {1.5f, 1.5f}), kQuadIndices, 0), at({0, 0, -1}));
-    b.cameraPath("front", 1.57079632679f, {{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 1.57079632679f}});
-    auto glb = b.write("toksvig_flat");
+    auto glb = writeFacingQuad(b, "toksvig_flat");
     const int size = 64;
     auto on = runGraph(gbufferGraph(glb, size, size, json::object(), {{"toksvig", true}}));
     const double wrong = cpuToksvigShininess(shininess, glm::length(glm::dvec3(0.00196, 0.00196, 0.99216)));
@@ -841,9 +844,7 @@ TEST_F(Gbuffer, ToksvigWidensWithTheNormalScale) {
     m.layers[0].normal.scale = scale;
     m.layers[0].normal.texture.transform.scale = glm::vec2(64.0f);
     b.s.materials.push_back(m);
-    b.node("quad", b.mesh("quad", quadVertices(2.0f, {-0.5f, -0.5f}, {1.5f, 1.5f}), kQuadIndices, 0), at({0, 0, -1}));
-    b.cameraPath("front", 1.57079632679f, {{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 1.57079632679f}});
-    auto glb = b.write("toksvig_scale");
+    auto glb = writeFacingQuad(b, "toksvig_scale");
     const int size = 64;
     auto on = runGraph(gbufferGraph(glb, size, size, json::object(), {{"toksvig", true}}));
     auto scaled = [&](uint8_t x) {
