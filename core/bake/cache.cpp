@@ -58,19 +58,9 @@ fs::path BakeCache::pathOf(const BakeKey& key) const {
 }
 
 std::optional<std::vector<uint8_t>> BakeCache::get(const BakeKey& key) const {
-    std::ifstream in(pathOf(key), std::ios::binary);
-    if (!in) return std::nullopt;
-    Header h{};
-    if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return std::nullopt;
-    if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.key != key.hash) return std::nullopt;
-    in.seekg(0, std::ios::end);
-    if (static_cast<uint64_t>(in.tellg()) != sizeof(Header) + h.size) return std::nullopt;
-    in.seekg(sizeof(Header));
-    std::vector<uint8_t> bytes(h.size);
-    if (h.size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(h.size)))
-        return std::nullopt;
-    if (checksum(bytes) != h.checksum) return std::nullopt;
-    return bytes;
+    std::optional<BakeView> view = map(key);
+    if (!view) return std::nullopt;
+    return std::vector<uint8_t>(view->bytes().begin(), view->bytes().end());
 }
 
 BakeView::BakeView(BakeView&& o) noexcept { *this = std::move(o); }
