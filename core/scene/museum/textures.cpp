@@ -249,8 +249,9 @@ MuseumTextures makeTextures(Scene& scene, uint32_t size, Rng& rng, const MuseumO
     std::vector<TextureImage> images;
     if (options.loadTextures) {
         if (std::optional<std::vector<TextureImage>> loaded = options.loadTextures(key)) {
+            // (A conditional `ok ? *loaded : std::vector<TextureImage>{}` here copied all 64 MiB of them.)
             bool ok = loaded->size() == slots.size();
-            for (const TextureImage& image : ok ? *loaded : std::vector<TextureImage>{})
+            for (const TextureImage& image : *loaded)
                 ok = ok && image.width > 0 && image.height > 0 &&
                      image.pixels.size() == static_cast<size_t>(image.width) * image.height * 4;
             if (ok) images = std::move(*loaded);
