@@ -661,17 +661,15 @@ struct CpuPathTracer::Impl {
         return false;
     }
 
-    // The hit triangle's three vertices (object space).
-    std::array<const scene::Vertex*, 3> triangleVertices(const Hit& hit) const {
-        const TriangleRef& ref = refs[hit.triangle];
-        const scene::Primitive& prim = scene.primitives[ref.primitive];
-        const uint32_t* idx = &scene.indices[prim.firstIndex + 3 * ref.triangle];
-        return {&scene.vertices[idx[0] + prim.vertexOffset], &scene.vertices[idx[1] + prim.vertexOffset],
-                &scene.vertices[idx[2] + prim.vertexOffset]};
-    }
+    // The hit triangle's three indices, and its three vertices (object space).
     const uint32_t* triangleIndices(const Hit& hit) const {
         const TriangleRef& ref = refs[hit.triangle];
         return &scene.indices[scene.primitives[ref.primitive].firstIndex + 3 * ref.triangle];
+    }
+    std::array<const scene::Vertex*, 3> triangleVertices(const Hit& hit) const {
+        const uint32_t* idx = triangleIndices(hit);
+        const uint32_t offset = scene.primitives[refs[hit.triangle].primitive].vertexOffset;
+        return {&scene.vertices[idx[0] + offset], &scene.vertices[idx[1] + offset], &scene.vertices[idx[2] + offset]};
     }
     void prefetchIndices(const Hit& hit) const { __builtin_prefetch(triangleIndices(hit)); }
     void prefetchVertices(const Hit& hit) const {
