@@ -34,7 +34,10 @@ TEST_P(ShippedGraph, ValidatesAndRunsAtPreviewSize) {
     const fs::path file = fs::path(VITRINE_SOURCE_DIR) / "graphs" / GetParam();
     std::vector<std::string> sets = {"frame.width=64", "frame.height=36"};
     // Bakes at preview quality too (the shipped quality is measured by the golden and bake tests).
-    for (const auto& [id, node] : loadGraphDocument(file)["nodes"].items()) {
+    // The document lives in a variable: a range-for over loadGraphDocument(file)["nodes"].items() iterates a destroyed
+    // temporary (only the range's last object has its life extended before C++23), and the preview overrides were lost.
+    const nlohmann::json document = loadGraphDocument(file);
+    for (const auto& [id, node] : document["nodes"].items()) {
         if (node.value("type", "") == "bake.lightmap")
             for (const char* p : {".params.samples=2", ".params.texels_per_meter=1", ".params.probe_spacing=10"})
                 sets.push_back(id + p);
