@@ -31,7 +31,10 @@ public:
         static_assert(std::is_trivially_copyable_v<T>);
         bytes(&v, sizeof(T));
     }
-    template <typename T> void array(const std::vector<T>& v) {
+    // A contiguous range (std::vector, PixelBuffer): its length, then its elements' bytes.
+    template <typename R> void array(const R& v) {
+        using T = std::remove_cvref_t<decltype(*v.data())>;
+        static_assert(std::is_trivially_copyable_v<T>);
         value(v.size());
         if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
     }

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "core/scene/pixel_buffer.hpp"
+
 #include <glm/glm.hpp>
 
 namespace vitrine::scene {
@@ -24,7 +26,7 @@ struct TextureImage {
     std::string name;
     uint32_t width = 0;
     uint32_t height = 0;
-    std::vector<uint8_t> pixels; // width * height * 4
+    PixelBuffer pixels; // width * height * 4; a view of the bake cache for the museum's loaded textures
 
     uint8_t* at(uint32_t x, uint32_t y) { return &pixels[(static_cast<size_t>(y) * width + x) * 4]; }
     const uint8_t* at(uint32_t x, uint32_t y) const { return &pixels[(static_cast<size_t>(y) * width + x) * 4]; }

@@ -6,8 +6,6 @@
 #include "core/shader/compiler.hpp"
 #include "nodes/scene/scene_node.hpp"
 
-#include <sys/mman.h>
-
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -57,18 +55,10 @@ std::vector<uint8_t> serializeTextures(const std::vector<scene::TextureImage>& i
     return out;
 }
 
-// Fresh memory is mapped a 4 KiB page per fault; in a VM each fault is costly, and the museum's 64 MiB of textures
-// take about 16,000 of them (page faults and copies were most of a warm start's scene build under perf). Transparent
-// huge pages (2 MiB) on the aligned interior of a large buffer, where the kernel grants them on request, need a
-// fault per 2 MiB instead.
-void adviseHugePages(void* data, size_t bytes) {
-    constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-    const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-    const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
-    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE); // advice: failure is harmless
-}
-
-std::optional<std::vector<scene::TextureImage>> deserializeTextures(std::span<const uint8_t> bytes) {
+// The images of a stored texture set. Their pixels are views of `bytes` (kept alive by `keepAlive`, the mapped cache
+// file): nothing is copied into fresh memory (PixelBuffer).
+std::optional<std::vector<scene::TextureImage>> deserializeTextures(std::span<const uint8_t> bytes,
+                                                                    const std::shared_ptr<const void>& keepAlive) {
     size_t at = 0;
     auto get32 = [&](uint32_t& v) {
         if (bytes.size() - at < 4) return false;
@@ -88,9 +78,7 @@ std::optional<std::vector<scene::TextureImage>> deserializeTextures(std::span<co
             return std::nullopt;
         const size_t n = static_cast<size_t>(image.width) * image.height * 4;
         if (bytes.size() - at < n) return std::nullopt;
-        image.pixels.reserve(n);
-        adviseHugePages(image.pixels.data(), n);
-        image.pixels.assign(bytes.data() + at, bytes.data() + at + n);
+        image.pixels = scene::PixelBuffer::view(bytes.subspan(at, n), keepAlive);
         at += n;
     }
     if (at != bytes.size()) return std::nullopt;
@@ -111,9 +99,11 @@ std::shared_ptr<const scene::Scene> museum(uint64_t seed, uint32_t size) {
     auto ms = [&] { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count(); };
     bool loaded = false;
     options.loadTextures = [&](uint64_t key) -> std::optional<std::vector<scene::TextureImage>> {
-        std::optional<BakeView> bytes = bake.map(BakeKey{"museum_textures", key});
-        if (!bytes) return std::nullopt;
-        auto images = deserializeTextures(bytes->bytes());
+        std::optional<BakeView> mapped = bake.map(BakeKey{"museum_textures", key});
+        if (!mapped) return std::nullopt;
+        // The mapping lives as long as the last image viewing it (the scene, or a copy of an image).
+        auto view = std::make_shared<const BakeView>(std::move(*mapped));
+        auto images = deserializeTextures(view->bytes(), view);
         loaded = images.has_value();
         return images;
     };

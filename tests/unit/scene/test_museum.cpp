@@ -80,6 +80,39 @@ TEST_F(Museum, TexturesLoadedFromTheStoreBuildTheSameScene) {
     EXPECT_NE(museumTextureSourceHash(), 0u);
 }
 
+// scene.museum hands over the loaded textures as views of the mapped cache file (PixelBuffer): the build must read
+// them where they lie. A build that wrote to them, or took a non-const reference, would copy each into fresh memory
+// (the cost the views remove from a warm start) and let go of the mapping.
+TEST_F(Museum, LoadedTexturesStayViewsOfTheStore) {
+    std::vector<TextureImage> stored;
+    MuseumOptions o;
+    o.textureSize = 32;
+    o.storeTextures = [&](uint64_t, const std::vector<TextureImage>& images) { stored = images; };
+    const uint64_t expected = buildMuseum(o).contentHash();
+    ASSERT_FALSE(stored.empty());
+    auto mapped = std::make_shared<std::vector<std::vector<uint8_t>>>();
+    for (const TextureImage& image : stored) mapped->push_back(image.pixels.toVector());
+    std::weak_ptr<const void> alive = mapped;
+    o.storeTextures = nullptr;
+    o.loadTextures = [&](uint64_t) -> std::optional<std::vector<TextureImage>> {
+        std::vector<TextureImage> images = stored;
+        for (size_t i = 0; i < images.size(); ++i) images[i].pixels = PixelBuffer::view((*mapped)[i], mapped);
+        return images;
+    };
+    {
+        const Scene loaded = buildMuseum(o);
+        EXPECT_EQ(loaded.contentHash(), expected);
+        ASSERT_EQ(loaded.images.size(), stored.size());
+        for (size_t i = 0; i < stored.size(); ++i) {
+            EXPECT_TRUE(loaded.images[i].pixels.isView()) << loaded.images[i].name << " was copied by the build";
+            EXPECT_EQ(loaded.images[i].pixels.data(), (*mapped)[i].data()) << loaded.images[i].name;
+        }
+        mapped.reset();
+        EXPECT_FALSE(alive.expired()) << "the scene's images keep the store's memory alive";
+    }
+    EXPECT_TRUE(alive.expired()) << "the scene gone, the store's memory is let go";
+}
+
 TEST_F(Museum, RejectsBadOptions) {
     MuseumOptions bad;
     bad.textureSize = 1000;
