@@ -22,7 +22,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'V', 'T', 'B', 'A', 'K', 'E', '0', '1'};
+// VTBAKE02 files carry checksum() below; VTBAKE01 files (written before 2026-12-05) carry checksumV1() and are still
+// read, so an existing cache stays valid. put() writes VTBAKE02.
+constexpr char kMagic[8] = {'V', 'T', 'B', 'A', 'K', 'E', '0', '2'};
+constexpr char kMagicV1[8] = {'V', 'T', 'B', 'A', 'K', 'E', '0', '1'};
 
 // The file: this header, then the payload.
 struct Header {
@@ -33,9 +36,30 @@ struct Header {
 };
 static_assert(sizeof(Header) == 32);
 
-uint64_t checksum(std::span<const uint8_t> bytes) {
+// The version-1 checksum: one scene::Hasher over the payload, a single chain of dependent multiplies (about 37 ms
+// for the museum's 64 MiB of textures, a sixth of a warm start's scene build).
+uint64_t checksumV1(std::span<const uint8_t> bytes) {
     scene::Hasher h;
     h.bytes(bytes.data(), bytes.size());
+    return h.result();
+}
+
+// The payload's checksum: four independent scene::Hasher lanes over interleaved 8-byte words (the CPU overlaps
+// their multiplies), the tail and the size in a fifth, the lanes' results hashed together.
+uint64_t checksum(std::span<const uint8_t> bytes) {
+    scene::Hasher lanes[4];
+    const size_t blocks = bytes.size() / 32;
+    const uint8_t* p = bytes.data();
+    for (size_t i = 0; i < blocks; ++i, p += 32)
+        for (int l = 0; l < 4; ++l) {
+            uint64_t w;
+            std::memcpy(&w, p + 8 * l, 8);
+            lanes[l].word(w);
+        }
+    scene::Hasher h;
+    h.bytes(p, bytes.size() - blocks * 32);
+    h.value(static_cast<uint64_t>(bytes.size()));
+    for (const scene::Hasher& lane : lanes) h.value(lane.result());
     return h.result();
 }
 
@@ -101,8 +125,10 @@ std::optional<BakeView> BakeCache::map(const BakeKey& key) const {
     view.mOffset = sizeof(Header);
     Header h{};
     std::memcpy(&h, base, sizeof h);
-    if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.key != key.hash || sizeof(Header) + h.size != view.mLength ||
-        checksum(view.bytes()) != h.checksum)
+    const bool v2 = std::memcmp(h.magic, kMagic, sizeof kMagic) == 0;
+    const bool v1 = std::memcmp(h.magic, kMagicV1, sizeof kMagicV1) == 0;
+    if ((!v2 && !v1) || h.key != key.hash || sizeof(Header) + h.size != view.mLength ||
+        (v2 ? checksum(view.bytes()) : checksumV1(view.bytes())) != h.checksum)
         return std::nullopt;
     return view;
 }
@@ -162,8 +188,8 @@ std::vector<BakeEntry> BakeCache::list() const {
             const unsigned long long hash = std::strtoull(e.path.stem().string().c_str(), &end, 16);
             if (!in.read(reinterpret_cast<char*>(&h), sizeof h))
                 e.problem = "shorter than the 32-byte header";
-            else if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0)
-                e.problem = "not a bake cache file (no VTBAKE01 magic)";
+            else if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 && std::memcmp(h.magic, kMagicV1, sizeof kMagicV1) != 0)
+                e.problem = "not a bake cache file (no VTBAKE02 or VTBAKE01 magic)";
             else if (e.path.extension() != ".bin" || *end != '\0' || h.key != hash)
                 e.problem = "the header's key is not the file name's";
             else if (h.size != e.bytes - sizeof(Header))

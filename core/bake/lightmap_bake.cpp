@@ -173,6 +173,7 @@ BakeKey lightmapCacheKey(const scene::Scene& scene, const LightmapBakeSettings& 
     h.value(s.sunScale);
     h.value(s.skyScale);
     h.value(s.emissiveScale);
+    if (s.seed != 0) h.value(s.seed); // seed 0 keeps the key it had before the seed existed
     return {"lightmap", h.result()};
 }
 

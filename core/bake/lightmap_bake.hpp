@@ -40,6 +40,9 @@ struct LightmapBakeSettings {
     uint32_t maxProbes = 4096; // the spacing grows when the scene would need more
     LightmapFilterOptions filter;
     float sunScale = 1.0f, skyScale = 1.0f, emissiveScale = 1.0f;
+    // The paths' random sequence: 0 is the default; another value gives an independent bake of the same quality (two
+    // seeds differ by the bake's noise). Dispatch d of seed s draws the sequence of index d + 65536 s.
+    uint32_t seed = 0;
 };
 
 // A regular grid of probes: probe (x, y, z) sits at origin + spacing * (x, y, z).

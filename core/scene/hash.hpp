@@ -43,6 +43,10 @@ public:
         bytes(s.data(), s.size());
     }
 
+    // One 8-byte word, mixed as bytes() mixes each whole word (without bytes()'s length word): for callers that
+    // split a stream into lanes of words themselves (the bake cache's checksum).
+    void word(uint64_t w) { mix(w); }
+
     uint64_t result() const {
         // Final avalanche (splitmix64's) so that nearby states give unrelated hashes.
         uint64_t z = mState;

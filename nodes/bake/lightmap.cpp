@@ -78,6 +78,7 @@ NodeSchema schema() {
         {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
         {"sky_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky cube map's radiance"},
         {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of emissive surfaces"},
+        {"seed", ParamType::Int, 0, 0.0, 65535.0, {}, "Random sequence of the paths: another seed bakes independently at the same quality (the spread between seeds is the bake's noise)"},
         {"cache", ParamType::Bool, true, {}, {}, {}, "Load and store the bake in the bake cache (off: bake every run)"},
     };
     return s;
@@ -100,6 +101,7 @@ public:
         mSettings.sunScale = p.getFloat("sun_scale");
         mSettings.skyScale = p.getFloat("sky_scale");
         mSettings.emissiveScale = p.getFloat("emissive_scale");
+        mSettings.seed = static_cast<uint32_t>(p.getInt("seed"));
         mUseCache = p.getBool("cache");
 
         const scene::Scene& scene = mScene->scene();
@@ -231,7 +233,8 @@ private:
                 LightmapBakePush push{};
                 push.scales = {mSettings.sunScale, mSettings.skyScale, mSettings.emissiveScale, 0.0f};
                 const uint32_t count = std::min(perDispatch, mSettings.samples - done);
-                push.counts = {static_cast<uint32_t>(jobCount), count, d * 0x9E3779B9u + 0x7F4A7C15u, mSettings.maxBounces};
+                const uint32_t sequence = d + (mSettings.seed << 16u); // distinct for every dispatch (fewer than 65536) and seed
+                push.counts = {static_cast<uint32_t>(jobCount), count, sequence * 0x9E3779B9u + 0x7F4A7C15u, mSettings.maxBounces};
                 push.grid = {kJobsPerRow, d == 0 ? LIGHTMAP_BAKE_FIRST : 0u, 0u, 0u};
                 if (d > 0) ctx.computeBarrier();
                 ctx.dispatchWithSets(mPipeline, &push, sizeof(push), std::min<uint32_t>(kJobsPerRow, jobCount), rows,

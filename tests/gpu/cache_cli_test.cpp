@@ -38,7 +38,7 @@ TEST(CacheCli, ListsAndRemovesEntriesAndNothingOutside) {
     EXPECT_NE(ls.output.find("1.0 KiB"), std::string::npos) << ls.output; // 32-byte header + 1000
     EXPECT_NE(ls.output.find("3.0 MiB"), std::string::npos) << ls.output;
     EXPECT_NE(ls.output.find("42 B"), std::string::npos) << ls.output; // header + 10
-    EXPECT_NE(ls.output.find("no VTBAKE01 magic"), std::string::npos) << ls.output;
+    EXPECT_NE(ls.output.find("no VTBAKE02 or VTBAKE01 magic"), std::string::npos) << ls.output;
     // 4 files: 1032 + 42 + 3 MiB + 32 bytes and the garbage; the symlinked folder is not followed.
     EXPECT_NE(ls.output.find("4 entries, 3.0 MiB in all"), std::string::npos) << ls.output;
     EXPECT_EQ(ls.output.find("0000000000000001.bin"), std::string::npos) << ls.output;

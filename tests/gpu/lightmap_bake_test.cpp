@@ -19,6 +19,7 @@
 #include "core/accel/scene_bvh.hpp"
 #include "core/accel/traverse.hpp"
 #include "core/bake/lightmap_atlas.hpp"
+#include "core/bake/lightmap_bake.hpp"
 #include "core/bake/lightmap_raster.hpp"
 #include "core/graph/loader.hpp"
 #include "core/image/io.hpp"
@@ -175,6 +176,42 @@ TEST_F(LightmapBake, SkyLightBesideABlackWallFollowsTheViewFactor) {
             EXPECT_GT(lm.at(int(r.x + i), int(r.y + r.size))[0], 0.3 * kPi * C) << "gutter below column " << i;
         }
     }
+}
+
+// `seed`: the same seed bakes the same bits; another seed is an independent bake of the same light (the lightmap
+// differs texel by texel, by the noise of 16 paths, but its mean agrees), and another cache key.
+TEST_F(LightmapBake, AnotherSeedIsAnIndependentBakeOfTheSameLight) {
+    const double C = 1000.0;
+    const fs::path glb = floorAndWall("bake_seed", glm::vec3(0.5f), 0.0f, glm::vec3(0.0f), 1.0f, {0.3f, 1.0f, 0.2f});
+    const bake::LightmapRegion r = floorRegion(glb);
+    auto bakeWith = [&](int seed) {
+        return runGraph(bakeGraph(glb, uniformSky(glb, C),
+                                  {{"samples", 16}, {"sun_scale", 0.0}, {"filter_iterations", 0}, {"seed", seed}}))
+            .at("lightmap");
+    };
+    const Image a = bakeWith(0), again = bakeWith(0), b = bakeWith(7);
+    EXPECT_EQ(a.pixels, again.pixels);
+    double sumA = 0.0, sumB = 0.0, diff = 0.0;
+    int differing = 0, n = 0;
+    for (uint32_t j = 0; j < r.size; ++j)
+        for (uint32_t i = 0; i < r.size; ++i) {
+            const float va = a.at(int(r.x + i), int(r.y + j))[0], vb = b.at(int(r.x + i), int(r.y + j))[0];
+            sumA += va;
+            sumB += vb;
+            diff += std::abs(va - vb);
+            differing += va != vb ? 1 : 0;
+            ++n;
+        }
+    std::printf("seeds 0 and 7: %d of %d texels differ, mean |diff| %.4f of the mean, means %.1f and %.1f lux\n",
+                differing, n, diff / sumA, sumA / n, sumB / n);
+    // (Texels far from the wall see only the uniform sky: exact whatever the paths, the same in both.)
+    EXPECT_GT(differing, n / 4) << "seed 7 drew the same paths as seed 0";
+    EXPECT_GT(diff / sumA, 0.005) << "seed 7 drew (nearly) the same paths as seed 0";
+    EXPECT_NEAR(sumB / sumA, 1.0, 0.02) << "another seed must bake the same light";
+    bake::LightmapBakeSettings s0, s7;
+    s7.seed = 7;
+    scene::Scene empty;
+    EXPECT_NE(bake::lightmapCacheKey(empty, s0, 1).hash, bake::lightmapCacheKey(empty, s7, 1).hash);
 }
 
 // The floor beside a wall seen from behind: a single-sided quad at x = 0 facing away from the floor, which the

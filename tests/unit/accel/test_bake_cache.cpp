@@ -2,6 +2,7 @@
 #include "core/bake/cache.hpp"
 
 #include "core/base/error.hpp"
+#include "core/scene/hash.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -128,6 +129,56 @@ TEST_F(BakeCacheTest, DamagedOrForeignFilesAreMisses) {
     ASSERT_TRUE(cache.put(key, bytes(64, 9)));
     EXPECT_EQ(*cache.get(key), bytes(64, 9));
     EXPECT_EQ(mapped(cache, key), bytes(64, 9));
+}
+
+// The checksum covers every byte: a flip in any of its four interleaved lanes' words or in the tail (a size that is
+// not a multiple of 32) is a miss.
+TEST_F(BakeCacheTest, AFlipInAnyLaneOrTheTailIsAMiss) {
+    BakeCache cache(mRoot);
+    const BakeKey key{"bvh", 7};
+    const std::vector<uint8_t> payload = bytes(32 * 5 + 13, 4);
+    for (size_t at : {0, 8, 16, 24, 32 * 3 + 8 * 3 + 7, 32 * 5, 32 * 5 + 12}) {
+        ASSERT_TRUE(cache.put(key, payload));
+        ASSERT_EQ(*cache.get(key), payload);
+        {
+            std::fstream f(cache.pathOf(key), std::ios::in | std::ios::out | std::ios::binary);
+            f.seekp(static_cast<std::streamoff>(32 + at));
+            f.put(static_cast<char>(payload[at] ^ 0x10));
+        }
+        EXPECT_FALSE(cache.get(key)) << "byte " << at;
+        EXPECT_FALSE(mapped(cache, key)) << "byte " << at;
+    }
+}
+
+// Files written before the four-lane checksum (magic VTBAKE01, the payload's scene::Hasher as checksum) are still
+// read, so an existing cache stays valid; damaged ones are misses as before.
+TEST_F(BakeCacheTest, VersionOneFilesAreStillRead) {
+    BakeCache cache(mRoot);
+    const BakeKey key{"lightmap", 0xabcdefull};
+    const std::vector<uint8_t> payload = bytes(1000, 6);
+    auto writeV1 = [&](uint64_t checksum) {
+        fs::create_directories(cache.pathOf(key).parent_path());
+        std::ofstream out(cache.pathOf(key), std::ios::binary | std::ios::trunc);
+        const uint64_t header[3] = {key.hash, payload.size(), checksum};
+        out.write("VTBAKE01", 8);
+        out.write(reinterpret_cast<const char*>(header), sizeof header);
+        out.write(reinterpret_cast<const char*>(payload.data()), static_cast<std::streamsize>(payload.size()));
+    };
+    scene::Hasher h;
+    h.bytes(payload.data(), payload.size());
+    writeV1(h.result());
+    ASSERT_TRUE(cache.get(key));
+    EXPECT_EQ(*cache.get(key), payload);
+    EXPECT_EQ(mapped(cache, key), payload);
+    writeV1(h.result() ^ 1);
+    EXPECT_FALSE(cache.get(key));
+    EXPECT_FALSE(mapped(cache, key));
+    // What put() writes now is the new version, under the same name.
+    ASSERT_TRUE(cache.put(key, payload));
+    char magic[8];
+    std::ifstream(cache.pathOf(key), std::ios::binary).read(magic, 8);
+    EXPECT_EQ(std::string(magic, 8), "VTBAKE02");
+    EXPECT_EQ(*cache.get(key), payload);
 }
 
 TEST_F(BakeCacheTest, UnwritableCacheIsReportedNotThrown) {
