@@ -46,6 +46,28 @@ double luminance709(glm::dvec3 rgb) {
     return 0.2126729 * rgb.x + 0.7151522 * rgb.y + 0.0721750 * rgb.z;
 }
 
+namespace {
+
+// Radiance of the solar disk for turbidity T and sun zenith angle ts (see PreethamSky::sunRadiance()).
+glm::dvec3 sunRadianceAt(double T, double ts) {
+    // Slant-path transmittance of the extraterrestrial spectrum, 380-780 nm in 5 nm steps.
+    const double m =
+        1.0 / (std::cos(ts) + 0.15 * std::pow(std::max(93.885 - ts * 180.0 / kPi, 1e-3), -1.253)); // Kasten
+    const double beta = 0.04608365822050 * T - 0.04586025928522;
+    glm::dvec3 xyz(0.0);
+    for (int i = 0; i <= 80; ++i) {
+        const double nm = 380.0 + 5.0 * i, um = nm * 1e-3;
+        const double rayleigh = std::exp(-0.008735 * std::pow(um, -4.08) * m);
+        const double aerosol = std::exp(-beta * std::pow(um, -1.3) * m);
+        const double dz = (nm - 600.0) / 45.0;
+        const double ozone = std::exp(-0.12 * std::exp(-0.5 * dz * dz) * 0.35 * m);
+        xyz += cieXyz(nm) * (planck(um, 5778.0) * rayleigh * aerosol * ozone * 0.005);
+    }
+    return glm::max(xyzToRec709(683.0 * xyz), glm::dvec3(0.0));
+}
+
+} // namespace
+
 PreethamSky::PreethamSky(double turbidity, glm::dvec3 toSun, double groundAlbedo)
     : mTurbidity(turbidity), mToSun(glm::normalize(toSun)), mGroundAlbedo(groundAlbedo) {
     const double T = turbidity;
@@ -80,20 +102,7 @@ PreethamSky::PreethamSky(double turbidity, glm::dvec3 toSun, double groundAlbedo
                              {0.15346, -0.26756, 0.06670, 0.26688}};
     mZenithxyY = {zenith(mx), zenith(my), yz};
 
-    // Sun: slant-path transmittance of the extraterrestrial spectrum, 380-780 nm in 5 nm steps.
-    const double m =
-        1.0 / (std::cos(ts) + 0.15 * std::pow(std::max(93.885 - ts * 180.0 / kPi, 1e-3), -1.253)); // Kasten
-    const double beta = 0.04608365822050 * T - 0.04586025928522;
-    glm::dvec3 xyz(0.0);
-    for (int i = 0; i <= 80; ++i) {
-        const double nm = 380.0 + 5.0 * i, um = nm * 1e-3;
-        const double rayleigh = std::exp(-0.008735 * std::pow(um, -4.08) * m);
-        const double aerosol = std::exp(-beta * std::pow(um, -1.3) * m);
-        const double dz = (nm - 600.0) / 45.0;
-        const double ozone = std::exp(-0.12 * std::exp(-0.5 * dz * dz) * 0.35 * m);
-        xyz += cieXyz(nm) * (planck(um, 5778.0) * rayleigh * aerosol * ozone * 0.005);
-    }
-    mSunRadiance = glm::max(xyzToRec709(683.0 * xyz), glm::dvec3(0.0));
+    mSunRadiance = sunRadianceAt(T, ts);
 
     // Horizontal irradiance from the sky dome: midpoint rule in (theta, phi).
     const int nt = 256, np = 512;
@@ -145,6 +154,12 @@ glm::dvec3 PreethamSky::sunRadiance() const {
 glm::dvec3 PreethamSky::sunIlluminance() const {
     double s = std::sin(kSunAngularRadius);
     return mSunRadiance * (kPi * s * s);
+}
+
+glm::dvec3 PreethamSky::sunIlluminance(double turbidity, glm::dvec3 toSun) {
+    const double ts = std::acos(std::clamp(glm::normalize(toSun).y, -1.0, 1.0));
+    double s = std::sin(kSunAngularRadius);
+    return sunRadianceAt(turbidity, ts) * (kPi * s * s);
 }
 
 } // namespace vitrine::shading

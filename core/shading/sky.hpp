@@ -42,6 +42,9 @@ public:
     glm::dvec3 sunRadiance() const;
     // Sun illuminance on a surface perpendicular to it: sunRadiance * pi sin^2(angular radius).
     glm::dvec3 sunIlluminance() const;
+    // The same for a turbidity and sun direction without building the sky (whose constructor integrates the sky dome's
+    // irradiance: most of its cost). Bit-identical to PreethamSky(turbidity, toSun, any).sunIlluminance().
+    static glm::dvec3 sunIlluminance(double turbidity, glm::dvec3 toSun);
     // Irradiance from the Perez sky (without the sun) on a horizontal surface.
     glm::dvec3 skyIrradianceHorizontal() const { return mSkyIrradiance; }
     glm::dvec3 groundRadiance() const;

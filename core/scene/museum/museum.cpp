@@ -305,7 +305,7 @@ Scene buildMuseum(const MuseumOptions& options) {
     scene.sun.toSun = glm::normalize(glm::vec3(0.3f, 0.72f, -0.63f));
     // The Preetham sun of the museum's sky for that direction (the ground albedo does not change it): color ×
     // illuminance is its RGB illuminance, colour normalised to a largest component of 1.
-    glm::dvec3 e = shading::PreethamSky(kMuseumSkyTurbidity, glm::dvec3(scene.sun.toSun), 0.3).sunIlluminance();
+    glm::dvec3 e = shading::PreethamSky::sunIlluminance(kMuseumSkyTurbidity, glm::dvec3(scene.sun.toSun));
     double peak = std::max({e.x, e.y, e.z});
     scene.sun.color = glm::vec3(e / peak);
     scene.sun.illuminance = static_cast<float>(peak);

@@ -81,5 +81,16 @@ TEST(Sky, SunAzimuthConvention) {
     EXPECT_NEAR(up.y, 1.0, 1e-12);
 }
 
+// The static sunIlluminance (scene.museum's sun, without integrating the sky dome) is the member's, bit for bit.
+TEST(Sky, SunIlluminanceWithoutTheSkyIsTheSkysSun) {
+    for (double turbidity : {2.0, 3.0, 6.5})
+        for (glm::dvec3 toSun : {glm::dvec3(0.3, 0.72, -0.63), glm::dvec3(0.0, 1.0, 0.0), glm::dvec3(1.0, 0.1, 2.0)}) {
+            const glm::dvec3 a = PreethamSky(turbidity, toSun, 0.3).sunIlluminance();
+            const glm::dvec3 b = PreethamSky::sunIlluminance(turbidity, toSun);
+            EXPECT_EQ(a, b) << turbidity << " " << toSun.x << " " << toSun.y << " " << toSun.z;
+            EXPECT_GT(b.y, 0.0);
+        }
+}
+
 } // namespace
 } // namespace vitrine::shading
