@@ -28,10 +28,7 @@ public:
 
     PixelBuffer() = default;
     PixelBuffer(std::vector<uint8_t> bytes) : mOwned(std::move(bytes)) {} // NOLINT: implicit, as a vector converts
-    PixelBuffer(size_t count, uint8_t value) : mOwned(count, value) {}
     PixelBuffer(std::initializer_list<uint8_t> bytes) : mOwned(bytes) {}
-    template <class It>
-    PixelBuffer(It first, It last) : mOwned(first, last) {}
 
     // A view of `bytes`, valid while `keepAlive` lives (the buffer holds it).
     static PixelBuffer view(std::span<const uint8_t> bytes, std::shared_ptr<const void> keepAlive) {
@@ -49,8 +46,6 @@ public:
     const uint8_t& operator[](size_t i) const { return data()[i]; }
     const uint8_t* begin() const { return data(); }
     const uint8_t* end() const { return data() + size(); }
-    const uint8_t* cbegin() const { return begin(); }
-    const uint8_t* cend() const { return end(); }
 
     uint8_t* data() { return own().data(); }
     uint8_t& operator[](size_t i) { return own()[i]; }
@@ -59,11 +54,6 @@ public:
 
     void resize(size_t n) { own().resize(n); }
     void resize(size_t n, uint8_t value) { own().resize(n, value); }
-    void reserve(size_t n) { own().reserve(n); }
-    void push_back(uint8_t v) { own().push_back(v); }
-    void clear() {
-        *this = PixelBuffer();
-    }
     template <class It>
     void assign(It first, It last) {
         drop();
@@ -76,7 +66,6 @@ public:
 
     // The bytes as a vector (a copy).
     std::vector<uint8_t> toVector() const { return {begin(), end()}; }
-    operator std::span<const uint8_t>() const { return {data(), size()}; } // NOLINT: implicit, as a vector converts
 
     friend bool operator==(const PixelBuffer& a, const PixelBuffer& b) {
         return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin());

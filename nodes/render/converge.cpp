@@ -78,7 +78,8 @@ bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
         // batch: with a few samples a pixel's standard error is estimated low (the rare bright paths are not yet
         // seen), and the first batch's time includes one-off costs. Measured on the museum's reference (80x45,
         // target 0.036, lavapipe's CPU tracer): after the first 16 spp it predicted 6,574 spp and 204 s for what took
-        // 11,520 spp and 90 s; at 64 spp, 9,189 spp and 67 s. The progress bar's time left follows the rate as it goes.
+        // 11,520 spp and 90 s; announced at 64 spp, 9,189 spp and 69 s for a run of 11,520 spp and 85 s. The progress
+        // bar's time left follows the rate as it goes.
         if (run.report && !announced && b > 0 && (samples >= run.minSpp || noise <= run.target)) {
             const double perSample = (t - firstBatchEnd) / (samples - run.batch);
             char line[280];
