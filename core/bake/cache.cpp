@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // VTBAKE02 files carry checksum() below; VTBAKE01 files (written before 2026-12-05) carry checksumV1() and are still
-// read, so an existing cache stays valid. put() writes VTBAKE02.
+// read, so an existing cache stays valid. put() writes VTBAKE02, and map() rewrites a valid VTBAKE01 file as VTBAKE02
+// once, so an entry that is only ever read (the museum's textures) stops paying the old checksum.
 constexpr char kMagic[8] = {'V', 'T', 'B', 'A', 'K', 'E', '0', '2'};
 constexpr char kMagicV1[8] = {'V', 'T', 'B', 'A', 'K', 'E', '0', '1'};
 
@@ -130,6 +131,9 @@ std::optional<BakeView> BakeCache::map(const BakeKey& key) const {
     if ((!v2 && !v1) || h.key != key.hash || sizeof(Header) + h.size != view.mLength ||
         (v2 ? checksum(view.bytes()) : checksumV1(view.bytes())) != h.checksum)
         return std::nullopt;
+    // The rewrite replaces the file by rename: this view keeps mapping the old one. A failed rewrite (a read-only
+    // cache) only means the next read checks the old checksum again.
+    if (v1) put(key, view.bytes());
     return view;
 }
 
