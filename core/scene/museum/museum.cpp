@@ -287,6 +287,8 @@ Scene buildMuseum(const MuseumOptions& options) {
     }
     Scene scene;
     scene.name = "museum";
+    scene.vertices.reserve(kMuseumVertexReserve);
+    scene.indices.reserve(kMuseumIndexReserve);
     Museum m{scene, {}, {}, Rng(options.seed), 0};
     m.tex = makeTextures(scene, size, m.rng, options);
     m.mat = makeMaterials(scene, m.tex);

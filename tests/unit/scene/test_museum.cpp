@@ -32,6 +32,17 @@ TEST_F(Museum, IsDeterministicFromTheSeed) {
     EXPECT_NE(buildMuseum(other).contentHash(), museum().contentHash());
 }
 
+// buildMuseum reserves the default museum's geometry up front (a warm start's scene build): the hint must hold it
+// (else the vectors grow as before) without reserving much more than it uses.
+TEST_F(Museum, GeometryFitsTheReservedHint) {
+    EXPECT_LE(museum().vertices.size(), kMuseumVertexReserve);
+    EXPECT_GT(museum().vertices.size(), kMuseumVertexReserve * 9 / 10);
+    EXPECT_LE(museum().indices.size(), kMuseumIndexReserve);
+    EXPECT_GT(museum().indices.size(), kMuseumIndexReserve * 9 / 10);
+    EXPECT_EQ(museum().vertices.capacity(), kMuseumVertexReserve) << "the vertices outgrew the reserve";
+    EXPECT_EQ(museum().indices.capacity(), kMuseumIndexReserve) << "the indices outgrew the reserve";
+}
+
 // The texture store (what scene.museum wires to the bake cache): the first build stores its textures under a key,
 // a build that loads them is the same scene (every other random draw unchanged), a payload that does not fit is
 // ignored (generated and stored again), and the key follows the seed and the size.
