@@ -1065,6 +1065,19 @@ bool CpuRays::intersect(vec3 o, vec3 d, float tmax, CpuSurface& hit) const {
     return true;
 }
 
+bool CpuRays::firstHit(vec3 o, vec3 d, CpuSurface& hit, bool& inside) const {
+    const CpuPathTracer::Impl& impl = implOf(mImpl);
+    CpuPathTracer::Impl::Hit h;
+    inside = false;
+    if (!impl.closest(o, d, 0.0f, h, mRays)) return false;
+    if (impl.culled(h, d)) {
+        inside = true;
+        return false;
+    }
+    hit = impl.pathSurface(h, o, d);
+    return true;
+}
+
 bool CpuRays::occluded(vec3 o, vec3 d, float tmax) const { return implOf(mImpl).occluded(o, d, mRays, tmax); }
 
 vec3 CpuRays::radiance(vec3 o, vec3 d, uint32_t& rng) const {

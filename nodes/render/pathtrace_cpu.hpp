@@ -82,6 +82,10 @@ public:
     // The first visible surface along o + t d, t in (0, tmax) (single-sided materials' backs are skipped, as the
     // rasteriser culls them).
     bool intersect(glm::vec3 o, glm::vec3 d, float tmax, CpuSurface& hit) const;
+    // The first triangle along o + t d, either side: true with `hit` where it is a visible surface; false with
+    // `inside` set where it is the back of a single-sided surface (what intersect() passes through: the ray started
+    // inside geometry, as bake.lightmap counts it), false with `inside` clear where nothing is hit (the sky).
+    bool firstHit(glm::vec3 o, glm::vec3 d, CpuSurface& hit, bool& inside) const;
     // Whether anything (either side of any opaque triangle) lies along o + t d, t in (0, tmax).
     bool occluded(glm::vec3 o, glm::vec3 d, float tmax) const;
     // render.pathtrace's estimate of the radiance arriving at o from direction -d (emission of the first surface,

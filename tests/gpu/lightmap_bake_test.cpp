@@ -102,11 +102,17 @@ json uniformSky(const fs::path& glb, double c) {
     return {{"type", "sky.hdri"}, {"params", {{"path", file.string()}, {"intensity", c}, {"size", 16}}}};
 }
 
-json bakeGraph(const fs::path& glb, json sky, json params) {
+// Both integrators of bake.lightmap are held to each case: shaders/bake/lightmap.comp ("gpu") and render.pathtrace's
+// CPU tracer ("cpu", what "auto" picks on lavapipe).
+constexpr const char* kBackends[] = {"gpu", "cpu"};
+
+json bakeGraph(const fs::path& glb, json sky, json params, const char* backend) {
+    params["backend"] = backend;
     params["texels_per_meter"] = kTexelsPerMeter;
     params["probe_spacing"] = 100.0;
     params["probe_rays"] = 16;
-    params["cache"] = false; // always this build's integrator, never an earlier build's file
+    if (!params.contains("cache"))
+        params["cache"] = false; // always this build's integrator, never an earlier build's file
     json nodes = {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}}}}},
                   {"sky", sky},
                   {"bake", {{"type", "bake.lightmap"},
@@ -161,21 +167,24 @@ TEST_F(LightmapBake, SkyLightBesideABlackWallFollowsTheViewFactor) {
     const bake::LightmapRegion r = floorRegion(glb);
     // Raw with many samples (the integrator), then few samples (16, half the node's default) and the filter,
     // which must remove the noise without flattening the contact gradient near the wall.
-    for (auto [samples, iterations, tolerance, totalTolerance] :
-         {std::tuple{256, 0, 0.02, 0.01}, std::tuple{16, 4, 0.05, 0.03}}) {
-        SCOPED_TRACE("filter iterations " + std::to_string(iterations));
-        auto out = runGraph(bakeGraph(glb, uniformSky(glb, C),
-                                      {{"samples", samples}, {"sun_scale", 0.0}, {"filter_iterations", iterations}}));
-        std::printf("sky beside a black wall, %d samples, filter %d:\n", samples, iterations);
-        expectProfile(out.at("lightmap"), r, [&](double d) { return kPi * C * (1.0 - viewFactorToWall(d)); }, tolerance,
-                      totalTolerance);
-        // The gutter ring around the region holds its border's values (dilation): nothing black.
-        const Image& lm = out.at("lightmap");
-        for (uint32_t i = 0; i < r.size; ++i) {
-            EXPECT_GT(lm.at(int(r.x + i), int(r.y) - 1)[0], 0.3 * kPi * C) << "gutter above column " << i;
-            EXPECT_GT(lm.at(int(r.x + i), int(r.y + r.size))[0], 0.3 * kPi * C) << "gutter below column " << i;
+    for (const char* backend : kBackends)
+        for (auto [samples, iterations, tolerance, totalTolerance] :
+             {std::tuple{256, 0, 0.02, 0.01}, std::tuple{16, 4, 0.05, 0.03}}) {
+            SCOPED_TRACE(std::string(backend) + ", filter iterations " + std::to_string(iterations));
+            auto out = runGraph(bakeGraph(glb, uniformSky(glb, C),
+                                          {{"samples", samples}, {"sun_scale", 0.0}, {"filter_iterations", iterations}},
+                                          backend));
+            std::printf("%s: sky beside a black wall, %d samples, filter %d:\n", backend, samples, iterations);
+            expectProfile(
+                out.at("lightmap"), r, [&](double d) { return kPi * C * (1.0 - viewFactorToWall(d)); }, tolerance,
+                totalTolerance);
+            // The gutter ring around the region holds its border's values (dilation): nothing black.
+            const Image& lm = out.at("lightmap");
+            for (uint32_t i = 0; i < r.size; ++i) {
+                EXPECT_GT(lm.at(int(r.x + i), int(r.y) - 1)[0], 0.3 * kPi * C) << "gutter above column " << i;
+                EXPECT_GT(lm.at(int(r.x + i), int(r.y + r.size))[0], 0.3 * kPi * C) << "gutter below column " << i;
+            }
         }
-    }
 }
 
 // `seed`: the same seed bakes the same bits; another seed is an independent bake of the same light (the lightmap
@@ -184,34 +193,61 @@ TEST_F(LightmapBake, AnotherSeedIsAnIndependentBakeOfTheSameLight) {
     const double C = 1000.0;
     const fs::path glb = floorAndWall("bake_seed", glm::vec3(0.5f), 0.0f, glm::vec3(0.0f), 1.0f, {0.3f, 1.0f, 0.2f});
     const bake::LightmapRegion r = floorRegion(glb);
-    auto bakeWith = [&](int seed) {
-        return runGraph(bakeGraph(glb, uniformSky(glb, C),
-                                  {{"samples", 16}, {"sun_scale", 0.0}, {"filter_iterations", 0}, {"seed", seed}}))
-            .at("lightmap");
-    };
-    const Image a = bakeWith(0), again = bakeWith(0), b = bakeWith(7);
-    EXPECT_EQ(a.pixels, again.pixels);
-    double sumA = 0.0, sumB = 0.0, diff = 0.0;
-    int differing = 0, n = 0;
-    for (uint32_t j = 0; j < r.size; ++j)
-        for (uint32_t i = 0; i < r.size; ++i) {
-            const float va = a.at(int(r.x + i), int(r.y + j))[0], vb = b.at(int(r.x + i), int(r.y + j))[0];
-            sumA += va;
-            sumB += vb;
-            diff += std::abs(va - vb);
-            differing += va != vb ? 1 : 0;
-            ++n;
-        }
-    std::printf("seeds 0 and 7: %d of %d texels differ, mean |diff| %.4f of the mean, means %.1f and %.1f lux\n",
-                differing, n, diff / sumA, sumA / n, sumB / n);
-    // (Texels far from the wall see only the uniform sky: exact whatever the paths, the same in both.)
-    EXPECT_GT(differing, n / 4) << "seed 7 drew the same paths as seed 0";
-    EXPECT_GT(diff / sumA, 0.005) << "seed 7 drew (nearly) the same paths as seed 0";
-    EXPECT_NEAR(sumB / sumA, 1.0, 0.02) << "another seed must bake the same light";
+    for (const char* backend : kBackends) {
+        SCOPED_TRACE(backend);
+        auto bakeWith = [&](int seed) {
+            return runGraph(bakeGraph(glb, uniformSky(glb, C),
+                                      {{"samples", 16}, {"sun_scale", 0.0}, {"filter_iterations", 0}, {"seed", seed}},
+                                      backend))
+                .at("lightmap");
+        };
+        const Image a = bakeWith(0), again = bakeWith(0), b = bakeWith(7);
+        EXPECT_EQ(a.pixels, again.pixels);
+        double sumA = 0.0, sumB = 0.0, diff = 0.0;
+        int differing = 0, n = 0;
+        for (uint32_t j = 0; j < r.size; ++j)
+            for (uint32_t i = 0; i < r.size; ++i) {
+                const float va = a.at(int(r.x + i), int(r.y + j))[0], vb = b.at(int(r.x + i), int(r.y + j))[0];
+                sumA += va;
+                sumB += vb;
+                diff += std::abs(va - vb);
+                differing += va != vb ? 1 : 0;
+                ++n;
+            }
+        std::printf(
+            "%s: seeds 0 and 7: %d of %d texels differ, mean |diff| %.4f of the mean, means %.1f and %.1f lux\n",
+            backend, differing, n, diff / sumA, sumA / n, sumB / n);
+        // (Texels far from the wall see only the uniform sky: exact whatever the paths, the same in both.)
+        EXPECT_GT(differing, n / 4) << "seed 7 drew the same paths as seed 0";
+        EXPECT_GT(diff / sumA, 0.005) << "seed 7 drew (nearly) the same paths as seed 0";
+        EXPECT_NEAR(sumB / sumA, 1.0, 0.02) << "another seed must bake the same light";
+    }
     bake::LightmapBakeSettings s0, s7;
     s7.seed = 7;
     scene::Scene empty;
     EXPECT_NE(bake::lightmapCacheKey(empty, s0, 1).hash, bake::lightmapCacheKey(empty, s7, 1).hash);
+}
+
+// `backend`: auto traces on the CPU when the Vulkan device is a CPU (lavapipe), else on the GPU; the two integrators
+// draw different paths (the same light, other bits), and each is its own cache entry.
+TEST_F(LightmapBake, AutoTracesOnTheCpuOfACpuDevice) {
+    const fs::path glb = floorAndWall("bake_backend", glm::vec3(0.5f), 0.0f, glm::vec3(0.0f), 1.0f, {0.3f, 1.0f, 0.2f});
+    auto bakeWith = [&](const char* backend, bool cache) {
+        return runGraph(bakeGraph(glb, uniformSky(glb, 1000.0), {{"samples", 8}, {"sun_scale", 0.0}, {"cache", cache}},
+                                  backend))
+            .at("lightmap");
+    };
+    const Image automatic = bakeWith("auto", false), cpu = bakeWith("cpu", false), gpuBake = bakeWith("gpu", false);
+    const bool cpuDevice = gpu().deviceInfo().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    EXPECT_EQ(automatic.pixels, cpuDevice ? cpu.pixels : gpuBake.pixels) << "device is a CPU: " << cpuDevice;
+    EXPECT_NE(cpu.pixels, gpuBake.pixels);
+    // Through a cache of its own: the GPU bake after a stored CPU bake is the GPU's, and the other way round.
+    const fs::path cacheDir = fs::path(VITRINE_TEST_OUT) / "bake_backend_cache";
+    fs::remove_all(cacheDir);
+    ScopedEnv env("VITRINE_CACHE_DIR", cacheDir.string());
+    EXPECT_EQ(bakeWith("cpu", true).pixels, cpu.pixels);
+    EXPECT_EQ(bakeWith("gpu", true).pixels, gpuBake.pixels);
+    EXPECT_EQ(bakeWith("cpu", true).pixels, cpu.pixels);
 }
 
 // The floor beside a wall seen from behind: a single-sided quad at x = 0 facing away from the floor, which the
@@ -235,9 +271,14 @@ TEST_F(LightmapBake, PathsThatStartBehindAWallAreLeftOutOfTheTexelsMean) {
     b.sun({0.3f, 1.0f, 0.2f});
     const fs::path glb = b.write();
     const bake::LightmapRegion r = floorRegion(glb);
-    auto out = runGraph(bakeGraph(glb, uniformSky(glb, C), {{"samples", 64}, {"sun_scale", 0.0}, {"filter_iterations", 0}}));
-    std::printf("floor beside a wall seen from behind, 64 samples:\n");
-    expectProfile(out.at("lightmap"), r, [&](double) { return kPi * C; }, 0.02, 0.01);
+    for (const char* backend : kBackends) {
+        SCOPED_TRACE(backend);
+        auto out = runGraph(bakeGraph(glb, uniformSky(glb, C),
+                                      {{"samples", 64}, {"sun_scale", 0.0}, {"filter_iterations", 0}}, backend));
+        std::printf("%s: floor beside a wall seen from behind, 64 samples:\n", backend);
+        expectProfile(
+            out.at("lightmap"), r, [&](double) { return kPi * C; }, 0.02, 0.01);
+    }
 }
 
 TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
@@ -245,17 +286,22 @@ TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
     const fs::path glb = floorAndWall("bake_sun_wall", glm::vec3(0.0f), 1.0f, wallBase, 0.0f, {1.0f, 1.0f, 0.3f});
     const bake::LightmapRegion r = floorRegion(glb);
     json sky = {{"type", "sky.procedural"}, {"in", {{"scene", "scene.scene"}}}, {"params", {{"size", 16}, {"sun_in_cubemap", false}}}};
-    auto out = runGraph(bakeGraph(glb, sky, {{"samples", 1024}, {"sky_scale", 0.0}, {"filter_iterations", 0}}));
-    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
-    const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-    // A Lambertian wall (no specular lobe): it reflects its base colour.
-    const double albedo = wallBase.r;
-    const double cosine = glm::dot(toSun, glm::dvec3(1, 0, 0));
-    ASSERT_GT(cosine, 0.3);
-    std::printf("sun off a white wall (E_sun %.0f lux, cos %.3f):\n", sunE.r, cosine);
-    // Few paths find the wall far from it (F = 0.11 at 3 m): columns to 3 m, each within 6 %, their sum 2 %.
-    expectProfile(out.at("lightmap"), r, [&](double d) { return albedo * sunE.r * cosine * viewFactorToWall(d); }, 0.06,
-                  0.02, 3.0);
+    for (const char* backend : kBackends) {
+        SCOPED_TRACE(backend);
+        auto out =
+            runGraph(bakeGraph(glb, sky, {{"samples", 1024}, {"sky_scale", 0.0}, {"filter_iterations", 0}}, backend));
+        const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
+        const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+        // A Lambertian wall (no specular lobe): it reflects its base colour.
+        const double albedo = wallBase.r;
+        const double cosine = glm::dot(toSun, glm::dvec3(1, 0, 0));
+        ASSERT_GT(cosine, 0.3);
+        std::printf("%s: sun off a white wall (E_sun %.0f lux, cos %.3f):\n", backend, sunE.r, cosine);
+        // Few paths find the wall far from it (F = 0.11 at 3 m): columns to 3 m, each within 6 %, their sum 2 %.
+        expectProfile(
+            out.at("lightmap"), r, [&](double d) { return albedo * sunE.r * cosine * viewFactorToWall(d); }, 0.06, 0.02,
+            3.0);
+    }
 }
 
 // A closed box whose six walls glow with Le and reflect with the material of (base, shininess 0 = roughness 1):
@@ -292,22 +338,29 @@ fs::path emissiveBox(const std::string& name, float Le, float base, float specul
 
 // Mean and worst relative texel error of the floor's lightmap against `expected`.
 void expectEmissiveBox(const fs::path& glb, int bounces, double expected, double scale) {
-    const bake::LightmapRegion r = floorRegion(glb);
-    auto out = runGraph(bakeGraph(glb, uniformSky(glb, 1000.0),
-                                  {{"samples", 64}, {"max_bounces", bounces}, {"sun_scale", 0.0}, {"sky_scale", 0.0},
-                                   {"emissive_scale", scale}}));
-    double sum = 0.0, worst = 0.0;
-    for (uint32_t j = 0; j < r.size; ++j)
-        for (uint32_t i = 0; i < r.size; ++i) {
-            const double e = out.at("lightmap").at(int(r.x + i), int(r.y + j))[0];
-            sum += e;
-            worst = std::max(worst, std::abs(e / expected - 1.0));
-        }
-    const double mean = sum / (double(r.size) * r.size);
-    std::printf("emissive box %s, %d bounces: mean %.1f lux, expected %.1f (worst texel %.3f off)\n",
-                glb.stem().string().c_str(), bounces, mean, expected, worst);
-    EXPECT_NEAR(mean / expected, 1.0, 0.01) << bounces << " bounces";
-    EXPECT_LT(worst, 0.1);
+    for (const char* backend : kBackends) {
+        SCOPED_TRACE(backend);
+        const bake::LightmapRegion r = floorRegion(glb);
+        auto out = runGraph(bakeGraph(glb, uniformSky(glb, 1000.0),
+                                      {{"samples", 64},
+                                       {"max_bounces", bounces},
+                                       {"sun_scale", 0.0},
+                                       {"sky_scale", 0.0},
+                                       {"emissive_scale", scale}},
+                                      backend));
+        double sum = 0.0, worst = 0.0;
+        for (uint32_t j = 0; j < r.size; ++j)
+            for (uint32_t i = 0; i < r.size; ++i) {
+                const double e = out.at("lightmap").at(int(r.x + i), int(r.y + j))[0];
+                sum += e;
+                worst = std::max(worst, std::abs(e / expected - 1.0));
+            }
+        const double mean = sum / (double(r.size) * r.size);
+        std::printf("%s: emissive box %s, %d bounces: mean %.1f lux, expected %.1f (worst texel %.3f off)\n", backend,
+                    glb.stem().string().c_str(), bounces, mean, expected, worst);
+        EXPECT_NEAR(mean / expected, 1.0, 0.01) << bounces << " bounces";
+        EXPECT_LT(worst, 0.1);
+    }
 }
 
 TEST_F(LightmapBake, ClosedEmissiveBoxFollowsTheGeometricSeries) {
@@ -350,10 +403,20 @@ struct MuseumTexels {
 TEST_F(LightmapBake, MuseumBakeIsFiniteLitWhereTheSunIsAndCached) {
     const float tpm = 2.0f;
     json nodes = {{"scene", {{"type", "scene.museum"}, {"params", {{"texture_size", 64}, {"camera", "static"}}}}},
-                  {"sky", {{"type", "sky.procedural"}, {"in", {{"scene", "scene.scene"}}}, {"params", {{"size", 16}, {"sun_in_cubemap", false}}}}},
-                  {"bake", {{"type", "bake.lightmap"},
-                            {"in", {{"scene", "scene.scene"}, {"sky", "sky.cubemap"}, {"sky_sh", "sky.sh"}}},
-                            {"params", {{"samples", 4}, {"texels_per_meter", tpm}, {"probe_spacing", 6.0}, {"probe_rays", 16}}}}}};
+                  {"sky",
+                   {{"type", "sky.procedural"},
+                    {"in", {{"scene", "scene.scene"}}},
+                    {"params", {{"size", 16}, {"sun_in_cubemap", false}}}}},
+                  {"bake",
+                   {{"type", "bake.lightmap"},
+                    {"in", {{"scene", "scene.scene"}, {"sky", "sky.cubemap"}, {"sky_sh", "sky.sh"}}},
+                    // The GPU integrator: the last step edits its shader (the CPU one is compiled in).
+                    {"params",
+                     {{"samples", 4},
+                      {"texels_per_meter", tpm},
+                      {"probe_spacing", 6.0},
+                      {"probe_rays", 16},
+                      {"backend", "gpu"}}}}}};
     const json g = graph(nodes, {{"lightmap", "bake.lightmap"}, {"volume", "bake.volume"}, {"sh", "sky.sh"}}, 16, 16);
 
     // A cache of its own, so the first run bakes.
