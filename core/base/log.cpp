@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <vector>
 
 namespace vitrine {
@@ -43,6 +44,11 @@ void Progress::advance(size_t steps) {
     if (mDone > mTotal) mDone = mTotal;
     draw(false);
     notify(false);
+}
+
+void Progress::advanceTo(double fraction) {
+    const size_t target = static_cast<size_t>(std::clamp(fraction, 0.0, 1.0) * static_cast<double>(mTotal));
+    if (target > mDone) advance(target - mDone);
 }
 
 void Progress::finish() {

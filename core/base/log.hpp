@@ -27,7 +27,11 @@ public:
     Progress& operator=(const Progress&) = delete;
 
     void advance(size_t steps = 1);
+    // Advances to `fraction` (0..1) of the total when that is further than done so far (for work that reports the
+    // fraction it has done).
+    void advanceTo(double fraction);
     void finish();
+    size_t done() const { return mDone; }
 
 private:
     void draw(bool force);

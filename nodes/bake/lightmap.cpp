@@ -176,16 +176,14 @@ public:
         ctx.splitSubmission();
         scene::Hasher lighting;
         const GpuImage& sky = ctx.input("sky");
-        CpuSky cpuSky;
-        cpuSky.size = static_cast<int>(sky.desc().width);
+        std::vector<Image> faces;
         for (uint32_t face = 0; face < sky.desc().layers; ++face) {
-            cpuSky.faces.push_back(readImage(ctx.gpu(), sky, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
-            hashImage(cpuSky.faces.back(), lighting);
+            faces.push_back(readImage(ctx.gpu(), sky, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
+            hashImage(faces.back(), lighting);
         }
         const Image sh = readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
         hashImage(sh, lighting);
-        cpuSky.sunIlluminance = glm::vec3(sh.at(9, 0)[0], sh.at(9, 0)[1], sh.at(9, 0)[2]);
-        cpuSky.sunDirection = glm::vec3(sh.at(10, 0)[0], sh.at(10, 0)[1], sh.at(10, 0)[2]);
+        const CpuSky cpuSky = cpuSkyFrom(std::move(faces), sh);
         const bool cpu =
             mBackend == "cpu" || (mBackend == "auto" && ctx.gpu().deviceInfo().type == VK_PHYSICAL_DEVICE_TYPE_CPU);
         // The tracer changes the bits (another estimator of the same light): a CPU bake is stored apart from a GPU
@@ -357,14 +355,9 @@ private:
                               std::to_string(mVolume.probeCount()) + " probes, " + std::to_string(mSettings.samples) +
                               " paths each)",
                           100);
-        size_t shown = 0;
         CpuAccumulation acc;
         acc.reset(s.width, s.height);
-        tracer.estimate(s, sky, acc, sample, [&](double done) {
-            const size_t now = static_cast<size_t>(done * 100.0);
-            if (now > shown) progress.advance(now - shown);
-            shown = std::max(shown, now);
-        });
+        tracer.estimate(s, sky, acc, sample, [&](double done) { progress.advanceTo(done); });
         progress.finish();
         std::vector<glm::vec4> sums(2 * jobCount);
         for (size_t job = 0; job < jobCount; ++job) {

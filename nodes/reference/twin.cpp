@@ -120,18 +120,13 @@ void TwinNode::execute(ExecuteContext& ctx) {
         (ctx.frameIndex() * 0x9E3779B9u) ^ (static_cast<uint32_t>(p.getInt("seed")) * 0x85EBCA6Bu + 0x27D4EB2Fu);
     const bool report = p.getBool("report");
     std::unique_ptr<Progress> bar;
-    size_t shown = 0;
     std::function<void(double)> progress;
     if (report) {
         bar = std::make_unique<Progress>(mTwin.what + " " + std::to_string(out.width) + "x" +
                                              std::to_string(out.height) + " at " + std::to_string(spp) +
                                              " spp on the CPU",
                                          100);
-        progress = [&](double done) {
-            size_t now = static_cast<size_t>(done * 100.0);
-            if (now > shown) bar->advance(now - shown);
-            shown = std::max(shown, now);
-        };
+        progress = [&](double done) { bar->advanceTo(done); };
     }
     traceBatch(ctx, sky, spp, seed, progress);
     bar.reset();

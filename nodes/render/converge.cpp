@@ -156,15 +156,22 @@ void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFra
     h.value(height);
 }
 
-CpuSky readCpuSky(ExecuteContext& ctx) {
+CpuSky cpuSkyFrom(std::vector<Image> faces, const Image& sh) {
     CpuSky sky;
-    const GpuImage& cube = ctx.input("sky");
-    sky.size = static_cast<int>(cube.desc().width);
-    for (uint32_t face = 0; face < 6; ++face)
-        sky.faces.push_back(readImage(ctx.gpu(), cube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
-    const Image sh = readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    sky.size = faces.empty() ? 0 : faces.front().width;
+    sky.faces = std::move(faces);
     sky.sunIlluminance = glm::vec3(sh.at(9, 0)[0], sh.at(9, 0)[1], sh.at(9, 0)[2]);
     sky.sunDirection = glm::vec3(sh.at(10, 0)[0], sh.at(10, 0)[1], sh.at(10, 0)[2]);
+    return sky;
+}
+
+CpuSky readCpuSky(ExecuteContext& ctx) {
+    const GpuImage& cube = ctx.input("sky");
+    std::vector<Image> faces;
+    for (uint32_t face = 0; face < 6; ++face)
+        faces.push_back(readImage(ctx.gpu(), cube, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, face));
+    CpuSky sky = cpuSkyFrom(std::move(faces),
+                            readImage(ctx.gpu(), ctx.input("sky_sh"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
     if (ctx.hasInput("env_cdf"))
         sky.envCdf = readImage(ctx.gpu(), ctx.input("env_cdf"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     return sky;

@@ -55,6 +55,9 @@ void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFra
 // optional `env_cdf`. They must be computed earlier in the frame (call ctx.splitSubmission() first) and declared
 // readBack.
 CpuSky readCpuSky(ExecuteContext& ctx);
+// A CpuSky of six read-back cube faces (+X -X +Y -Y +Z -Z) and a sky node's `sh` (sun illuminance at texel 9,
+// direction at texel 10), without a sampling table; readCpuSky's own, and for nodes that read the sky themselves.
+CpuSky cpuSkyFrom(std::vector<Image> faces, const Image& sh);
 
 // A CpuAccumulation into a node's `color` and `stats` outputs (storage images) through a host-visible buffer and
 // render/pathtrace_store.comp (the pipeline, made in setup: ctx.computePipeline("render/pathtrace_store.comp", {}, 1)).

@@ -374,18 +374,13 @@ private:
 
         const bool report = p.getBool("report");
         std::unique_ptr<Progress> bar;
-        size_t shown = 0;
         std::function<void(double)> progress;
         if (report) {
             bar = std::make_unique<Progress>("path tracing " + std::to_string(out.width) + "x" +
                                                  std::to_string(out.height) + " at " + std::to_string(s.spp) +
                                                  " spp on the CPU",
                                              100);
-            progress = [&](double done) {
-                size_t now = static_cast<size_t>(done * 100.0);
-                if (now > shown) bar->advance(now - shown);
-                shown = std::max(shown, now);
-            };
+            progress = [&](double done) { bar->advanceTo(done); };
         }
         const CpuTraceCounters counters = mCpu->trace(s, sky, mAccumulation, progress);
         bar.reset();

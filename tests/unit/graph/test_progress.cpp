@@ -56,6 +56,19 @@ TEST(Progress, ObserverHearsStartAndEndWithTheOutermostNode) {
     EXPECT_EQ(heard.back().done, 2u) << "finish() reports the end";
 }
 
+// advanceTo: work that reports the fraction it has done moves the bar forward only, and never past the end.
+TEST(Progress, AdvanceToMovesForwardToTheFraction) {
+    Progress p("fraction", 100);
+    p.advanceTo(0.5);
+    EXPECT_EQ(p.done(), 50u);
+    p.advanceTo(0.25);
+    EXPECT_EQ(p.done(), 50u);
+    p.advanceTo(0.999);
+    EXPECT_EQ(p.done(), 99u);
+    p.advanceTo(2.0);
+    EXPECT_EQ(p.done(), 100u);
+}
+
 TEST(Progress, ObserversArePerThread) {
     std::vector<Heard> heard, other;
     ScopedProgressObserver observer(recorder(heard));
