@@ -174,6 +174,7 @@ BakeKey lightmapCacheKey(const scene::Scene& scene, const LightmapBakeSettings& 
     h.value(s.skyScale);
     h.value(s.emissiveScale);
     if (s.seed != 0) h.value(s.seed); // seed 0 keeps the key it had before the seed existed
+    h.value(s.causticFootprint);
     return {"lightmap", h.result()};
 }
 

@@ -43,6 +43,10 @@ struct LightmapBakeSettings {
     // The paths' random sequence: 0 is the default; another value gives an independent bake of the same quality (two
     // seeds differ by the bake's noise). Dispatch d of seed s draws the sequence of index d + 65536 s.
     uint32_t seed = 0;
+    // Texels over which a glossy surface's reflection of the sun (a caustic, e.g. off a polished floor onto the
+    // ceiling) is spread: regularizedRoughness's footprint, 1 / atlas.texelsPerMeter metres per texel. 0: exact.
+    float causticFootprint = 0.0f;
+    float causticFootprintMeters() const { return causticFootprint / atlas.texelsPerMeter; }
 };
 
 // A regular grid of probes: probe (x, y, z) sits at origin + spacing * (x, y, z).

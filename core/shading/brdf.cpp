@@ -198,6 +198,12 @@ glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::v
     return brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric) * (kPi * intensity);
 }
 
+float regularizedRoughness(float roughness, float footprint, float distance) {
+    if (footprint <= 0.0f) return roughness;
+    const float alpha = std::min(footprint / (2.0f * std::max(distance, 1e-4f)), 1.0f);
+    return std::max(roughness, std::sqrt(alpha));
+}
+
 float toksvigRoughness(float roughness, float normalLength) {
     float na = std::clamp(normalLength, 1e-4f, 1.0f);
     float alpha = ggxAlpha(roughness);

@@ -67,6 +67,9 @@ glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor,
 glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,
                            glm::vec3 intensity);
 float toksvigRoughness(float roughness, float normalLength);
+// The perceptual roughness at which a glossy lobe lit by a delta light spreads over `footprint` metres at a point
+// `distance` away (path-space regularisation for the lightmap bake; brdf.glsl's regularizedRoughness). 0: unchanged.
+float regularizedRoughness(float roughness, float footprint, float distance);
 
 // Split-sum environment BRDF by Karis' analytic fit ("mobile" approximation), as inlined in
 // shaders/lighting/deferred.comp: returns (a, b) with directional albedo ~= F0 a + b for the GGX

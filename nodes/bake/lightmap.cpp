@@ -37,7 +37,7 @@ using Clock = std::chrono::steady_clock;
 using gpu_types::LightmapBakePush;
 
 constexpr uint32_t kJobsPerRow = 4096;
-constexpr uint32_t kCpuBakeVersion = 1; // of traceOnCpu's integrator, in the cache key
+constexpr uint32_t kCpuBakeVersion = 2; // of traceOnCpu's integrator, in the cache key
 
 NodeSchema schema() {
     NodeSchema s;
@@ -104,6 +104,15 @@ NodeSchema schema() {
          {},
          "Random sequence of the paths: another seed bakes independently at the same quality (the spread between seeds "
          "is the bake's noise)"},
+        {"caustic_footprint",
+         ParamType::Float,
+         2.0,
+         0.0,
+         64.0,
+         {},
+         "Texels over which a glossy surface's reflection of the sun is spread (path-space regularisation: the "
+         "sun's caustic off the polished floor, found by one path in tens of thousands with 40x a texel's light, "
+         "keeps its energy but is blurred to this size; 0: exact and spiky, see the README)"},
         {"backend",
          ParamType::Enum,
          "gpu",
@@ -137,6 +146,7 @@ public:
         mSettings.skyScale = p.getFloat("sky_scale");
         mSettings.emissiveScale = p.getFloat("emissive_scale");
         mSettings.seed = static_cast<uint32_t>(p.getInt("seed"));
+        mSettings.causticFootprint = p.getFloat("caustic_footprint");
         mUseCache = p.getBool("cache");
         mBackend = p.getString("backend");
 
@@ -284,7 +294,8 @@ private:
             uint32_t done = 0;
             for (uint32_t d = 0; d < dispatches; ++d) {
                 LightmapBakePush push{};
-                push.scales = {mSettings.sunScale, mSettings.skyScale, mSettings.emissiveScale, 0.0f};
+                push.scales = {mSettings.sunScale, mSettings.skyScale, mSettings.emissiveScale,
+                               mSettings.causticFootprintMeters()};
                 const uint32_t count = std::min(perDispatch, mSettings.samples - done);
                 const uint32_t sequence = d + (mSettings.seed << 16u); // distinct for every dispatch (fewer than 65536) and seed
                 push.counts = {static_cast<uint32_t>(jobCount), count, sequence * 0x9E3779B9u + 0x7F4A7C15u, mSettings.maxBounces};
@@ -327,6 +338,7 @@ private:
         s.sunScale = mSettings.sunScale;
         s.skyScale = mSettings.skyScale;
         s.emissiveScale = mSettings.emissiveScale;
+        s.causticFootprint = mSettings.causticFootprintMeters();
         s.envSampling = false; // the bake has the sky's cube map, not its sampling table
         std::vector<std::atomic<uint32_t>> inside(jobCount);
         const size_t width = static_cast<size_t>(s.width);

@@ -797,8 +797,11 @@ struct CpuPathTracer::Impl {
         vec3 weight = p.throughput * s.cavity;
 
         if (lights.sun && glm::dot(ng, lights.sunDir) > 0.0f) {
-            vec3 f = brdfCosineSheen(n, s.coatNormal, v, lights.sunDir, s.baseColor, s.metallic, s.roughness,
-                                     s.dielectric, s.coat, s.sheen);
+            // The bake widens the lobes the sun is reflected by (regularizedRoughness); s.t: from the last vertex.
+            const float roughness = regularizedRoughness(s.roughness, st.causticFootprint, s.t);
+            const vec2 coat(s.coat.x, regularizedRoughness(s.coat.y, st.causticFootprint, s.t));
+            vec3 f = brdfCosineSheen(n, s.coatNormal, v, lights.sunDir, s.baseColor, s.metallic, roughness,
+                                     s.dielectric, coat, s.sheen);
             if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) &&
                 !occluded(offsetRay(s.position, ng, lights.sunDir), lights.sunDir, rays))
                 p.radiance += weight * f * lights.sunE;

@@ -37,6 +37,9 @@ struct CpuTraceSettings {
     float sunScale = 1.0f, skyScale = 1.0f, emissiveScale = 1.0f;
     bool antialias = true;
     bool envSampling = true;
+    // Metres over which the sun's reflection by a glossy lobe is spread (regularizedRoughness; the lightmap bake's
+    // caustic_footprint). 0, the path tracer's: exact.
+    float causticFootprint = 0.0f;
 };
 
 // Per-pixel accumulation, the layout of the node's outputs: color (mean rgb, 1) and stats (count, mean luminance,

@@ -7,7 +7,8 @@
 //   probe ray:  the radiance arriving along the ray's fixed direction.
 // What arrives is the sky, emitters, and light reflected by the scene, where every surface reflects
 // diffusely with its normal-incidence albedo (the bake's "albedo-only" material) and is lit by the sun
-// (next-event estimation with a shadow ray), the sky and other surfaces. The sun's direct light on the
+// (next-event estimation with a shadow ray), the sky and other surfaces; a glossy lobe the sun is reflected by is
+// widened to the caustic footprint (push.scales.w). The sun's direct light on the
 // texel or probe itself is left out: the frame draws it with its shadow maps. A ray that first meets the
 // back of a single-sided surface started inside geometry (a texel under a wall, a probe in a pillar): it
 // brings no light and is counted (w), so probes inside walls can be told apart.
@@ -61,10 +62,13 @@ vec3 incoming(vec3 origin, vec3 dir, inout uint rng, out bool inside) {
         addClearcoatLobe(lobes, s.coat, s.coatNormal, v);
         addSheenLobe(lobes, s.sheen, clamp(dot(n, v), 0.0, 1.0));
         vec3 weight = throughput * s.cavity;
+        // The sun's reflection by a glossy lobe is spread over push.scales.w metres where the path came from (its
+        // caustic, common/brdf.glsl's regularizedRoughness): hit.t is the distance from there.
         if (sun && dot(ng, sunDir) > 0.0 && !bvhTraceAny(offsetRay(s.position, ng, sunDir), sunDir, 0.0, kInfinity))
             radiance += weight * sunE *
-                        brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
-                                        s.coat, s.sheen);
+                        brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic,
+                                        regularizedRoughness(s.roughness, push.scales.w, hit.t), s.dielectric,
+                                        vec2(s.coat.x, regularizedRoughness(s.coat.y, push.scales.w, hit.t)), s.sheen);
         vec3 l;
         if (!sampleBrdf(lobes, n, v, vec3(rngNext(rng), rngNext(rng), rngNext(rng)), l) || dot(ng, l) <= 0.0) break;
         float pdf = brdfPdf(lobes, n, v, l);

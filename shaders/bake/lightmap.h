@@ -8,7 +8,7 @@ namespace vitrine::gpu_types {
 #endif
 
 VITRINE_PUSH_BEGIN(LightmapBakePush)
-    vec4 scales;  // x: sun, y: sky, z: emissive, w: 0
+    vec4 scales;  // x: sun, y: sky, z: emissive, w: caustic footprint (metres; 0: exact)
     uvec4 counts; // x: jobs, y: paths per job in this dispatch, z: seed of this dispatch, w: max bounces
     uvec4 grid;   // x: jobs per dispatch row, y: flags (LIGHTMAP_BAKE_*), zw: 0
 VITRINE_PUSH_END(push)

@@ -267,4 +267,17 @@ float toksvigRoughness(float roughness, float normalLength) {
     return sqrt(sqrt(alpha2));
 }
 
+// Path-space regularisation [Kaplanyan & Dachsbacher 2013] of a glossy lobe lit by a delta light (the sun), for
+// estimators that store their result at a finite resolution (the lightmap bake). A near-mirror lobe lit by the sun
+// is a caustic seen from the previous vertex of the path, `distance` away: found only by the rare directions that
+// land in the sun's tiny reflection, each with an enormous weight (one path in tens of thousands carries 40x a
+// texel's light). Widened so that the reflection spreads over `footprint` metres at the previous vertex (its
+// half-vector spread alpha widens the reflected lobe by about 2 alpha radians), the caustic keeps its energy and
+// its place to within the footprint, and its rare huge paths become many ordinary ones. footprint 0: unchanged.
+float regularizedRoughness(float roughness, float footprint, float distance) {
+    if (footprint <= 0.0) return roughness;
+    float alpha = min(footprint / (2.0 * max(distance, 1e-4)), 1.0);
+    return max(roughness, sqrt(alpha));
+}
+
 #endif

@@ -164,6 +164,31 @@ TEST(Brdf, ToksvigWidensTheLobeByTheNormalVariance) {
     EXPECT_NEAR(toksvigRoughness(0.0f, 0.01f), 1.0f, 0.05f);
 }
 
+// The bake's caustic footprint: a mirror's lobe for the sun widened so that half of the reflected sun lands within
+// `footprint` metres of the mirror image on a surface `distance` away (normal incidence: the reflection of a half
+// vector at theta_h turns by 2 theta_h, so it lands at distance tan(2 theta_h)), integrated here over GGX's own
+// distribution of half vectors (D cos theta_h, whose integral is 1).
+TEST(Brdf, RegularizedRoughnessLandsHalfTheSunsReflectionWithinTheFootprint) {
+    for (float distance : {1.0f, 4.0f, 12.0f})
+        for (float footprint : {0.05f, 0.25f}) {
+            const float alpha = ggxAlpha(regularizedRoughness(0.0f, footprint, distance));
+            const double thetaMax = 0.5 * std::atan(double(footprint) / distance);
+            const int steps = 20000;
+            double inside = 0.0;
+            for (int i = 0; i < steps; ++i) { // midpoint rule over theta_h, solid angle 2 pi sin
+                const double theta = (i + 0.5) / steps * thetaMax;
+                inside += ggxD(float(std::cos(theta)), alpha) * std::cos(theta) * 2.0 * 3.14159265358979 *
+                          std::sin(theta) * thetaMax / steps;
+            }
+            EXPECT_NEAR(inside, 0.5, 0.02) << "footprint " << footprint << " m at " << distance << " m";
+        }
+    // A lobe already wider keeps its roughness; footprint 0 changes nothing; the widening stops at roughness 1.
+    EXPECT_EQ(regularizedRoughness(0.7f, 0.25f, 4.0f), 0.7f);
+    EXPECT_EQ(regularizedRoughness(0.05f, 0.0f, 4.0f), 0.05f);
+    EXPECT_GT(regularizedRoughness(0.05f, 0.25f, 4.0f), 0.05f);
+    EXPECT_EQ(regularizedRoughness(0.05f, 10.0f, 0.01f), 1.0f);
+}
+
 } // namespace
 } // namespace vitrine::shading
 
