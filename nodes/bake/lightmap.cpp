@@ -115,14 +115,13 @@ NodeSchema schema() {
          "keeps its energy but is blurred to this size; 0: exact and spiky, see the README)"},
         {"backend",
          ParamType::Enum,
-         "gpu",
+         "auto",
          {},
          {},
          {"gpu", "cpu", "auto"},
          "Where the paths are traced: gpu (shaders/bake/lightmap.comp), cpu (render.pathtrace's CPU tracer through "
-         "Embree on every core: the same materials and BRDF, about 10x the paths per second of lavapipe, but a "
-         "heavier tail on the Museum's near pillar, see the README), auto: cpu when the Vulkan device is a CPU "
-         "(lavapipe), else gpu"},
+         "Embree on every core: the same materials and BRDF, about 10x the paths per second of lavapipe), auto: cpu "
+         "when the Vulkan device is a CPU (lavapipe), else gpu"},
         {"cache", ParamType::Bool, true, {}, {}, {}, "Load and store the bake in the bake cache (off: bake every run)"},
     };
     return s;
