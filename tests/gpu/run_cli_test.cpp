@@ -60,6 +60,26 @@ TEST(RunCli, FramesCountBeforeValidation) {
     EXPECT_TRUE(fs::exists(out / "frame.0002.exr")) << r.output;
 }
 
+// The device comes up on another thread while the graph compiles (a warm start's overlap): its errors still reach the
+// user as before, and a graph's own error is reported first, alone.
+TEST(RunCli, DeviceAndGraphErrorsSurviveTheOverlappedStart) {
+    const fs::path out = freshDir("run_device_errors");
+    CliResult unknownDevice = vitrine("run " + quote(kZoneplate) + " " + kTiny +
+                                      " --device no-such-gpu --quiet --out " + quote(out.string()));
+    EXPECT_EQ(unknownDevice.status, 1) << unknownDevice.output;
+    EXPECT_NE(unknownDevice.output.find("--device no-such-gpu: no such Vulkan device"), std::string::npos)
+        << unknownDevice.output;
+    CliResult both = vitrine("run " + quote(kSource + "/graphs/no_such_graph.json") +
+                             " --device no-such-gpu --quiet --out " + quote(out.string()));
+    EXPECT_EQ(both.status, 1) << both.output;
+    EXPECT_NE(both.output.find("no_such_graph.json: no such file"), std::string::npos) << both.output;
+    EXPECT_EQ(both.output.find("no such Vulkan device"), std::string::npos) << both.output;
+    CliResult fine =
+        vitrine("run " + quote(kZoneplate) + " " + kTiny + " --validate --quiet --out " + quote((out / "ok").string()));
+    EXPECT_EQ(fine.status, 0) << fine.output;
+    EXPECT_TRUE(fs::exists(out / "ok" / "final.png")) << fine.output;
+}
+
 TEST(CompareCli, FramesCountBeforeValidation) {
     const fs::path out = freshDir("compare_frames");
     CliResult r =

@@ -22,8 +22,10 @@
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 
 namespace vitrine::cli {
@@ -66,6 +68,11 @@ int runCommand(const Args& args) {
     const auto msSince = [](std::chrono::steady_clock::time_point t) {
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
     };
+    // The Vulkan instance and device come up on another core while the graph compiles (the scene build): neither
+    // needs the other, and each is a large part of the start (README "Caches"). A failure of either is reported
+    // when it is needed, the graph's first.
+    std::future<std::unique_ptr<Context>> pendingContext =
+        std::async(std::launch::async, [options = contextOptions(args)] { return std::make_unique<Context>(options); });
     CompiledGraph graph = compileFromArgs(args);
     const double compileMs = msSince(start);
     std::string exrMode = args.get("exr", "half");
@@ -76,7 +83,8 @@ int runCommand(const Args& args) {
     fs::path outDir = args.get("out", (fs::path("out") / stem).string());
     OutputDir out(outDir, args.has("overwrite") || args.has("force"));
 
-    Context ctx(contextOptions(args));
+    const std::unique_ptr<Context> context = pendingContext.get();
+    Context& ctx = *context;
     logInfo("device: " + ctx.deviceInfo().name + "; " + std::to_string(graph.passes.size()) + " passes, " +
             std::to_string(graph.desc.frame.width) + "x" + std::to_string(graph.desc.frame.height) + ", " +
             std::to_string(graph.desc.frame.frames) + " frame(s)");
