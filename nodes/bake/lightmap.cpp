@@ -483,7 +483,7 @@ private:
     bake::LightmapAtlas mAtlas;
     bake::IrradianceVolume mVolume;
     bool mUseCache = true;
-    std::string mBackend = "gpu";
+    std::string mBackend; // the `backend` param (gpu, cpu or auto), read in setup
     bool mUploaded = false;
     PipelineId mPipeline = 0;
 };

@@ -5,10 +5,10 @@
 // job's running sum:
 //   texel:      irradiance E = pi x radiance arriving along a cosine-distributed direction around the normal;
 //   probe ray:  the radiance arriving along the ray's fixed direction.
-// What arrives is the sky, emitters, and light reflected by the scene, where every surface reflects
-// diffusely with its normal-incidence albedo (the bake's "albedo-only" material) and is lit by the sun
-// (next-event estimation with a shadow ray), the sky and other surfaces; a glossy lobe the sun is reflected by is
-// widened to the caustic footprint (push.scales.w). The sun's direct light on the
+// What arrives is the sky, emitters, and light reflected by the scene, where every surface reflects with its
+// full material (common/brdf.glsl, as render.pathtrace's) and is lit by the sun (next-event estimation with a
+// shadow ray), the sky and other surfaces; a glossy lobe the sun is reflected by is widened to the caustic
+// footprint (push.scales.w). The sun's direct light on the
 // texel or probe itself is left out: the frame draws it with its shadow maps. A ray that first meets the
 // back of a single-sided surface started inside geometry (a texel under a wall, a probe in a pillar): it
 // brings no light and is counted (w), so probes inside walls can be told apart.
