@@ -1,5 +1,6 @@
 // vitrine: run, validate, inspect and benchmark render graphs headless.
 #include "core/base/error.hpp"
+#include "core/base/heap.hpp"
 #include "core/base/log.hpp"
 #include "tools/vitrine/cli.hpp"
 #include "tools/vitrine/version.hpp"
@@ -121,6 +122,16 @@ int main(int argc, char** argv) {
                                     {{"nodes", {"json"}}});
         if (args.has("quiet")) setLogLevel(LogLevel::Warning);
         if (args.has("verbose")) setLogLevel(LogLevel::Debug);
+        // Short runs keep freed memory and take huge pages (core/base/heap.hpp); the editor's long-lived server keeps
+        // glibc's defaults, which give memory back between requests.
+        if (args.command != "serve") {
+            const HeapPolicy heap = tuneHeapForLargeBlocks();
+            if (!heap.note.empty())
+                logDebug("heap: " + heap.note);
+            else
+                logDebug("heap: freed memory kept, " + std::to_string(heap.reserved >> 20) +
+                         " MiB reserved with huge pages");
+        }
         if (args.command.empty() || args.command == "help" || args.has("help")) {
             std::fputs(kUsage, args.command.empty() ? stderr : stdout);
             return args.command.empty() ? 1 : 0;
