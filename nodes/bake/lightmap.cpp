@@ -321,9 +321,8 @@ private:
     // per job, `samples` paths of CpuRays::radiance (sky, emitters, the sun and the sky by next-event estimation at
     // every surface, the full material) from the texel along a cosine-distributed direction (irradiance: pi L) or
     // from the probe along its ray (radiance L). A path whose first triangle is the back of a single-sided surface
-    // started inside geometry: it brings nothing and is counted, as on the GPU. Past the first surface the CPU
-    // tracer's rule holds (it passes through such backs, as render.pathtrace does) where the GPU integrator ends the
-    // path. Returns the GPU's sums: per job (sum of estimates rgb, paths inside), (sum of squared luminance, 0, 0, 0).
+    // started inside geometry: it brings nothing and is counted, as on the GPU. Past the first surface such backs are
+    // passed through, by both integrators and render.pathtrace (test BouncesPassThroughTheBackOfASingleSidedSurface). Returns the GPU's sums: per job (sum of estimates rgb, paths inside), (sum of squared luminance, 0, 0, 0).
     std::vector<glm::vec4> traceOnCpu(const std::vector<glm::vec4>& jobs, size_t jobCount, size_t texelJobs,
                                       const CpuSky& sky) const {
         const scene::Scene& scene = mScene->scene();

@@ -11,7 +11,9 @@
 // footprint (push.scales.w). The sun's direct light on the
 // texel or probe itself is left out: the frame draws it with its shadow maps. A ray that first meets the
 // back of a single-sided surface started inside geometry (a texel under a wall, a probe in a pillar): it
-// brings no light and is counted (w), so probes inside walls can be told apart.
+// brings no light and is counted (w), so probes inside walls can be told apart. Past the first surface such
+// backs are passed through (pathtrace/surface.glsl's pathTraceVisible), the rule of render.pathtrace and of the
+// CPU integrator.
 #define VITRINE_BVH_SET 1
 #define VITRINE_SCENE_SET 2
 #define VITRINE_GEOMETRY_SET 3
@@ -43,13 +45,16 @@ vec3 incoming(vec3 origin, vec3 dir, inout uint rng, out bool inside) {
     inside = false;
     vec3 radiance = vec3(0.0), throughput = vec3(1.0);
     for (uint bounce = 0u;; ++bounce) {
+        // The first ray asks whether the texel or probe is inside geometry (it sees the back of a single-sided
+        // surface: no light, counted); later rays pass through such backs, as render.pathtrace's do.
         BvhHit hit;
-        if (!bvhTraceClosest(origin, dir, 0.0, kInfinity, hit)) {
+        bool found = bounce == 0u ? bvhTraceClosest(origin, dir, 0.0, kInfinity, hit) : pathTraceVisible(origin, dir, hit);
+        if (!found) {
             radiance += throughput * textureLod(in_sky, dir, 0.0).rgb * push.scales.y;
             break;
         }
-        if (pathCulled(hit, dir)) {
-            inside = bounce == 0u;
+        if (bounce == 0u && pathCulled(hit, dir)) {
+            inside = true;
             break;
         }
         PathSurface s = pathSurface(hit, origin, dir);

@@ -61,6 +61,19 @@ bool pathCulled(BvhHit hit, vec3 direction) {
     return dot(cross(p1 - p0, p2 - p0), direction) > 0.0;
 }
 
+// The closest surface the rasteriser would draw: back faces of single-sided materials are passed through, as
+// gbuffer.layered culls them (shadow rays stop at either side, as shadow.directional draws both). The one rule of
+// render.pathtrace and of bake.lightmap's bounces, both integrators (the CPU one: pathtrace_cpu.cpp traceVisible).
+bool pathTraceVisible(vec3 origin, vec3 dir, out BvhHit hit) {
+    float tmin = 0.0;
+    for (int skip = 0; skip < 4; ++skip) {
+        if (!bvhTraceClosest(origin, dir, tmin, 3.4e38, hit)) return false;
+        if (!pathCulled(hit, dir)) return true;
+        tmin = hit.t;
+    }
+    return false;
+}
+
 PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
     GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];

@@ -33,18 +33,6 @@ vec3 offsetRay(vec3 p, vec3 ng, vec3 dir) {
     return p + ng * (dot(ng, dir) >= 0.0 ? scale : -scale);
 }
 
-// The closest surface the rasteriser would draw: back faces of single-sided materials are passed through, as
-// gbuffer.layered culls them (shadow rays stop at either side, as shadow.directional draws both).
-bool traceVisible(vec3 origin, vec3 dir, out BvhHit hit) {
-    float tmin = 0.0;
-    for (int skip = 0; skip < 4; ++skip) {
-        if (!bvhTraceClosest(origin, dir, tmin, kInfinity, hit)) return false;
-        if (!pathCulled(hit, dir)) return true;
-        tmin = hit.t;
-    }
-    return false;
-}
-
 vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     bool envSampling = (push.counts.w & PATHTRACE_ENV_CDF) != 0u && push.scales.y > 0.0;
     int envSize = textureSize(in_sky, 0).x;
@@ -58,7 +46,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     uint maxBounces = push.counts.y;
     for (uint bounce = 0u;; ++bounce) {
         BvhHit hit;
-        if (!traceVisible(origin, dir, hit)) {
+        if (!pathTraceVisible(origin, dir, hit)) {
             float w = bounce == 0u || !envSampling ? 1.0 : powerHeuristic(brdfPdfPrev, envPdf(in_env_cdf, envSize, dir));
             radiance += throughput * skyRadiance(dir) * w;
             break;

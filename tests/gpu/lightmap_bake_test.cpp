@@ -386,7 +386,8 @@ TEST_F(LightmapBake, SunGlintOffAMirrorIsSpreadOverTheCausticFootprint) {
 // the floor's irradiance after k bounces. Lambertian walls (specular strength 0) give pi Le sum rho^k exactly; the
 // default dielectric (GGX + Lambert) after one bounce pi Le (1 + A), A the cosine-weighted mean of the directional
 // albedo of core/shading's brdfCosine (the CPU mirror of brdf.glsl): the bake reflects with the path tracer's material.
-fs::path emissiveBox(const std::string& name, float Le, float base, float specular) {
+// panel: also a single-sided quad of the same material across half the box at mid-height (y = 0, z < 0), facing up.
+fs::path emissiveBox(const std::string& name, float Le, float base, float specular, bool panel = false) {
     SceneBuilder b(name);
     const uint32_t material = b.material("glow", glm::vec3(base), 0.0f, 0.0f);
     b.s.materials[material].specular = specular;
@@ -409,6 +410,11 @@ fs::path emissiveBox(const std::string& name, float Le, float base, float specul
     b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
     b.node("floor", static_cast<int32_t>(floorMesh));
     b.node("walls", static_cast<int32_t>(b.mesh("walls", walls, material)));
+    if (panel) {
+        std::vector<Tri> shelf;
+        addQuad(shelf, {0.0f, 0.0f, -half.z / 2}, {half.x, 0.0f, 0.0f}, {0.0f, 0.0f, half.z / 2}, {0.0f, 1.0f, 0.0f});
+        b.node("panel", static_cast<int32_t>(b.mesh("panel", shelf, material)));
+    }
     b.camera({0.0f, 0.0f, 0.0f}, {0.0f, -1.0f, 1.0f}, 0.9f);
     b.sun({0.3f, 1.0f, 0.2f});
     return b.write();
@@ -450,6 +456,23 @@ TEST_F(LightmapBake, ClosedEmissiveBoxFollowsTheGeometricSeries) {
         for (int k = 0; k <= bounces; ++k) series += std::pow(double(base), k);
         expectEmissiveBox(glb, bounces, kPi * scale * Le * series, scale);
     }
+}
+
+// One back-face rule for both integrators, render.pathtrace's: past a path's first surface, the back of a single-sided
+// triangle is passed through (the rasteriser culls it). The box above with a single-sided panel of the same material
+// across half of it, facing up: seen from below the panel is not there, seen from above it emits and reflects like
+// every wall, so radiance is still the same everywhere and the floor's irradiance is the same series. Paths that
+// bounce off a lower wall up into the panel's back must go on through it (ending them there darkens the floor);
+// a floor texel's own first ray into the panel's back starts "inside" and is left out, which in a uniform field
+// changes nothing either.
+TEST_F(LightmapBake, BouncesPassThroughTheBackOfASingleSidedSurface) {
+    const float Le = 100.0f, base = 0.5f;
+    const double scale = 2.0;
+    const fs::path glb = emissiveBox("bake_emissive_box_panel", Le, base, 0.0f, true);
+    const int bounces = 4;
+    double series = 0.0;
+    for (int k = 0; k <= bounces; ++k) series += std::pow(double(base), k);
+    expectEmissiveBox(glb, bounces, kPi * scale * Le * series, scale);
 }
 
 TEST_F(LightmapBake, BouncesReflectWithTheFullMaterial) {
