@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 
 namespace vitrine::test {
 namespace {
@@ -51,17 +52,37 @@ TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
             p[2] = static_cast<uint8_t>(e.z);
             p[3] = static_cast<uint8_t>((state >> 8) & 0xff); // junk: a normal texture's alpha means nothing
         }
-    // Alpha of level m: sqrt(1 - L), L the length of the mean of the unit normals of level 0 under the texel
-    // (the bytes' own lengths are rounding, not disagreement).
-    auto expectedAlpha = [&](uint32_t level, uint32_t x, uint32_t y) {
+    // Alpha of level m: sqrt(1 - L), L the agreement of the core of the normals under the texel (toksvig_mip.comp):
+    // a level-0 texel has L = 1 and its decoded normal's direction (the bytes' own lengths are rounding, not
+    // disagreement); a texel of level m+1 has the direction of the plain mean of the decoded normals under it and
+    // L = (the largest L of its four children) x |mean of the children's unit directions|.
+    struct Texel {
+        glm::dvec3 direction;
+        double agreement;
+    };
+    std::function<Texel(uint32_t, uint32_t, uint32_t)> texel = [&](uint32_t level, uint32_t x, uint32_t y) -> Texel {
+        if (level == 0) {
+            const uint8_t* p = img.at(x, y);
+            return {glm::normalize(glm::dvec3(p[0], p[1], p[2]) / 255.0 * 2.0 - 1.0), 1.0};
+        }
         glm::dvec3 sum(0.0);
         const uint32_t k = 1u << level;
         for (uint32_t j = 0; j < k; ++j)
             for (uint32_t i = 0; i < k; ++i) {
                 const uint8_t* p = img.at(x * k + i, y * k + j);
-                sum += glm::normalize(glm::dvec3(p[0], p[1], p[2]) / 255.0 * 2.0 - 1.0);
+                sum += glm::dvec3(p[0], p[1], p[2]) / 255.0 * 2.0 - 1.0;
             }
-        return std::sqrt(std::max(1.0 - glm::length(sum / double(k * k)), 0.0));
+        glm::dvec3 directions(0.0);
+        double core = 0.0;
+        for (uint32_t c = 0; c < 4; ++c) {
+            const Texel child = texel(level - 1, 2 * x + c % 2, 2 * y + c / 2);
+            directions += child.direction;
+            core = std::max(core, child.agreement);
+        }
+        return {glm::normalize(sum), core * glm::length(directions / 4.0)};
+    };
+    auto expectedAlpha = [&](uint32_t level, uint32_t x, uint32_t y) {
+        return std::sqrt(std::max(1.0 - texel(level, x, y).agreement, 0.0));
     };
     s.images.push_back(img);
     sc::Texture tex;
@@ -130,7 +151,7 @@ TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
         below = std::move(bytes);
     }
     std::printf("toksvig mips: max deviation from the 2x2 byte mean %.3f (ties: 0.5), mean |n| of level 1 %.4f; alpha: "
-                "worst %.2f of 255 from sqrt(1 - |mean unit normal|) (mean %.3f), level 0 must be 0\n",
+                "worst %.2f of 255 from sqrt(1 - L of the core) (mean %.3f), level 0 must be 0\n",
                 worst, meanLength, worstAlpha, meanAlpha);
     EXPECT_LE(worst, 0.5 + 1e-6);
     // Alpha is rounded once per level from the level below (rounded directions and alphas): measured 0.9 here.
@@ -138,6 +159,74 @@ TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
     EXPECT_GT(meanAlpha, 0.3); // the levels really disagree
     // ±45° columns average to ~cos 45°: not renormalised.
     EXPECT_NEAR(meanLength, 0.71, 0.03);
+}
+
+// A flat normal map with one narrow V-groove (columns 4 and 5 tilted 45° to either side, the museum floor's grout in
+// miniature). Where the groove is resolved (level 1: the texel holding both columns) its disagreement counts:
+// |mean| = cos 45°, alpha = sqrt(1 - 0.707) = 0.54. Above that the groove's texel points straight up like its
+// flat siblings, so the core agrees (alpha 0), where plain Toksvig (the mean of all the unit normals under the
+// texel) would still read 1 - L = 0.073 on level 2 (alpha 0.27) and 0.018 on level 4: a lobe widened over the whole
+// footprint by a few steep texels.
+TEST_F(SceneGpu, NormalMapMipsKeepTheCoresSpreadNotAGroovesAbove) {
+    const uint32_t n = 16;
+    sc::Scene s;
+    s.name = "toksvig_groove";
+    sc::TextureImage img;
+    img.name = "groove";
+    img.width = img.height = n;
+    img.pixels.resize(n * n * 4);
+    for (uint32_t y = 0; y < n; ++y)
+        for (uint32_t x = 0; x < n; ++x) {
+            const double sx = x == 4 ? -1.0 : x == 5 ? 1.0 : 0.0;
+            const glm::dvec3 e = glm::round((glm::normalize(glm::dvec3(sx, 0.0, 1.0)) * 0.5 + 0.5) * 255.0);
+            uint8_t* p = img.at(x, y);
+            p[0] = static_cast<uint8_t>(e.x);
+            p[1] = static_cast<uint8_t>(e.y);
+            p[2] = static_cast<uint8_t>(e.z);
+            p[3] = 255;
+        }
+    s.images.push_back(img);
+    sc::Texture tex;
+    tex.name = "groove";
+    tex.usage = sc::TextureUsage::Normal;
+    s.textures.push_back(tex);
+    sc::Material m;
+    m.name = "grooved";
+    m.layers.resize(1);
+    m.layers[0].normal.texture.texture = 0;
+    s.materials.push_back(m);
+    for (int i = 0; i < 3; ++i) {
+        sc::Vertex v;
+        v.position = glm::vec3(i == 1, i == 2, 0);
+        v.normal = {0, 0, 1};
+        s.vertices.push_back(v);
+        s.indices.push_back(static_cast<uint32_t>(i));
+    }
+    s.primitives.push_back({0, 3, 0, 3, 0, {}});
+    s.meshes.push_back({"tri", 0, 1, {}});
+    sc::Node node;
+    node.name = "tri";
+    node.mesh = 0;
+    s.nodes.push_back(node);
+    s.finalize();
+    s.validate();
+
+    ShaderCompiler shaders;
+    GpuScene gpuScene(gpu(), shaders, s);
+    const GpuImage& image = gpuScene.texture(0);
+    ASSERT_EQ(image.desc().mipLevels, 5u);
+    const Image level1 = readImage(gpu(), image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 1);
+    const double grooveAlpha = std::sqrt(1.0 - std::sqrt(0.5));
+    for (uint32_t y = 0; y < n / 2; ++y)
+        for (uint32_t x = 0; x < n / 2; ++x)
+            EXPECT_NEAR(level1.at(x, y)[3], x == 2 ? grooveAlpha : 0.0, 1.5 / 255.0)
+                << "level 1, texel " << x << ", " << y;
+    for (uint32_t level = 2; level < 5; ++level) {
+        const Image got = readImage(gpu(), image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, level);
+        for (int y = 0; y < got.height; ++y)
+            for (int x = 0; x < got.width; ++x)
+                EXPECT_LE(got.at(x, y)[3], 1.5 / 255.0) << "level " << level << ", texel " << x << ", " << y;
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
