@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
@@ -216,6 +217,25 @@ CompiledShader ShaderCompiler::compileSource(const std::string& name, const std:
         fs::rename(tmpSpv, spvPath, ec);
     }
     return result;
+}
+
+uint64_t ShaderCompiler::treeHash() const {
+    if (mTreeHash) return *mTreeHash;
+    std::vector<std::string> files;
+    std::error_code ec;
+    for (fs::recursive_directory_iterator it(mRoot, ec), end; !ec && it != end; it.increment(ec))
+        if (it->is_regular_file()) files.push_back(fs::relative(it->path(), mRoot).generic_string());
+    std::sort(files.begin(), files.end()); // directory order is the file system's
+    uint64_t h = fnv1a(std::to_string(files.size()));
+    for (const std::string& f : files) {
+        std::ifstream in(mRoot / f, std::ios::binary);
+        std::ostringstream bytes;
+        bytes << in.rdbuf();
+        h = fnv1a(f + '\0' + std::to_string(bytes.str().size()) + '\0', h);
+        h = fnv1a(bytes.str(), h);
+    }
+    mTreeHash = h;
+    return h;
 }
 
 } // namespace vitrine

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -60,12 +61,18 @@ public:
     uint32_t cacheHits() const { return mHits; }
     uint32_t cacheMisses() const { return mMisses; }
 
+    // A hash of every regular file under root() (its path relative to the root and its bytes), read once per
+    // compiler. For results cached on disk that come out of whole graphs of shaders, such as ibl.capture's probes
+    // (rendered by the G-buffer, lighting and scene shaders): any shader edit gives them another key.
+    uint64_t treeHash() const;
+
 private:
     std::filesystem::path mRoot;
     std::filesystem::path mCacheDir;
     bool mUseCache;
     uint32_t mHits = 0;
     uint32_t mMisses = 0;
+    mutable std::optional<uint64_t> mTreeHash;
 };
 
 VkShaderStageFlagBits stageFromPath(const std::string& path);

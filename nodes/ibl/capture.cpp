@@ -260,7 +260,7 @@ public:
             inputs->volume = readImage(ctx.gpu(), ctx.input("volume"), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
             inputs->baked = mBaked;
         }
-        const BakeKey key = cacheKey(ctx.params(), *inputs);
+        const BakeKey key = cacheKey(ctx.params(), *inputs, ctx.shaders().treeHash());
         const BakeCache cache(defaultCacheDir());
         const scene::Scene& scene = mScene->scene();
 
@@ -299,10 +299,13 @@ public:
     }
 
 private:
-    BakeKey cacheKey(const Params& p, const CaptureInputs& in) const {
+    // shaderTree: ShaderCompiler::treeHash(). The capture renders through gbuffer.layered, lighting.deferred and the
+    // scene's shaders (the Toksvig mips among them), so an edit to any shader is another capture.
+    BakeKey cacheKey(const Params& p, const CaptureInputs& in, uint64_t shaderTree) const {
         scene::Hasher h;
         h.string("probes");
         h.value(kCacheVersion);
+        h.value(shaderTree);
         h.value(in.scene->contentHash());
         h.value(in.time);
         for (const Image& f : in.sky) h.array(f.pixels);

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -404,6 +405,21 @@ TEST_F(IblCapture, DeterministicAndCachedByScenePlacementAndSun) {
     const Capture sky = runCapture(captureGraph("cached_box", hazy, params));
     EXPECT_EQ(files().size(), 4u) << "another sky must not reuse the capture";
     EXPECT_NE(sky.mips[0][2].pixels, sun.mips[0][2].pixels);
+
+    // The capture renders through the G-buffer, lighting and scene shaders: a shader tree with one file edited (a
+    // comment added to the Toksvig mip shader) must not reuse it, the same tree again must.
+    const fs::path tree = fs::path(VITRINE_TEST_OUT) / "ibl_capture_shaders";
+    fs::remove_all(tree);
+    fs::copy(defaultShaderDir(), tree, fs::copy_options::recursive);
+    {
+        std::ofstream edit(tree / "scene" / "toksvig_mip.comp", std::ios::app);
+        edit << "\n// an edit\n";
+    }
+    ScopedEnv shaderDir("VITRINE_SHADER_DIR", tree.string());
+    expectSame(runCapture(captureGraph("cached_box", hazy, params)), sky);
+    EXPECT_EQ(files().size(), 5u) << "a capture by other shaders must not reuse the cached one";
+    runCapture(captureGraph("cached_box", hazy, params));
+    EXPECT_EQ(files().size(), 5u) << "the same shaders must reuse it";
 }
 
 } // namespace
