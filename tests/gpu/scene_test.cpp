@@ -28,12 +28,43 @@ class SceneGpu : public GpuTest {};
 // ---------------------------------------------------------------------------------------------
 // Toksvig mips, read back from the uploaded texture
 
+// A finalized scene of one triangle whose material's only layer is normal-mapped by `image` (a TextureUsage::Normal
+// texture, so GpuScene builds its Toksvig mip chain).
+sc::Scene sceneWithNormalMap(const std::string& name, const sc::TextureImage& image) {
+    sc::Scene s;
+    s.name = name;
+    s.images.push_back(image);
+    sc::Texture tex;
+    tex.name = image.name;
+    tex.usage = sc::TextureUsage::Normal;
+    s.textures.push_back(tex);
+    sc::Material m;
+    m.name = "normal_mapped";
+    m.layers.resize(1);
+    m.layers[0].normal.texture.texture = 0;
+    s.materials.push_back(m);
+    for (int i = 0; i < 3; ++i) {
+        sc::Vertex v;
+        v.position = glm::vec3(i == 1, i == 2, 0);
+        v.normal = {0, 0, 1};
+        s.vertices.push_back(v);
+        s.indices.push_back(static_cast<uint32_t>(i));
+    }
+    s.primitives.push_back({0, 3, 0, 3, 0, {}});
+    s.meshes.push_back({"tri", 0, 1, {}});
+    sc::Node node;
+    node.name = "tri";
+    node.mesh = 0;
+    s.nodes.push_back(node);
+    s.finalize();
+    s.validate();
+    return s;
+}
+
 TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
     // 16x16 normal map: columns alternate ±45° about +Y, with an irregular y tilt per texel, so the
     // 2x2 footprints differ and the averages are clearly shorter than 1.
     const uint32_t n = 16;
-    sc::Scene s;
-    s.name = "toksvig_mips";
     sc::TextureImage img;
     img.name = "ridges";
     img.width = img.height = n;
@@ -84,32 +115,7 @@ TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
     auto expectedAlpha = [&](uint32_t level, uint32_t x, uint32_t y) {
         return std::sqrt(std::max(1.0 - texel(level, x, y).agreement, 0.0));
     };
-    s.images.push_back(img);
-    sc::Texture tex;
-    tex.name = "ridges";
-    tex.usage = sc::TextureUsage::Normal;
-    s.textures.push_back(tex);
-    sc::Material m;
-    m.name = "normal_mapped";
-    m.layers.resize(1);
-    m.layers[0].normal.texture.texture = 0;
-    s.materials.push_back(m);
-    // One triangle using it, so the scene is a real one.
-    for (int i = 0; i < 3; ++i) {
-        sc::Vertex v;
-        v.position = glm::vec3(i == 1, i == 2, 0);
-        v.normal = {0, 0, 1};
-        s.vertices.push_back(v);
-        s.indices.push_back(static_cast<uint32_t>(i));
-    }
-    s.primitives.push_back({0, 3, 0, 3, 0, {}});
-    s.meshes.push_back({"tri", 0, 1, {}});
-    sc::Node node;
-    node.name = "tri";
-    node.mesh = 0;
-    s.nodes.push_back(node);
-    s.finalize();
-    s.validate();
+    const sc::Scene s = sceneWithNormalMap("toksvig_mips", img);
 
     ShaderCompiler shaders;
     GpuScene gpuScene(gpu(), shaders, s);
@@ -169,8 +175,6 @@ TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
 // footprint by a few steep texels.
 TEST_F(SceneGpu, NormalMapMipsKeepTheCoresSpreadNotAGroovesAbove) {
     const uint32_t n = 16;
-    sc::Scene s;
-    s.name = "toksvig_groove";
     sc::TextureImage img;
     img.name = "groove";
     img.width = img.height = n;
@@ -185,31 +189,7 @@ TEST_F(SceneGpu, NormalMapMipsKeepTheCoresSpreadNotAGroovesAbove) {
             p[2] = static_cast<uint8_t>(e.z);
             p[3] = 255;
         }
-    s.images.push_back(img);
-    sc::Texture tex;
-    tex.name = "groove";
-    tex.usage = sc::TextureUsage::Normal;
-    s.textures.push_back(tex);
-    sc::Material m;
-    m.name = "grooved";
-    m.layers.resize(1);
-    m.layers[0].normal.texture.texture = 0;
-    s.materials.push_back(m);
-    for (int i = 0; i < 3; ++i) {
-        sc::Vertex v;
-        v.position = glm::vec3(i == 1, i == 2, 0);
-        v.normal = {0, 0, 1};
-        s.vertices.push_back(v);
-        s.indices.push_back(static_cast<uint32_t>(i));
-    }
-    s.primitives.push_back({0, 3, 0, 3, 0, {}});
-    s.meshes.push_back({"tri", 0, 1, {}});
-    sc::Node node;
-    node.name = "tri";
-    node.mesh = 0;
-    s.nodes.push_back(node);
-    s.finalize();
-    s.validate();
+    const sc::Scene s = sceneWithNormalMap("toksvig_groove", img);
 
     ShaderCompiler shaders;
     GpuScene gpuScene(gpu(), shaders, s);
