@@ -9,17 +9,20 @@ namespace {
 NodeSchema schema() {
     NodeSchema s;
     s.type = "ssr.composite";
-    s.doc = "Blends the environment's indirect specular with SSR by the SSR confidence c and writes the final "
-            "colour: color - I + mix(I, E L_ssr vertexAO cavity, c), where I is lighting.deferred's "
-            "specular_indirect and E the same split-sum environment BRDF that weighs I (shaders/lighting/"
-            "ambient.glsl). The reflection is upsampled bilinearly.";
+    s.doc =
+        "Blends the environment's indirect specular with SSR by the SSR confidence c and writes the final "
+        "colour: color - I + mix(I, E L_ssr vertexAO cavity, c), where I is lighting.deferred's "
+        "specular_indirect and E the same split-sum environment BRDF that weighs I (shaders/lighting/"
+        "ambient.glsl). The reflection is premultiplied (c L_ssr, c) and upsampled bilinearly, so pixels that found "
+        "nothing lower the confidence of their neighbours' mix without darkening it.";
     auto tex = [](const char* name, const char* doc) {
         return InputPort{name, PortKind::Texture, {}, false, Usage::Sampled, doc};
     };
     s.inputs = {
         tex("color", "Lit HDR colour that includes specular_indirect (lighting.color)"),
         tex("specular_indirect", "The environment's indirect specular inside color (lighting.specular_indirect)"),
-        tex("reflection", "ssr.hiz's reflection (or its temporal accumulation): rgb radiance, a confidence"),
+        tex("reflection",
+            "ssr.hiz's reflection (or its temporal accumulation): rgb radiance x confidence, a confidence"),
         tex("normal", "G-buffer: octahedral normal, view depth, shininess"),
         tex("base_color", "G-buffer: base colour, metallic"),
         tex("material", "G-buffer: alpha, 1 − specular strength, vertex AO, cavity"),

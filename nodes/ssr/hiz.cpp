@@ -38,8 +38,9 @@ NodeSchema schema() {
     out.name = "reflection";
     out.format = VK_FORMAT_R16G16B16A16_SFLOAT;
     out.size = SizeRule::ofInput("normal", 0.5f);
-    out.doc = "rgb: reflected radiance (the mean of the rays that hit, before the BRDF); a: confidence 0..1 (the "
-              "mean over the rays; 0 where nothing was found)";
+    out.doc = "Premultiplied: rgb = reflected radiance (the confidence-weighted mean of the rays that hit, before the "
+              "BRDF) x a; a = confidence 0..1 (the mean over the rays; 0 where nothing was found). Premultiplied so "
+              "that temporal.accumulate's mean and ssr.composite's bilinear upsampling are linear";
     s.outputs = {out};
     s.params = {
         {"resolution_scale", ParamType::Float, 0.5, 0.125, 1.0, {}, "Output size relative to the G-buffer"},

@@ -7,9 +7,11 @@
 
 // SSR composite (MUSEUM_SPEC §5 step 3): the lit colour carries the indirect specular I = E(f0, roughness, NoV)
 // L_env occlusion (lighting.deferred's specular_indirect, E the split-sum environment BRDF); SSR brings the
-// reflected radiance L_ssr with a confidence c. The same BRDF factor weighs it, with the surface's own
-// micro-occlusion (vertex AO, cavity; not the sky stand-in's, SSR sees the real surroundings):
-//   S = E L_ssr vertexAo cavity,   final = color - I + mix(I, S, c).
+// reflected radiance L_ssr with a confidence c, premultiplied (ssr.hiz writes (c L_ssr, c), so its bilinear
+// upsampling here and the temporal mean before are linear, and a neighbour that found nothing does not darken L_ssr).
+// The same BRDF factor weighs it, with the surface's own micro-occlusion (vertex AO, cavity; not the sky stand-in's,
+// SSR sees the real surroundings):
+//   S = E L_ssr vertexAo cavity,   final = color - I + mix(I, S, c) = color - I + I (1 - c) + E (c L_ssr) vertexAo cavity.
 // The term that replaced I, mix(I, S, c), is written alone too (specular_indirect: the twin of reference.reflections).
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_color;
@@ -49,9 +51,9 @@ void main() {
     vec3 brdf = environmentBrdfF90(specularF0With(g1.rgb, g1.a, 0.04, dielectric), specularF90(g1.a, dielectric),
                                    roughnessFromShininess(g0.w), NoV);
     vec3 indirect = texelFetch(in_specular_indirect, p, 0).rgb;
-    vec3 reflected = brdf * ssr.rgb * (g2.z * g2.w);
-    vec3 final = color.rgb - indirect + mix(indirect, reflected, clamp(ssr.a, 0.0, 1.0));
-    vec3 specular = mix(indirect, reflected, clamp(ssr.a, 0.0, 1.0)); // the term alone
+    float c = clamp(ssr.a, 0.0, 1.0);
+    vec3 specular = indirect * (1.0 - c) + brdf * ssr.rgb * (g2.z * g2.w); // the term alone
+    vec3 final = color.rgb - indirect + specular;
     imageStore(out_specular_indirect, p, vec4(min(max(specular, vec3(0.0)), vec3(kHalfMax)), 1.0));
     imageStore(out_color, p, vec4(min(max(final, vec3(0.0)), vec3(kHalfMax)), color.a));
 }

@@ -11,7 +11,10 @@
 // min/max Hi-Z pyramid in screen space (x, y in pixels, reverse-Z depth: a straight line there) with at most
 // max_taps fetches; at the hit the colour pyramid is read at the level of the ray's cone footprint. The
 // confidence of a hit is the product of a screen-edge fade, a back-face test, a thickness test and a ray-length
-// fade; a ray that leaves the screen, runs out of taps or misses has none. No spatial filter.
+// fade; a ray that leaves the screen, runs out of taps or misses has none. No spatial filter. The output is
+// premultiplied, (radiance x confidence, confidence), so that whatever filters it next (the temporal accumulation's
+// running mean, the composite's bilinear upsampling) is linear: a pixel that found nothing is (0, 0) and lowers the
+// confidence of its neighbours' mix without darkening its colour.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_normal;
 layout(binding = 1) uniform sampler2D in_depth;
@@ -212,6 +215,8 @@ void main() {
         radiance += hit.rgb * hit.a;
         confidence += hit.a;
     }
-    radiance = confidence > 0.0 ? radiance / confidence : vec3(0.0);
-    imageStore(out_reflection, q, vec4(min(radiance, vec3(60000.0)), confidence / float(rays) * roughnessFade));
+    // The rays' confidence-weighted mean radiance, times the pixel's confidence (their mean, faded by roughness).
+    float c = confidence / float(rays) * roughnessFade;
+    radiance = confidence > 0.0 ? min(radiance / confidence, vec3(60000.0)) * c : vec3(0.0);
+    imageStore(out_reflection, q, vec4(radiance, c));
 }

@@ -65,6 +65,18 @@ void main() {
 }
 )";
 
+// One colour everywhere (every pyramid level the same): whatever a ray hits, it reads kUniformColour.
+const char* kUniformSource = R"(#version 460
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) writeonly uniform image2D out_result;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(p, imageSize(out_result)))) return;
+    imageStore(out_result, p, vec4(400.0, 800.0, 1600.0, 1.0));
+}
+)";
+constexpr glm::dvec3 kUniformColour(400.0, 800.0, 1600.0); // as bright as the floor's environment term
+
 class FrameSource final : public Node {
 public:
     FrameSource(const char* name, const char* source) : mName(name), mSource(source) {}
@@ -97,6 +109,8 @@ const NodeRegistration kNoise(frameSourceSchema("test.ssr_noise"),
                               [] { return std::make_unique<FrameSource>("test/ssr_noise", kNoiseSource); });
 const NodeRegistration kChecker(frameSourceSchema("test.ssr_checker"),
                                 [] { return std::make_unique<FrameSource>("test/ssr_checker", kCheckerSource); });
+const NodeRegistration kUniform(frameSourceSchema("test.ssr_uniform"),
+                                [] { return std::make_unique<FrameSource>("test/ssr_uniform", kUniformSource); });
 const NodeRegistration kCoords(frameSourceSchema("test.ssr_coords"),
                                [] { return std::make_unique<FrameSource>("test/ssr_coords", kCoordsSource); });
 
@@ -317,6 +331,14 @@ json ssrNodes(const std::filesystem::path& glb, json params, const char* source 
     return n;
 }
 
+// ssr.hiz writes premultiplied (radiance x confidence, confidence): what its rays read at a pixel is rgb / a, and its
+// confidence a.
+glm::dvec4 reflectionRead(const Image& ssr, int x, int y) {
+    const float* p = ssr.at(x, y);
+    const double a = p[3];
+    return a > 0.0 ? glm::dvec4(p[0] / a, p[1] / a, p[2] / a, a) : glm::dvec4(0.0);
+}
+
 // --- A mirror floor under a wall, a pillar and a plate -------------------------------------------------------
 
 enum class Hit { None, Floor, Wall, Pillar, Plate };
@@ -477,7 +499,7 @@ TEST_F(Ssr, MirrorFloorReflectsTheAnalyticMirrorTexel) {
             glm::dvec3 p = m.cam->position + t * d;
             glm::dvec3 r(d.x, -d.y, d.z);
             auto [tr, hit] = m.trace(p, r);
-            const float* got = ssr.at(x, y);
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
             glm::dvec3 end = p + r * std::min(tr, kMaxDistance);
             MirrorScene::Path path = m.classify(p, end, 2.0 * kThickness + 0.05);
             if (path == MirrorScene::Path::Ambiguous) {
@@ -609,7 +631,7 @@ TEST_F(Ssr, RefinedHitsLieOnTheMirrorImage) {
             const glm::dvec2 uv(s.x / W, s.y / H);
             if (std::min({uv.x, uv.y, 1.0 - uv.x, 1.0 - uv.y}) < kEdgeFade) continue; // before the edge fade
             if (std::hypot(s.x - (x + 0.5), s.y - (y + 0.5)) < 3.0) continue; // the wall's foot: below what the march resolves
-            const float* got = ssr.at(x, y);
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
             if (got[3] < 0.5f) {
                 ++missed;
                 continue;
@@ -696,7 +718,7 @@ TEST_F(Ssr, ThicknessFadesHitsFoundBehindTheSurface) {
             // its path), inside B's slab as it enters B's pixels.
             if (gA < thickness + 0.02 || g < 0.04 || g > thickness - 0.04) continue;
             const double expected = std::clamp(2.0 - 2.0 * g / thickness, 0.0, 1.0);
-            const float* got = ssr.at(x, y);
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
             ++checked;
             if (expected < 0.95) ++faded;
             const double err = std::abs(got[3] - expected);
@@ -728,8 +750,10 @@ TEST_F(Ssr, TapLimitBoundsTheMarch) {
     double farthest = 0.0;
     for (int y = 0; y < MirrorScene::H; ++y)
         for (int x = 0; x < MirrorScene::W; ++x) {
-            const float* got = ssr.at(x, y);
-            if (got[3] <= 0.0f) continue;
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
+            // Premultiplied half floats: below a confidence of 1e-3 (a read that weighs < 0.1 %) rgb / a is no position
+            // (at the smallest subnormal, 6e-8, it is a few pixels off).
+            if (got[3] < 1e-3) continue;
             ++hits;
             farthest = std::max(farthest, std::hypot(got[0] - (x + 0.5), got[1] - (y + 0.5)));
         }
@@ -737,10 +761,31 @@ TEST_F(Ssr, TapLimitBoundsTheMarch) {
     EXPECT_LE(farthest, 8.0);
 }
 
+// The walk spends its fetches well: where a cell's depth slab stops the ray, it moves to where the ray enters the slab
+// before going one level finer, rather than descending from the cell's entry. On the mirror floor, 16 fetches (the
+// Museum's budget until 2026-12) find 60 % of the confident hits (>= 0.5) that 64 find; descending from the cell's
+// entry they found 41 %.
+TEST_F(Ssr, TheMarchAdvancesToTheSlabBeforeDescending) {
+    MirrorScene m;
+    auto confident = [&](int taps) {
+        auto out =
+            runGraph(graph(m.nodes(mirrorParams(taps)), {{"ssr", "ssr.reflection"}}, MirrorScene::W, MirrorScene::H));
+        int n = 0;
+        for (int y = 0; y < MirrorScene::H; ++y)
+            for (int x = 0; x < MirrorScene::W; ++x)
+                if (out.at("ssr").at(x, y)[3] >= 0.5f) ++n;
+        return n;
+    };
+    const int few = confident(16), many = confident(64);
+    std::printf("march: %d confident hits with 16 taps, %d with 64 (%.2f)\n", few, many, double(few) / many);
+    EXPECT_GT(many, 3000);
+    EXPECT_GE(few, 0.55 * many);
+}
+
 // ssr.composite on a lit glossy floor (roughness 0.15, cavity 0.8, vertex AO 0.5..1) with SSR at half
 // resolution: every pixel against the blend evaluated on the CPU from the read-back inputs, with Karis' environment
-// BRDF from core/shading and the half-resolution reflection upsampled bilinearly (clamped at the edges); its
-// specular_indirect output against the blended term alone.
+// BRDF from core/shading and the half-resolution (premultiplied) reflection upsampled bilinearly (clamped at the
+// edges); its specular_indirect output against the blended term alone.
 TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
     MirrorScene m(0.85f, 0.8f, true);
     const int W = MirrorScene::W, H = MirrorScene::H;
@@ -801,11 +846,12 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
             glm::vec2 ab = shading::envBrdfApprox(NoV, shading::roughnessFromShininess(g0[3]));
             glm::dvec3 f0 = shading::specularF0({g1[0], g1[1], g1[2]}, g1[3]);
             glm::dvec3 e = f0 * double(ab.x) + double(ab.y);
-            glm::dvec3 reflected = e * glm::dvec3(r) * double(g2[2] * g2[3]);
+            // r is premultiplied (c L_ssr, c): the bilinear mix of the four texels is c L_ssr of the mix.
+            glm::dvec3 reflectedTimesC = e * glm::dvec3(r) * double(g2[2] * g2[3]);
             double c = std::clamp(r.w, 0.0, 1.0);
-            glm::dvec3 expected = glm::max(color - spec + spec * (1.0 - c) + reflected * c, glm::dvec3(0.0));
+            glm::dvec3 expected = glm::max(color - spec + spec * (1.0 - c) + reflectedTimesC, glm::dvec3(0.0));
             // Its specular_indirect output: the blended term alone (what reference.reflections is compared with).
-            const glm::dvec3 term = spec * (1.0 - c) + reflected * c, gotTerm = rgb(out.at("final_specular"), x, y);
+            const glm::dvec3 term = spec * (1.0 - c) + reflectedTimesC, gotTerm = rgb(out.at("final_specular"), x, y);
             for (int k = 0; k < 3; ++k)
                 EXPECT_LT(std::abs(gotTerm[k] - term[k]), 4e-3 * std::abs(term[k]) + 1e-3 * std::abs(color[k]) + 1e-6)
                     << "specular_indirect, pixel " << x << "," << y << " channel " << k;
@@ -824,6 +870,104 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
     EXPECT_GT(blended, 100);
 }
 
+// Pixels that found nothing must not darken the reflection of those that did. A glossy floor (roughness 0.15: one
+// GGX ray per pixel, a new one each frame) reflects a world of one colour C (the pyramid is uniform), so every hit
+// reads C and the rays that leave the screen or the wall find nothing: hits and misses mix at half resolution, in
+// the temporal mean of 4 frames and in the composite's bilinear upsampling. Whatever that mix's confidence c, the
+// reflection it blends in is C: every floor pixel's specular_indirect must be I (1 - c) + E C vertexAO cavity c, with
+// c the bilinear mix of the accumulated confidences and E Karis' environment BRDF from core/shading. (Filtering
+// radiance and confidence apart, as before 2026-12-05, gave C times the share of hits in the mix: up to 100 % too
+// dark at the border of a miss, and "+"-shaped dark rings across the Museum's floor.)
+TEST_F(Ssr, MissesDoNotDarkenTheReflectionOfTheHits) {
+    MirrorScene m(0.85f, 0.8f, true);
+    const int W = MirrorScene::W, H = MirrorScene::H;
+    json nodes = m.nodes({{"resolution_scale", 0.5},
+                          {"max_taps", 64},
+                          {"thickness", kThickness},
+                          {"max_distance", kMaxDistance},
+                          {"edge_fade", kEdgeFade}},
+                         "test.ssr_uniform");
+    nodes["lighting"] = lightingNode(json::object(), false);
+    nodes["accumulate"] = {{"type", "temporal.accumulate"},
+                           {"in",
+                            {{"color", "ssr.reflection"},
+                             {"history", "accumulate.color@prev"},
+                             {"history_samples", "accumulate.samples@prev"}}}};
+    nodes["composite"] = {{"type", "ssr.composite"},
+                          {"in",
+                           {{"color", "lighting.color"},
+                            {"specular_indirect", "lighting.specular_indirect"},
+                            {"reflection", "accumulate.color"},
+                            {"normal", "gbuffer.normal"},
+                            {"base_color", "gbuffer.base_color"},
+                            {"material", "gbuffer.material"},
+                            {"depth", "gbuffer.depth"},
+                            {"camera", "scene.camera"}}}};
+    json g = graph(nodes,
+                   {{"color", "lighting.color"},
+                    {"spec", "lighting.specular_indirect"},
+                    {"ssr", "accumulate.color"},
+                    {"normal", "gbuffer.normal"},
+                    {"base", "gbuffer.base_color"},
+                    {"material", "gbuffer.material"},
+                    {"term", "composite.specular_indirect"}},
+                   W, H);
+    g["frame"]["frames"] = 4;
+    auto out = runGraph(g);
+    const Image& ssr = out.at("ssr");
+    ASSERT_EQ(ssr.width, W / 2);
+    auto confidence = [&](int x, int y) {
+        return double(ssr.at(std::clamp(x, 0, ssr.width - 1), std::clamp(y, 0, ssr.height - 1))[3]);
+    };
+    int checked = 0, beside = 0, wrong = 0;
+    double worst = 0.0, darkest = 1.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float* g0 = out.at("normal").at(x, y);
+            if (g0[2] <= 0.0f || m.trace(m.cam->position, m.cam->ray(x, y)).second != Hit::Floor) continue;
+            // Half-resolution texel q stands for pixel 2q: pixel p reads p / 2, between two texels when odd.
+            const int x0 = x / 2, y0 = y / 2, x1 = (x + 1) / 2, y1 = (y + 1) / 2;
+            const double taps[4] = {confidence(x0, y0), confidence(x1, y0), confidence(x0, y1), confidence(x1, y1)};
+            const double c = std::clamp(0.25 * (taps[0] + taps[1] + taps[2] + taps[3]), 0.0, 1.0);
+            if (c < 0.05) continue;
+            const bool besideAMiss = *std::min_element(taps, taps + 4) < 0.02;
+            const float* g1 = out.at("base").at(x, y);
+            const float* g2 = out.at("material").at(x, y);
+            const glm::vec3 n = shading::octDecode({g0[0], g0[1]});
+            const glm::dvec3 v = -m.cam->ray(x, y);
+            const float NoV = std::clamp(float(glm::dot(glm::dvec3(n), v)), 1e-4f, 1.0f);
+            const glm::vec2 ab = shading::envBrdfApprox(NoV, shading::roughnessFromShininess(g0[3]));
+            const glm::dvec3 e =
+                glm::dvec3(shading::specularF0({g1[0], g1[1], g1[2]}, g1[3])) * double(ab.x) + double(ab.y);
+            const glm::dvec3 spec = rgb(out.at("spec"), x, y), got = rgb(out.at("term"), x, y);
+            const glm::dvec3 ssrPart = e * kUniformColour * double(g2[2] * g2[3]) * c;
+            const glm::dvec3 expected = spec * (1.0 - c) + ssrPart;
+            ++checked;
+            if (besideAMiss) ++beside;
+            bool bad = false;
+            for (int k = 0; k < 3; ++k) {
+                const double err = std::abs(got[k] - expected[k]) / (std::abs(expected[k]) + 1e-6);
+                worst = std::max(worst, err);
+                bad = bad || err > 1e-2;
+            }
+            // The reflected colour this pixel blended in, in units of C (1 when right), where it is most of the term.
+            if (glm::dot(ssrPart, glm::dvec3(1.0)) > glm::dot(spec * (1.0 - c), glm::dvec3(1.0)))
+                darkest = std::min(darkest, glm::dot(got - spec * (1.0 - c), glm::dvec3(1.0)) /
+                                                glm::dot(ssrPart, glm::dvec3(1.0)));
+            if (bad && ++wrong <= 5)
+                ADD_FAILURE() << "pixel " << x << "," << y << " (confidence " << c
+                              << (besideAMiss ? ", beside a miss" : "") << "): specular_indirect " << got.x << ","
+                              << got.y << "," << got.z << ", expected " << expected.x << "," << expected.y << ","
+                              << expected.z;
+        }
+    std::printf("misses: %d floor pixels with confidence, %d of them beside a miss; %d wrong; largest relative error "
+                "%.2g; darkest reflection %.3f of C\n",
+                checked, beside, wrong, worst, darkest);
+    EXPECT_EQ(wrong, 0);
+    EXPECT_GT(checked, 1000);
+    EXPECT_GT(beside, 100) << "the floor must mix hits with misses for this test to mean anything";
+}
+
 // Cone tracing: on a rough floor (roughness 0.4: two rays, cones of tan 1.29 alpha / sqrt 2 = 0.15) every hit's
 // footprint is several pixels wide (2 x distance x 0.15 over a pixel's ~2.4 cm at 6 m: > 2 px beyond 0.25 m), so the
 // pyramid is read at level 1 or coarser, where a one-pixel checkerboard is exactly 0.5; read at level 0 it is not.
@@ -838,7 +982,7 @@ TEST_F(Ssr, ConeFootprintSelectsACoarsePyramidLevel) {
     double meanDev = 0.0, worstDev = 0.0;
     for (int y = 0; y < MirrorScene::H; ++y)
         for (int x = 0; x < MirrorScene::W; ++x) {
-            const float* got = ssr.at(x, y);
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
             glm::dvec3 d = m.cam->ray(x, y);
             if (m.trace(m.cam->position, d).second != Hit::Floor || got[3] < 0.2f) continue;
             // Hits within 8 px of their pixel may be short enough for a sub-2-px cone: not counted.
@@ -856,7 +1000,7 @@ TEST_F(Ssr, ConeFootprintSelectsACoarsePyramidLevel) {
     int counted = 0;
     for (int y = 0; y < MirrorScene::H; ++y)
         for (int x = 0; x < MirrorScene::W; ++x) {
-            const float* got = ssr.at(x, y);
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
             glm::dvec3 d = m.cam->ray(x, y);
             auto [t, what] = m.trace(m.cam->position, d);
             if (what != Hit::Floor || got[3] < 0.5f) continue;
@@ -1007,7 +1151,7 @@ TEST_F(Ssr, VelocityReprojectsHitsIntoLastFrame) {
                 return s.x >= 8 && s.y >= 8 && s.x <= MirrorScene::W - 8 && s.y <= MirrorScene::H - 8;
             };
             if (!inside(now) || !inside(before) || std::hypot(now.x - (x + 0.5), now.y - (y + 0.5)) < 3.0) continue;
-            const float* got = ssr.at(x, y);
+            const glm::dvec4 got = reflectionRead(ssr, x, y);
             if (got[3] < 0.5f) {
                 ++wrong;
                 continue;
@@ -1115,9 +1259,9 @@ TEST_F(Ssr, RoughRaysFollowTheVisibleNormalDistribution) {
             sumBelow += below / total;
             sumGot += ssr.at(x, y)[3];
             sumExpectedPixel += expectedPixel / total;
-            // rgb is the confidence-weighted mean of the rays' reads, a the mean confidence: their product is the
-            // mean over the rays of confidence x position, an unbiased estimate of expectedPixel.
-            sumGotPixel += glm::dvec2(ssr.at(x, y)[0], ssr.at(x, y)[1]) * double(ssr.at(x, y)[3]);
+            // rgb is premultiplied: the confidence-weighted mean of the rays' reads times the mean confidence, i.e.
+            // the mean over the rays of confidence x position, an unbiased estimate of expectedPixel.
+            sumGotPixel += glm::dvec2(ssr.at(x, y)[0], ssr.at(x, y)[1]);
             ++pixels;
         }
     const double got = sumGot / pixels, expected = sumExpected / pixels;
@@ -1294,7 +1438,7 @@ TEST_F(Ssr, ConeFootprintMatchesTheLobeAtTheHit) {
         double worst = 0.0, meanLod = 0.0;
         for (int y = 0; y < H; ++y)
             for (int x = 0; x < W; ++x) {
-                const float* got = ssr.at(x, y);
+                const glm::dvec4 got = reflectionRead(ssr, x, y);
                 const glm::dvec3 d = cam.ray(x, y);
                 if (d.y >= 0.0 || got[3] < 0.9f) continue; // every ray hit, away from the fades
                 const glm::dvec3 p = cam.position + (-cam.position.y / d.y) * d;
