@@ -96,6 +96,8 @@ BakeView& BakeView::operator=(BakeView&& o) noexcept {
         mBase = std::exchange(o.mBase, nullptr);
         mLength = std::exchange(o.mLength, 0);
         mOffset = std::exchange(o.mOffset, 0);
+        mChecksum = std::exchange(o.mChecksum, 0);
+        mVersion = std::exchange(o.mVersion, 2);
     }
     return *this;
 }
@@ -109,8 +111,13 @@ std::span<const uint8_t> BakeView::bytes() const {
     return {static_cast<const uint8_t*>(mBase) + mOffset, mLength - mOffset};
 }
 
-std::optional<BakeView> BakeCache::map(const BakeKey& key) const {
-    const int fd = ::open(pathOf(key).c_str(), O_RDONLY | O_CLOEXEC);
+bool BakeView::intact() const {
+    return mBase && (mVersion == 1 ? checksumV1(bytes()) : checksum(bytes())) == mChecksum;
+}
+
+// The file mapped, its header checked (magic, key, size); `version` 1 or 2 by its magic.
+std::optional<BakeView> BakeCache::mapFile(const fs::path& path, uint64_t key, int& version) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return std::nullopt;
     struct stat st {};
     void* base = MAP_FAILED;
@@ -120,20 +127,36 @@ std::optional<BakeView> BakeCache::map(const BakeKey& key) const {
         base = ::mmap(nullptr, static_cast<size_t>(st.st_size), PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
     ::close(fd);
     if (base == MAP_FAILED) return std::nullopt;
-    BakeView view;
-    view.mBase = base;
-    view.mLength = static_cast<size_t>(st.st_size);
-    view.mOffset = sizeof(Header);
     Header h{};
     std::memcpy(&h, base, sizeof h);
-    const bool v2 = std::memcmp(h.magic, kMagic, sizeof kMagic) == 0;
-    const bool v1 = std::memcmp(h.magic, kMagicV1, sizeof kMagicV1) == 0;
-    if ((!v2 && !v1) || h.key != key.hash || sizeof(Header) + h.size != view.mLength ||
-        (v2 ? checksum(view.bytes()) : checksumV1(view.bytes())) != h.checksum)
-        return std::nullopt;
+    const size_t length = static_cast<size_t>(st.st_size);
+    BakeView view; // unmaps when dropped
+    view.mBase = base;
+    view.mLength = length;
+    view.mOffset = sizeof(Header);
+    view.mChecksum = h.checksum;
+    version = std::memcmp(h.magic, kMagic, sizeof kMagic) == 0       ? 2
+              : std::memcmp(h.magic, kMagicV1, sizeof kMagicV1) == 0 ? 1
+                                                                     : 0;
+    view.mVersion = version;
+    if (version == 0 || h.key != key || sizeof(Header) + h.size != length) return std::nullopt;
+    return view;
+}
+
+std::optional<BakeView> BakeCache::map(const BakeKey& key) const {
+    int version = 0;
+    std::optional<BakeView> view = mapFile(pathOf(key), key.hash, version);
+    if (!view || !view->intact()) return std::nullopt;
     // The rewrite replaces the file by rename: this view keeps mapping the old one. A failed rewrite (a read-only
     // cache) only means the next read checks the old checksum again.
-    if (v1) put(key, view.bytes());
+    if (version == 1) put(key, view->bytes());
+    return view;
+}
+
+std::optional<BakeView> BakeCache::mapUnverified(const BakeKey& key) const {
+    int version = 0;
+    std::optional<BakeView> view = mapFile(pathOf(key), key.hash, version);
+    if (!view || version != 2) return std::nullopt;
     return view;
 }
 

@@ -44,12 +44,18 @@ public:
     ~BakeView();
 
     std::span<const uint8_t> bytes() const;
+    // Whether the payload matches the checksum stored with it (what map() checks before it returns a view;
+    // mapUnverified() leaves it to the caller, e.g. to a second thread). Reads every byte; safe to call from another
+    // thread while this one reads bytes().
+    bool intact() const;
 
 private:
     friend class BakeCache;
     void* mBase = nullptr; // the whole file, header included
     size_t mLength = 0;
     size_t mOffset = 0; // where the payload starts
+    uint64_t mChecksum = 0; // stored in the header
+    int mVersion = 2;       // of the file's format: which checksum it carries
 };
 
 class BakeCache {
@@ -63,6 +69,11 @@ public:
     std::optional<std::vector<uint8_t>> get(const BakeKey& key) const;
     // The same bytes, checked the same way, mapped rather than read (see BakeView).
     std::optional<BakeView> map(const BakeKey& key) const;
+    // The same mapping with the header checked (magic of the current format, key, size) but not the payload's
+    // checksum: the caller must check BakeView::intact() before it trusts what it built from the bytes (the museum's
+    // 64 MiB of textures are checked on a second thread while the geometry is built). A file of the older format
+    // gives nullopt: map() reads and rewrites it.
+    std::optional<BakeView> mapUnverified(const BakeKey& key) const;
 
     // Stores bytes under key, replacing what was there. Atomic: written to a temporary file that is then
     // renamed, so a concurrent reader sees the old file or the new one, never a partial one. Returns false
@@ -77,6 +88,9 @@ public:
     const std::filesystem::path& dir() const { return mDir; }
 
 private:
+    // The file mapped with its header checked (magic, key, size); `version`: 1 or 2 by its magic.
+    static std::optional<BakeView> mapFile(const std::filesystem::path& path, uint64_t key, int& version);
+
     std::filesystem::path mDir;
 };
 

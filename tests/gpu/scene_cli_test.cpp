@@ -8,6 +8,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <sys/wait.h>
@@ -242,6 +243,23 @@ TEST_F(SceneCli, MuseumTexturesComeFromTheBakeCacheOnTheSecondBuild) {
     const CliResult fourth = vitrine(args, env);
     EXPECT_NE(fourth.output.find("procedural textures loaded from the bake cache"), std::string::npos)
         << fourth.output;
+    // Damaged inside (one byte of the pixels flipped, the size and header intact): the checksum, run on a second
+    // thread while the geometry is built, fails before the scene is used; generated again, stored again.
+    {
+        std::fstream f(files[0], std::ios::in | std::ios::out | std::ios::binary);
+        const std::streamoff at = static_cast<std::streamoff>(fs::file_size(files[0]) - 100);
+        f.seekg(at);
+        const char c = static_cast<char>(f.get());
+        f.seekp(at);
+        f.put(static_cast<char>(c ^ 0x40));
+    }
+    const CliResult fifth = vitrine(args, env);
+    ASSERT_EQ(fifth.status, 0) << fifth.output;
+    EXPECT_NE(fifth.output.find("fail their checksum"), std::string::npos) << fifth.output;
+    EXPECT_NE(fifth.output.find("procedural textures generated and stored"), std::string::npos) << fifth.output;
+    const CliResult sixth = vitrine(args, env);
+    EXPECT_NE(sixth.output.find("procedural textures loaded from the bake cache"), std::string::npos) << sixth.output;
+    EXPECT_EQ(sixth.output.find("fail their checksum"), std::string::npos) << sixth.output;
 }
 
 // KHR_materials_variants from the command line: --set scene.params.material_variant=NAME on graphs/gltf.json with

@@ -150,6 +150,55 @@ TEST_F(BakeCacheTest, AFlipInAnyLaneOrTheTailIsAMiss) {
     }
 }
 
+// mapUnverified() checks the header only and leaves the payload's checksum to BakeView::intact(), which the caller
+// runs (the museum's textures: on a second thread): a flipped payload byte maps but is not intact; a wrong key, a
+// truncated file or no file is no view at all; a version-1 file is left to map(), which reads and rewrites it.
+TEST_F(BakeCacheTest, UnverifiedMappingsLeaveTheChecksumToIntact) {
+    BakeCache cache(mRoot);
+    const BakeKey key{"museum_textures", 11};
+    const std::vector<uint8_t> payload = bytes(32 * 7 + 5, 9);
+    ASSERT_TRUE(cache.put(key, payload));
+    {
+        std::optional<BakeView> view = cache.mapUnverified(key);
+        ASSERT_TRUE(view);
+        EXPECT_EQ(std::vector<uint8_t>(view->bytes().begin(), view->bytes().end()), payload);
+        EXPECT_TRUE(view->intact());
+        std::optional<BakeView> checked = cache.map(key);
+        ASSERT_TRUE(checked);
+        EXPECT_TRUE(checked->intact());
+    }
+    {
+        std::fstream f(cache.pathOf(key), std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(32 + 100);
+        f.put(static_cast<char>(payload[100] ^ 0x01));
+    }
+    std::optional<BakeView> damaged = cache.mapUnverified(key);
+    ASSERT_TRUE(damaged) << "the header is fine: the view is handed out";
+    EXPECT_FALSE(damaged->intact());
+    EXPECT_FALSE(cache.map(key));
+    EXPECT_FALSE(cache.mapUnverified(BakeKey{"museum_textures", 12}));
+    ASSERT_TRUE(cache.put(key, payload));
+    fs::resize_file(cache.pathOf(key), 32 + payload.size() - 1);
+    EXPECT_FALSE(cache.mapUnverified(key));
+    // Version 1: not mapped unverified; map() checks it with the old checksum and rewrites it as version 2.
+    {
+        std::ofstream out(cache.pathOf(key), std::ios::binary | std::ios::trunc);
+        scene::Hasher h;
+        h.bytes(payload.data(), payload.size());
+        const uint64_t header[3] = {key.hash, payload.size(), h.result()};
+        out.write("VTBAKE01", 8);
+        out.write(reinterpret_cast<const char*>(header), sizeof header);
+        out.write(reinterpret_cast<const char*>(payload.data()), static_cast<std::streamsize>(payload.size()));
+    }
+    EXPECT_FALSE(cache.mapUnverified(key));
+    std::optional<BakeView> old = cache.map(key);
+    ASSERT_TRUE(old);
+    EXPECT_TRUE(old->intact()) << "a version-1 view is checked with its own checksum";
+    std::optional<BakeView> rewritten = cache.mapUnverified(key);
+    ASSERT_TRUE(rewritten);
+    EXPECT_TRUE(rewritten->intact());
+}
+
 // Files written before the four-lane checksum (magic VTBAKE01, the payload's scene::Hasher as checksum) are still
 // read, so an existing cache stays valid; damaged ones are misses as before.
 TEST_F(BakeCacheTest, VersionOneFilesAreStillRead) {
