@@ -115,8 +115,8 @@ bool BakeView::intact() const {
     return mBase && (mVersion == 1 ? checksumV1(bytes()) : checksum(bytes())) == mChecksum;
 }
 
-// The file mapped, its header checked (magic, key, size); `version` 1 or 2 by its magic.
-std::optional<BakeView> BakeCache::mapFile(const fs::path& path, uint64_t key, int& version) {
+// The file mapped, its header checked (magic, key, size); the view's mVersion says which checksum it carries.
+std::optional<BakeView> BakeCache::mapFile(const fs::path& path, uint64_t key) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return std::nullopt;
     struct stat st {};
@@ -135,28 +135,25 @@ std::optional<BakeView> BakeCache::mapFile(const fs::path& path, uint64_t key, i
     view.mLength = length;
     view.mOffset = sizeof(Header);
     view.mChecksum = h.checksum;
-    version = std::memcmp(h.magic, kMagic, sizeof kMagic) == 0       ? 2
-              : std::memcmp(h.magic, kMagicV1, sizeof kMagicV1) == 0 ? 1
-                                                                     : 0;
-    view.mVersion = version;
-    if (version == 0 || h.key != key || sizeof(Header) + h.size != length) return std::nullopt;
+    view.mVersion = std::memcmp(h.magic, kMagic, sizeof kMagic) == 0       ? 2
+                    : std::memcmp(h.magic, kMagicV1, sizeof kMagicV1) == 0 ? 1
+                                                                           : 0;
+    if (view.mVersion == 0 || h.key != key || sizeof(Header) + h.size != length) return std::nullopt;
     return view;
 }
 
 std::optional<BakeView> BakeCache::map(const BakeKey& key) const {
-    int version = 0;
-    std::optional<BakeView> view = mapFile(pathOf(key), key.hash, version);
+    std::optional<BakeView> view = mapFile(pathOf(key), key.hash);
     if (!view || !view->intact()) return std::nullopt;
     // The rewrite replaces the file by rename: this view keeps mapping the old one. A failed rewrite (a read-only
     // cache) only means the next read checks the old checksum again.
-    if (version == 1) put(key, view->bytes());
+    if (view->mVersion == 1) put(key, view->bytes());
     return view;
 }
 
 std::optional<BakeView> BakeCache::mapUnverified(const BakeKey& key) const {
-    int version = 0;
-    std::optional<BakeView> view = mapFile(pathOf(key), key.hash, version);
-    if (!view || version != 2) return std::nullopt;
+    std::optional<BakeView> view = mapFile(pathOf(key), key.hash);
+    if (!view || view->mVersion != 2) return std::nullopt;
     return view;
 }
 

@@ -88,8 +88,8 @@ public:
     const std::filesystem::path& dir() const { return mDir; }
 
 private:
-    // The file mapped with its header checked (magic, key, size); `version`: 1 or 2 by its magic.
-    static std::optional<BakeView> mapFile(const std::filesystem::path& path, uint64_t key, int& version);
+    // The file mapped with its header checked (magic, key, size); its format's version in the view's mVersion.
+    static std::optional<BakeView> mapFile(const std::filesystem::path& path, uint64_t key);
 
     std::filesystem::path mDir;
 };

@@ -61,28 +61,38 @@ sc::Scene sceneWithNormalMap(const std::string& name, const sc::TextureImage& im
     return s;
 }
 
-TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
-    // 16x16 normal map: columns alternate ±45° about +Y, with an irregular y tilt per texel, so the
-    // 2x2 footprints differ and the averages are clearly shorter than 1.
-    const uint32_t n = 16;
+// An n x n normal map: texel (x, y) (visited row by row) holds normal(x, y).first, normalised and encoded to 8 bits,
+// and .second as its alpha.
+template <class Normal> sc::TextureImage normalMapImage(const char* name, uint32_t n, Normal normal) {
     sc::TextureImage img;
-    img.name = "ridges";
+    img.name = name;
     img.width = img.height = n;
     img.pixels.resize(n * n * 4);
-    uint32_t state = 99;
     for (uint32_t y = 0; y < n; ++y)
         for (uint32_t x = 0; x < n; ++x) {
-            state = state * 1664525u + 1013904223u;
-            double ty = ((state >> 24) / 255.0 - 0.5) * 0.6;
-            double sx = x % 2 ? 1.0 : -1.0;
-            glm::dvec3 v = glm::normalize(glm::dvec3(sx, ty, 1.0));
-            glm::dvec3 e = glm::round((v * 0.5 + 0.5) * 255.0);
+            const auto [direction, alpha] = normal(x, y);
+            const glm::dvec3 e = glm::round((glm::normalize(direction) * 0.5 + 0.5) * 255.0);
             uint8_t* p = img.at(x, y);
             p[0] = static_cast<uint8_t>(e.x);
             p[1] = static_cast<uint8_t>(e.y);
             p[2] = static_cast<uint8_t>(e.z);
-            p[3] = static_cast<uint8_t>((state >> 8) & 0xff); // junk: a normal texture's alpha means nothing
+            p[3] = alpha;
         }
+    return img;
+}
+
+TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
+    // 16x16 normal map: columns alternate ±45° about +Y, with an irregular y tilt per texel, so the
+    // 2x2 footprints differ and the averages are clearly shorter than 1.
+    const uint32_t n = 16;
+    uint32_t state = 99;
+    const sc::TextureImage img = normalMapImage("ridges", n, [&](uint32_t x, uint32_t) {
+        state = state * 1664525u + 1013904223u;
+        double ty = ((state >> 24) / 255.0 - 0.5) * 0.6;
+        double sx = x % 2 ? 1.0 : -1.0;
+        // Alpha: junk, a normal texture's alpha means nothing.
+        return std::pair{glm::dvec3(sx, ty, 1.0), static_cast<uint8_t>((state >> 8) & 0xff)};
+    });
     // Alpha of level m: sqrt(1 - L), L the agreement of the core of the normals under the texel (toksvig_mip.comp):
     // a level-0 texel has L = 1 and its decoded normal's direction (the bytes' own lengths are rounding, not
     // disagreement); a texel of level m+1 has the direction of the plain mean of the decoded normals under it and
@@ -175,20 +185,10 @@ TEST_F(SceneGpu, NormalMapMipsAreUnnormalisedAverages) {
 // footprint by a few steep texels.
 TEST_F(SceneGpu, NormalMapMipsKeepTheCoresSpreadNotAGroovesAbove) {
     const uint32_t n = 16;
-    sc::TextureImage img;
-    img.name = "groove";
-    img.width = img.height = n;
-    img.pixels.resize(n * n * 4);
-    for (uint32_t y = 0; y < n; ++y)
-        for (uint32_t x = 0; x < n; ++x) {
-            const double sx = x == 4 ? -1.0 : x == 5 ? 1.0 : 0.0;
-            const glm::dvec3 e = glm::round((glm::normalize(glm::dvec3(sx, 0.0, 1.0)) * 0.5 + 0.5) * 255.0);
-            uint8_t* p = img.at(x, y);
-            p[0] = static_cast<uint8_t>(e.x);
-            p[1] = static_cast<uint8_t>(e.y);
-            p[2] = static_cast<uint8_t>(e.z);
-            p[3] = 255;
-        }
+    const sc::TextureImage img = normalMapImage("groove", n, [](uint32_t x, uint32_t) {
+        const double sx = x == 4 ? -1.0 : x == 5 ? 1.0 : 0.0;
+        return std::pair{glm::dvec3(sx, 0.0, 1.0), uint8_t(255)};
+    });
     const sc::Scene s = sceneWithNormalMap("toksvig_groove", img);
 
     ShaderCompiler shaders;

@@ -782,6 +782,34 @@ TEST_F(Ssr, TheMarchAdvancesToTheSlabBeforeDescending) {
     EXPECT_GE(few, 0.55 * many);
 }
 
+// ssr.composite fed by lighting, the G-buffer and `reflection` (ssr.reflection or its temporal accumulation).
+json compositeNode(const char* reflection) {
+    return {{"type", "ssr.composite"},
+            {"in",
+             {{"color", "lighting.color"},
+              {"specular_indirect", "lighting.specular_indirect"},
+              {"reflection", reflection},
+              {"normal", "gbuffer.normal"},
+              {"base_color", "gbuffer.base_color"},
+              {"material", "gbuffer.material"},
+              {"depth", "gbuffer.depth"},
+              {"camera", "scene.camera"}}}};
+}
+
+// What ssr.composite weighs SSR's radiance by at pixel (x, y), from the read-back G-buffer ("normal", "base",
+// "material"): Karis' environment BRDF E from core/shading times the vertex AO and the cavity.
+glm::dvec3 weightOfSsr(const std::map<std::string, Image>& out, const MirrorScene& m, int x, int y) {
+    const float* g0 = out.at("normal").at(x, y);
+    const float* g1 = out.at("base").at(x, y);
+    const float* g2 = out.at("material").at(x, y);
+    const glm::vec3 n = shading::octDecode({g0[0], g0[1]});
+    const glm::dvec3 v = -m.cam->ray(x, y);
+    const float NoV = std::clamp(float(glm::dot(glm::dvec3(n), v)), 1e-4f, 1.0f);
+    const glm::vec2 ab = shading::envBrdfApprox(NoV, shading::roughnessFromShininess(g0[3]));
+    const glm::dvec3 e = glm::dvec3(shading::specularF0({g1[0], g1[1], g1[2]}, g1[3])) * double(ab.x) + double(ab.y);
+    return e * double(g2[2] * g2[3]);
+}
+
 // ssr.composite on a lit glossy floor (roughness 0.15, cavity 0.8, vertex AO 0.5..1) with SSR at half
 // resolution: every pixel against the blend evaluated on the CPU from the read-back inputs, with Karis' environment
 // BRDF from core/shading and the half-resolution (premultiplied) reflection upsampled bilinearly (clamped at the
@@ -800,16 +828,7 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
                       {"hiz", "hiz.hiz"},
                       {"color", "pyramid.pyramid"},
                       {"camera", "scene.camera"}}}};
-    nodes["composite"] = {{"type", "ssr.composite"},
-                          {"in",
-                           {{"color", "lighting.color"},
-                            {"specular_indirect", "lighting.specular_indirect"},
-                            {"reflection", "ssr.reflection"},
-                            {"normal", "gbuffer.normal"},
-                            {"base_color", "gbuffer.base_color"},
-                            {"material", "gbuffer.material"},
-                            {"depth", "gbuffer.depth"},
-                            {"camera", "scene.camera"}}}};
+    nodes["composite"] = compositeNode("ssr.reflection");
     auto out = runGraph(graph(nodes,
                               {{"color", "lighting.color"},
                                {"spec", "lighting.specular_indirect"},
@@ -838,16 +857,8 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
             // Half-resolution texel q stands for pixel 2q: pixel p reads p / 2, between two texels when odd.
             int x0 = x / 2, y0 = y / 2, x1 = (x + 1) / 2, y1 = (y + 1) / 2;
             glm::dvec4 r = 0.25 * (fetch(x0, y0) + fetch(x1, y0) + fetch(x0, y1) + fetch(x1, y1));
-            const float* g1 = out.at("base").at(x, y);
-            const float* g2 = out.at("material").at(x, y);
-            glm::vec3 n = shading::octDecode({g0[0], g0[1]});
-            glm::dvec3 v = -m.cam->ray(x, y);
-            float NoV = std::clamp(float(glm::dot(glm::dvec3(n), v)), 1e-4f, 1.0f);
-            glm::vec2 ab = shading::envBrdfApprox(NoV, shading::roughnessFromShininess(g0[3]));
-            glm::dvec3 f0 = shading::specularF0({g1[0], g1[1], g1[2]}, g1[3]);
-            glm::dvec3 e = f0 * double(ab.x) + double(ab.y);
             // r is premultiplied (c L_ssr, c): the bilinear mix of the four texels is c L_ssr of the mix.
-            glm::dvec3 reflectedTimesC = e * glm::dvec3(r) * double(g2[2] * g2[3]);
+            glm::dvec3 reflectedTimesC = weightOfSsr(out, m, x, y) * glm::dvec3(r);
             double c = std::clamp(r.w, 0.0, 1.0);
             glm::dvec3 expected = glm::max(color - spec + spec * (1.0 - c) + reflectedTimesC, glm::dvec3(0.0));
             // Its specular_indirect output: the blended term alone (what reference.reflections is compared with).
@@ -893,16 +904,7 @@ TEST_F(Ssr, MissesDoNotDarkenTheReflectionOfTheHits) {
                             {{"color", "ssr.reflection"},
                              {"history", "accumulate.color@prev"},
                              {"history_samples", "accumulate.samples@prev"}}}};
-    nodes["composite"] = {{"type", "ssr.composite"},
-                          {"in",
-                           {{"color", "lighting.color"},
-                            {"specular_indirect", "lighting.specular_indirect"},
-                            {"reflection", "accumulate.color"},
-                            {"normal", "gbuffer.normal"},
-                            {"base_color", "gbuffer.base_color"},
-                            {"material", "gbuffer.material"},
-                            {"depth", "gbuffer.depth"},
-                            {"camera", "scene.camera"}}}};
+    nodes["composite"] = compositeNode("accumulate.color");
     json g = graph(nodes,
                    {{"color", "lighting.color"},
                     {"spec", "lighting.specular_indirect"},
@@ -931,16 +933,8 @@ TEST_F(Ssr, MissesDoNotDarkenTheReflectionOfTheHits) {
             const double c = std::clamp(0.25 * (taps[0] + taps[1] + taps[2] + taps[3]), 0.0, 1.0);
             if (c < 0.05) continue;
             const bool besideAMiss = *std::min_element(taps, taps + 4) < 0.02;
-            const float* g1 = out.at("base").at(x, y);
-            const float* g2 = out.at("material").at(x, y);
-            const glm::vec3 n = shading::octDecode({g0[0], g0[1]});
-            const glm::dvec3 v = -m.cam->ray(x, y);
-            const float NoV = std::clamp(float(glm::dot(glm::dvec3(n), v)), 1e-4f, 1.0f);
-            const glm::vec2 ab = shading::envBrdfApprox(NoV, shading::roughnessFromShininess(g0[3]));
-            const glm::dvec3 e =
-                glm::dvec3(shading::specularF0({g1[0], g1[1], g1[2]}, g1[3])) * double(ab.x) + double(ab.y);
             const glm::dvec3 spec = rgb(out.at("spec"), x, y), got = rgb(out.at("term"), x, y);
-            const glm::dvec3 ssrPart = e * kUniformColour * double(g2[2] * g2[3]) * c;
+            const glm::dvec3 ssrPart = weightOfSsr(out, m, x, y) * kUniformColour * c;
             const glm::dvec3 expected = spec * (1.0 - c) + ssrPart;
             ++checked;
             if (besideAMiss) ++beside;
@@ -1039,16 +1033,7 @@ TEST_F(Ssr, ReducesTheFlipErrorAgainstThePathTracedReference) {
                       {"hiz", "hiz.hiz"},
                       {"color", "pyramid.pyramid"},
                       {"camera", "scene.camera"}}}};
-    nodes["composite"] = {{"type", "ssr.composite"},
-                          {"in",
-                           {{"color", "lighting.color"},
-                            {"specular_indirect", "lighting.specular_indirect"},
-                            {"reflection", "ssr.reflection"},
-                            {"normal", "gbuffer.normal"},
-                            {"base_color", "gbuffer.base_color"},
-                            {"material", "gbuffer.material"},
-                            {"depth", "gbuffer.depth"},
-                            {"camera", "scene.camera"}}}};
+    nodes["composite"] = compositeNode("ssr.reflection");
     nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
     nodes["pt"] = {{"type", "render.pathtrace"},
                    {"in",
