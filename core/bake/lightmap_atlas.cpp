@@ -78,10 +78,15 @@ LightmapAtlas planLightmapAtlas(const scene::Scene& s, const LightmapAtlasOption
         }
         // size² texels over the uv square: world area per texel = world / (uv size²) = 1 / texelsPerMeter².
         // (The small allowance keeps float noise in the areas from adding a texel row to an exact size.)
-        const double size = std::ceil(o.texelsPerMeter * std::sqrt(a.world / a.uv) - 1e-3);
+        double size = std::ceil(o.texelsPerMeter * std::sqrt(a.world / a.uv) - 1e-3);
+        // Charts a known distance apart get at least minChartGap texels between them.
+        const float gap = s.meshes[inst.mesh].lightmapChartGap;
+        if (gap > 0.0f) size = std::max(size, std::ceil(double(o.minChartGap) / gap - 1e-3));
         LightmapRegion r;
         r.instance = i;
         r.size = static_cast<uint32_t>(std::clamp(size, double(o.minSize), double(o.maxSize)));
+        if (gap > 0.0f && float(r.size) * gap < o.minChartGap)
+            atlas.narrowChartGaps.emplace_back(i, float(r.size) * gap);
         atlas.regions.push_back(r);
     }
 

@@ -154,13 +154,14 @@ BakeKey lightmapCacheKey(const scene::Scene& scene, const LightmapBakeSettings& 
     scene::Hasher h;
     h.string("lightmap");
     h.value(kVersion);
-    h.value(scene.lightTransportHash()); // probes do not change the lightmaps
+    h.value(scene.lightmapHash()); // probes do not change the lightmaps
     h.value(lightingHash);
     h.value(s.atlas.texelsPerMeter);
     h.value(s.atlas.minSize);
     h.value(s.atlas.maxSize);
     h.value(s.atlas.gutter);
     h.value(s.atlas.atlasWidth);
+    h.value(s.atlas.minChartGap);
     h.value(s.samples);
     h.value(s.maxBounces);
     h.value(s.probeSpacing);

@@ -121,6 +121,10 @@ struct Mesh {
     // Morph target weights of the rest pose (glTF's node or mesh `weights`), one per target of its primitives;
     // empty without targets. An animation of the weights re-morphs from here (morphVertices()).
     std::vector<float> weights;
+    // The narrowest gap between two charts of its lightmap UVs (Vertex::uv1), in uv1 units: the lightmap atlas sizes
+    // the mesh's region so that this gap spans enough texels for bilinear filtering and dilation to keep charts apart
+    // (core/bake/lightmap_atlas.hpp). 0: not known (a glTF file's TEXCOORD_1), sized by texel density alone.
+    float lightmapChartGap = 0.0f;
 };
 
 struct Transform {
@@ -336,16 +340,19 @@ struct Scene {
     // sun, rooms, probes) but not of derived data. Equal scenes hash equal on every run and build; used by
     // determinism tests and as a key of bake caches.
     uint64_t contentHash() const;
-    // The same without the reflection probes: what light transport (the lightmap bake) depends on, so moving a
-    // probe does not re-bake the lightmaps.
+    // The same without the reflection probes and without lightmap UVs (Vertex::uv1 where no material samples
+    // texture set 1, Mesh::lightmapChartGap): what light transport depends on, the key of path-traced references,
+    // so that moving a probe or re-packing the lightmap charts keeps a converged reference.
     uint64_t lightTransportHash() const;
+    // Light transport and the lightmap UVs, without the probes: the key of the lightmap bake.
+    uint64_t lightmapHash() const;
 
     size_t triangleCount() const { return indices.size() / 3; }
     // CPU bytes of geometry and texture pixels: what an upload will roughly cost.
     size_t memoryBytes() const;
 
 private:
-    uint64_t hashContent(bool withProbes) const;
+    uint64_t hashContent(bool withProbes, bool withLightmapUvs) const;
 };
 
 } // namespace vitrine::scene

@@ -115,14 +115,32 @@ bool usesNormalMap(const Material& m) {
                        [](const MaterialLayer& l) { return l.normal.texture.valid(); });
 }
 
-uint64_t Scene::contentHash() const { return hashContent(true); }
+uint64_t Scene::contentHash() const {
+    return hashContent(true, true);
+}
 
-uint64_t Scene::lightTransportHash() const { return hashContent(false); }
+uint64_t Scene::lightTransportHash() const {
+    return hashContent(false, false);
+}
 
-uint64_t Scene::hashContent(bool withProbes) const {
+uint64_t Scene::lightmapHash() const {
+    return hashContent(false, true);
+}
+
+uint64_t Scene::hashContent(bool withProbes, bool withLightmapUvs) const {
     Hasher h;
     h.string(name);
-    h.array(vertices);
+    if (withLightmapUvs) {
+        h.array(vertices);
+    } else { // uv1 as (0, 0) wherever no material samples texture set 1
+        std::vector<Vertex> transport = vertices;
+        for (const Primitive& p : primitives) {
+            if (p.material < materials.size() && usesUvSet(materials[p.material], 1)) continue;
+            for (uint32_t v = 0; v < p.vertexCount && p.vertexOffset + v < transport.size(); ++v)
+                transport[p.vertexOffset + v].uv1 = glm::vec2(0.0f);
+        }
+        h.array(transport);
+    }
     h.array(indices);
     h.value(primitives.size());
     for (const Primitive& p : primitives) {
@@ -135,6 +153,7 @@ uint64_t Scene::hashContent(bool withProbes) const {
         h.string(m.name);
         h.value(m.firstPrimitive);
         h.value(m.primitiveCount);
+        if (withLightmapUvs && m.lightmapChartGap != 0.0f) h.value(m.lightmapChartGap); // absent before: hashes stay
     }
     h.value(materials.size());
     for (const Material& m : materials)

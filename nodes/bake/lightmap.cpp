@@ -24,6 +24,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <numbers>
@@ -262,6 +263,14 @@ private:
             logInfo("scene '" + scene.name + "': " + std::to_string(mAtlas.skipped.size()) +
                     " instances have no lightmap (dynamic, or no TEXCOORD_1) and take their diffuse light from the "
                     "irradiance volume");
+        for (const auto& [instance, gap] : mAtlas.narrowChartGaps) {
+            char line[96];
+            std::snprintf(line, sizeof line, "%.1f texels apart (fewer than %.0f)", gap, mSettings.atlas.minChartGap);
+            logWarning("scene '" + scene.name + "': the lightmap charts of mesh '" +
+                       scene.meshes[scene.instances[instance].mesh].name + "' are " + line +
+                       " at its region's largest size: their borders may take some of their neighbours' light; "
+                       "lower texels_per_meter");
+        }
 
         bake::BakedLighting out;
         out.width = mAtlas.width;

@@ -58,7 +58,7 @@ size_t MeshBuilder::triangleCount() const {
     return n;
 }
 
-void MeshBuilder::packCharts() {
+float MeshBuilder::packCharts() {
     struct Chart {
         glm::vec2 min{1e30f}, max{-1e30f};
         bool rotated = false;
@@ -73,17 +73,17 @@ void MeshBuilder::packCharts() {
             c.max = glm::max(c.max, p.chartUvs[i]);
         }
     }
-    if (charts.empty()) return;
-    float area = 0.0f, widest = 0.0f;
+    if (charts.empty()) return 0.0f;
+    // A gap of kChartGapMeters between charts and around them (the atlas turns it into enough texels).
+    const float padding = kChartGapMeters;
+    float area = 0.0f, widest = 0.0f; // area: of the charts with their gaps
     for (auto& [id, c] : charts) {
         glm::vec2 s = c.max - c.min;
         c.rotated = s.y > s.x; // lay every chart on its long side: shelves waste less
         glm::vec2 r = c.size();
-        area += (r.x + 1e-3f) * (r.y + 1e-3f);
+        area += (r.x + padding) * (r.y + padding);
         widest = std::max(widest, r.x);
     }
-    // Gutters of ~4 texels of a 1024² lightmap, so that bilinear filtering never mixes two charts.
-    float padding = std::sqrt(area) * (4.0f / 1024.0f);
     std::vector<Chart*> order;
     for (auto& [id, c] : charts)
         order.push_back(&c);
@@ -112,12 +112,13 @@ void MeshBuilder::packCharts() {
             p.vertices[i].uv1 = (c.offset + local) / extent;
         }
     }
+    return padding / extent;
 }
 
 uint32_t MeshBuilder::commit(Scene& scene, bool lightmapped) {
-    if (lightmapped) packCharts();
     Mesh mesh;
     mesh.name = mName;
+    if (lightmapped) mesh.lightmapChartGap = packCharts();
     mesh.firstPrimitive = static_cast<uint32_t>(scene.primitives.size());
     for (Part& p : mParts) {
         if (p.indices.empty()) continue;

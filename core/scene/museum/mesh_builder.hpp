@@ -2,7 +2,7 @@
 
 // Collects the triangles of one museum mesh (one primitive per material) and, when the mesh is static,
 // its lightmap charts: every surface patch is given 2D chart coordinates in metres, and commit() packs
-// the charts into the unit square (uv1) at one texel density for the whole mesh.
+// the charts into the unit square (uv1) at one texel density for the whole mesh, kChartGapMeters apart.
 
 #include "core/scene/scene.hpp"
 
@@ -10,6 +10,11 @@
 #include <vector>
 
 namespace vitrine::scene::museum {
+
+// The gap between two lightmap charts, metres: 3 texels at bake.lightmap's default 4 texels per metre, so that
+// bilinear filtering of one chart's border never reads the next chart's light (the atlas keeps the gap at least
+// that many texels at other densities: Mesh::lightmapChartGap).
+inline constexpr float kChartGapMeters = 0.75f;
 
 class MeshBuilder {
 public:
@@ -45,7 +50,8 @@ private:
         std::vector<uint32_t> charts;    // per vertex
         std::vector<glm::vec2> chartUvs; // per vertex, metres
     };
-    void packCharts();
+    // Packs the charts into uv1; returns the gap between charts in uv1 units (Mesh::lightmapChartGap).
+    float packCharts();
 
     std::string mName;
     std::vector<Part> mParts;

@@ -1,14 +1,18 @@
 // The lightmap atlas plan (core/bake/lightmap_atlas): region sizes from world area and texel density worked
 // out by hand on quads, which instances are skipped and why, and on the museum: every static lightmapped
 // instance has a region, regions and their gutters never overlap and stay inside the atlas, and the plan is
-// the same every time.
+// the same every time, and its charts lie at least three texels apart at 2, 4 and 8 texels per metre.
 #include "core/bake/lightmap_atlas.hpp"
 
+#include "core/bake/lightmap_bake.hpp"
 #include "core/base/error.hpp"
 #include "core/scene/museum.hpp"
 #include "core/scene/scene.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
 
 namespace vitrine::bake {
 namespace {
@@ -165,6 +169,128 @@ TEST(LightmapAtlas, MuseumRegionsDoNotOverlapAndCoverEveryStaticLightmappedInsta
         EXPECT_EQ(again.regions[i].y, a.regions[i].y);
         EXPECT_EQ(again.regions[i].size, a.regions[i].size);
     }
+}
+
+TEST(LightmapAtlas, AKnownChartGapRaisesTheRegionUntilItSpansMinChartGapTexels) {
+    sc::Scene s = quads();
+    s.meshes[s.instances[0].mesh].lightmapChartGap = 0.1f; // 16 texels by density: a 1.6-texel gap
+    s.meshes[s.instances[1].mesh].lightmapChartGap = 0.5f; // 32 texels by density: 16 texels apart already
+    LightmapAtlasOptions o;
+    o.texelsPerMeter = 8.0f;
+    o.maxSize = 64;
+    o.atlasWidth = 256;
+    o.minChartGap = 3.0f;
+    const LightmapAtlas a = planLightmapAtlas(s, o);
+    EXPECT_EQ(a.regions[a.regionOfInstance[0]].size, 30u); // 3 / 0.1 texels per side
+    EXPECT_EQ(a.regions[a.regionOfInstance[1]].size, 32u); // unchanged
+    EXPECT_EQ(a.regions[a.regionOfInstance[2]].size, 16u); // no gap known: density alone
+    EXPECT_TRUE(a.narrowChartGaps.empty());
+
+    // Capped by maxSize: the region stays at the cap and the plan says how narrow its gaps are.
+    s.meshes[s.instances[0].mesh].lightmapChartGap = 0.01f; // would need 300 texels
+    const LightmapAtlas capped = planLightmapAtlas(s, o);
+    EXPECT_EQ(capped.regions[capped.regionOfInstance[0]].size, 64u);
+    ASSERT_EQ(capped.narrowChartGaps.size(), 1u);
+    EXPECT_EQ(capped.narrowChartGaps[0].first, 0u);
+    EXPECT_NEAR(capped.narrowChartGaps[0].second, 0.64f, 1e-4f);
+}
+
+// The charts of a mesh's lightmap UVs, found from the triangles themselves: triangles sharing a vertex are one
+// chart, and pieces whose uv bounding boxes overlap or touch are merged (a chart may be several patches). Returns
+// each chart's uv1 bounding box.
+std::vector<std::pair<glm::vec2, glm::vec2>> uvCharts(const sc::Scene& s, const sc::Mesh& mesh) {
+    std::vector<std::pair<glm::vec2, glm::vec2>> boxes;
+    for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+        const sc::Primitive& p = s.primitives[mesh.firstPrimitive + k];
+        if (!p.lightmapUvs) continue;
+        std::vector<uint32_t> parent(p.vertexCount);
+        std::iota(parent.begin(), parent.end(), 0u);
+        auto root = [&](uint32_t v) {
+            while (parent[v] != v)
+                v = parent[v] = parent[parent[v]];
+            return v;
+        };
+        for (uint32_t t = 0; t + 2 < p.indexCount; t += 3)
+            for (uint32_t e = 1; e < 3; ++e)
+                parent[root(s.indices[p.firstIndex + t + e])] = root(s.indices[p.firstIndex + t]);
+        std::vector<int> boxOf(p.vertexCount, -1);
+        for (uint32_t v = 0; v < p.vertexCount; ++v) {
+            const glm::vec2 uv = s.vertices[p.vertexOffset + v].uv1;
+            int& b = boxOf[root(v)];
+            if (b < 0) {
+                b = static_cast<int>(boxes.size());
+                boxes.emplace_back(uv, uv);
+            }
+            boxes[b].first = glm::min(boxes[b].first, uv);
+            boxes[b].second = glm::max(boxes[b].second, uv);
+        }
+    }
+    // Sweep along x: a box only meets the boxes that start before it ends. Repeat until nothing merges.
+    constexpr float kTouch = 1e-5f; // duplicated vertices along a chart's inner edges
+    for (bool merged = true; merged;) {
+        merged = false;
+        std::sort(boxes.begin(), boxes.end(), [](const auto& a, const auto& b) { return a.first.x < b.first.x; });
+        std::vector<bool> gone(boxes.size(), false);
+        for (size_t i = 0; i < boxes.size(); ++i) {
+            if (gone[i]) continue;
+            for (size_t j = i + 1; j < boxes.size() && boxes[j].first.x <= boxes[i].second.x + kTouch; ++j) {
+                if (gone[j] || boxes[j].first.y > boxes[i].second.y + kTouch ||
+                    boxes[i].first.y > boxes[j].second.y + kTouch)
+                    continue;
+                boxes[i] = {glm::min(boxes[i].first, boxes[j].first), glm::max(boxes[i].second, boxes[j].second)};
+                gone[j] = merged = true;
+            }
+        }
+        size_t kept = 0;
+        for (size_t i = 0; i < boxes.size(); ++i)
+            if (!gone[i]) boxes[kept++] = boxes[i];
+        boxes.resize(kept);
+    }
+    return boxes;
+}
+
+TEST(LightmapAtlas, MuseumChartsLieAtLeastThreeTexelsApart) {
+    // Bilinear filtering at a chart's border reads the texel beyond it, which dilation fills from the nearest chart:
+    // charts closer than about three texels take their neighbours' light (the doorway's jamb beside the museum's
+    // camera took the sunlit wall's, up to 4x its own, at 8 texels per metre).
+    sc::MuseumOptions mo;
+    mo.textureSize = 16;
+    const sc::Scene s = sc::buildMuseum(mo);
+    for (float density : {2.0f, 4.0f, 8.0f}) { // 2: the gap alone decides the size
+        LightmapAtlasOptions o;
+        o.texelsPerMeter = density;
+        const LightmapAtlas a = planLightmapAtlas(s, o);
+        EXPECT_TRUE(a.narrowChartGaps.empty()) << density << " texels/m";
+        for (const LightmapRegion& r : a.regions) {
+            const sc::Mesh& mesh = s.meshes[s.instances[r.instance].mesh];
+            const auto charts = uvCharts(s, mesh);
+            float closest = 1e9f;
+            for (size_t i = 0; i < charts.size(); ++i)
+                for (size_t j = i + 1; j < charts.size(); ++j) {
+                    const auto &p = charts[i], &q = charts[j];
+                    const float dx = std::max(p.first.x - q.second.x, q.first.x - p.second.x);
+                    const float dy = std::max(p.first.y - q.second.y, q.first.y - p.second.y);
+                    closest = std::min(closest, std::max(dx, dy) * float(r.size));
+                }
+            EXPECT_GE(closest, 2.99f) << mesh.name << " at " << density << " texels/m: " << charts.size()
+                                      << " charts in " << r.size << "² texels";
+        }
+    }
+}
+
+TEST(LightmapAtlas, TheBakeKeyFollowsTheLightmapUvsAndTheChartGap) {
+    // Re-packed charts must re-bake: the lightmap's key hashes uv1 (which references' keys leave out).
+    sc::Scene s = quads();
+    const LightmapBakeSettings settings;
+    const uint64_t key = lightmapCacheKey(s, settings, 1).hash;
+    s.vertices[1].uv1.x *= 0.5f;
+    const uint64_t moved = lightmapCacheKey(s, settings, 1).hash;
+    EXPECT_NE(moved, key);
+    s.meshes[0].lightmapChartGap = 0.05f;
+    EXPECT_NE(lightmapCacheKey(s, settings, 1).hash, moved);
+    LightmapBakeSettings wider = settings;
+    wider.atlas.minChartGap = 4.0f;
+    EXPECT_NE(lightmapCacheKey(s, wider, 1).hash, lightmapCacheKey(s, settings, 1).hash);
 }
 
 TEST(LightmapAtlas, BadOptionsAreUserErrors) {

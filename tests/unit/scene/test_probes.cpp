@@ -346,17 +346,47 @@ TEST(ProbeHash, EveryFieldChangesTheContentHash) {
 }
 
 TEST(ProbeHash, ProbesDoNotChangeTheLightTransportHash) {
-    // The lightmap bake is keyed by lightTransportHash(): moving or adding a probe must not re-bake, while any
-    // other content (here one vertex) still does.
+    // The lightmap bake is keyed by lightmapHash(), path-traced references by lightTransportHash(): moving or
+    // adding a probe must re-bake neither, while any other content (here one vertex) still does.
     Scene scene = loadGltf(test::dataDir() / "quad.gltf");
-    const uint64_t without = scene.lightTransportHash();
+    const uint64_t without = scene.lightTransportHash(), lightmapWithout = scene.lightmapHash();
     scene.probes = oddProbes();
     EXPECT_EQ(scene.lightTransportHash(), without);
+    EXPECT_EQ(scene.lightmapHash(), lightmapWithout);
     scene.probes[0].position.x += 0.5f;
     EXPECT_EQ(scene.lightTransportHash(), without);
+    EXPECT_EQ(scene.lightmapHash(), lightmapWithout);
     EXPECT_NE(scene.contentHash(), scene.lightTransportHash());
     scene.vertices[0].position.x += 0.01f;
     EXPECT_NE(scene.lightTransportHash(), without);
+    EXPECT_NE(scene.lightmapHash(), lightmapWithout);
+}
+
+TEST(ProbeHash, LightmapUvsChangeTheLightmapHashButNotTheLightTransportHash) {
+    // Re-packing the lightmap charts re-bakes the lightmap but keeps a converged reference (hours on a CPU) — unless
+    // a material samples texture set 1, when uv1 is light transport too.
+    Scene scene = loadGltf(test::dataDir() / "quad.gltf"); // its metallic-roughness texture reads TEXCOORD_1
+    for (MaterialLayer& l : scene.materials[scene.primitives[0].material].layers)
+        for (TextureRef* r : {&l.albedo.texture, &l.normal.texture, &l.shininess.texture, &l.metallic.texture,
+                              &l.cavity.texture, &l.mask.texture})
+            r->uvSet = 0;
+    ASSERT_FALSE(usesUvSet(scene.materials[scene.primitives[0].material], 1));
+    const uint64_t transport = scene.lightTransportHash(), lightmap = scene.lightmapHash(),
+                   content = scene.contentHash();
+    scene.vertices[scene.primitives[0].vertexOffset].uv1.x += 0.25f;
+    EXPECT_EQ(scene.lightTransportHash(), transport);
+    EXPECT_NE(scene.lightmapHash(), lightmap);
+    EXPECT_NE(scene.contentHash(), content);
+    const uint64_t movedUv = scene.lightmapHash();
+    scene.meshes[0].lightmapChartGap = 0.01f;
+    EXPECT_EQ(scene.lightTransportHash(), transport);
+    EXPECT_NE(scene.lightmapHash(), movedUv);
+
+    Scene sampled = loadGltf(test::dataDir() / "quad.gltf");
+    ASSERT_TRUE(usesUvSet(sampled.materials[sampled.primitives[0].material], 1));
+    const uint64_t sampledTransport = sampled.lightTransportHash();
+    sampled.vertices[sampled.primitives[0].vertexOffset].uv1.x += 0.25f;
+    EXPECT_NE(sampled.lightTransportHash(), sampledTransport);
 }
 
 } // namespace
