@@ -199,6 +199,8 @@ void Exporter::meshes() {
             jm["primitives"].push_back(jp);
         }
         if (!mesh.weights.empty()) jm["weights"] = mesh.weights;
+        // The gap between its lightmap charts (TEXCOORD_1), so that the atlas keeps it wide after a round trip.
+        if (mesh.lightmapChartGap > 0.0f) jm["extras"][gltf::kExtrasKey]["lightmapChartGap"] = mesh.lightmapChartGap;
         mDoc["meshes"].push_back(jm);
     }
 }

@@ -269,6 +269,17 @@ void loadMeshes(LoadContext& ctx) {
                      std::to_string(w.size()) + " weights; expected " + std::to_string(targets) +
                          " (one per morph target)");
         }
+        // extras.vitrine.lightmapChartGap: the gap between its lightmap charts in uv units (vitrine's own export).
+        if (const Json* extras = object(ctx, ctx.doc["meshes"][i], "extras", "meshes[" + std::to_string(i) + "]")) {
+            const std::string e = "meshes[" + std::to_string(i) + "].extras";
+            if (const Json* ours = object(ctx, *extras, kExtrasKey, e)) {
+                const double gap = number(ctx, *ours, "lightmapChartGap", 0.0, e + "." + kExtrasKey);
+                if (!(gap >= 0.0 && gap < 1.0))
+                    ctx.fail(e + "." + kExtrasKey + ".lightmapChartGap",
+                             "expected a gap in uv units in [0, 1), got " + std::to_string(gap));
+                mesh.lightmapChartGap = static_cast<float>(gap);
+            }
+        }
         mesh.weights.assign(targets, 0.0f);
         for (size_t k = 0; k < w.size(); ++k)
             mesh.weights[k] = static_cast<float>(w[k]);

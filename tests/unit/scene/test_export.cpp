@@ -46,6 +46,19 @@ TEST(Export, LayerExtensionRoundTrips) {
     EXPECT_FALSE(doc.contains("extensionsRequired"));
 }
 
+TEST(Export, LightmapChartGapRoundTrips) {
+    // The museum's meshes say how far apart their lightmap charts are; a round trip keeps it (and so the atlas's
+    // 3-texel gaps, and the content hash).
+    Scene original = loadGltf(test::dataDir() / "quad.gltf");
+    original.meshes[0].lightmapChartGap = 0.05f;
+    auto file = test::scratchDir() / "chart_gap.glb";
+    exportGlb(original, file);
+    Scene back = loadGltf(file);
+    EXPECT_EQ(back.meshes[0].lightmapChartGap, 0.05f);
+    EXPECT_EQ(back.contentHash(), original.contentHash());
+    EXPECT_EQ(glbJson(file)["meshes"][0]["extras"]["vitrine"]["lightmapChartGap"].get<float>(), 0.05f);
+}
+
 TEST(Export, QuadRoundTripsExactly) {
     Scene original = loadGltf(test::dataDir() / "quad.gltf");
     auto file = test::scratchDir() / "quad.glb";

@@ -38,6 +38,17 @@ protected:
     std::vector<uint8_t> mBuffer;
 };
 
+TEST_F(GltfErrors, LightmapChartGapMustBeAUvDistance) {
+    Json doc = mDoc;
+    doc["meshes"][0]["extras"]["vitrine"]["lightmapChartGap"] = -0.5;
+    const auto negative = write("negative_gap.gltf", doc);
+    expectUserError([&] { loadGltf(negative); },
+                    {"negative_gap.gltf", "meshes[0].extras.vitrine.lightmapChartGap", "[0, 1)"});
+    doc["meshes"][0]["extras"]["vitrine"]["lightmapChartGap"] = "wide";
+    const auto text = write("text_gap.gltf", doc);
+    expectUserError([&] { loadGltf(text); }, {"text_gap.gltf", "lightmapChartGap", "expected a number"});
+}
+
 TEST_F(GltfErrors, BadJson) {
     expectUserError([] { loadGltf(test::dataDir() / "bad_json.gltf"); }, {"bad_json.gltf", "JSON", "not valid JSON"});
 }
