@@ -270,8 +270,9 @@ void loadMeshes(LoadContext& ctx) {
                          " (one per morph target)");
         }
         // extras.vitrine.lightmapChartGap: the gap between its lightmap charts in uv units (vitrine's own export).
-        if (const Json* extras = object(ctx, ctx.doc["meshes"][i], "extras", "meshes[" + std::to_string(i) + "]")) {
-            const std::string e = "meshes[" + std::to_string(i) + "].extras";
+        const std::string element = "meshes[" + std::to_string(i) + "]";
+        if (const Json* extras = object(ctx, ctx.doc["meshes"][i], "extras", element)) {
+            const std::string e = element + ".extras";
             if (const Json* ours = object(ctx, *extras, kExtrasKey, e)) {
                 const double gap = number(ctx, *ours, "lightmapChartGap", 0.0, e + "." + kExtrasKey);
                 if (!(gap >= 0.0 && gap < 1.0))

@@ -269,7 +269,7 @@ private:
             logWarning("scene '" + scene.name + "': the lightmap charts of mesh '" +
                        scene.meshes[scene.instances[instance].mesh].name + "' are " + line +
                        " at its region's largest size: their borders may take some of their neighbours' light; "
-                       "lower texels_per_meter");
+                       "its lightmap UVs need wider gaps between charts");
         }
 
         bake::BakedLighting out;
