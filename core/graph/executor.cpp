@@ -97,6 +97,7 @@ public:
     Context& gpu() override { return mEx.mCtx; }
     VkCommandBuffer cmd() override { return mCmd; }
     uint32_t frameIndex() const override { return mEx.mFrame; }
+    bool stopRequested() const override { return mEx.mStop && mEx.mStop(); }
     const Params& params() const override { return *pass().params; }
     bool hasInput(const std::string& port) const override { return findUse(port, false) != nullptr; }
     bool inputValid(const std::string& port) const override {
@@ -672,6 +673,11 @@ uint32_t Executor::run(const RunOptions& options) {
     }
     std::unique_ptr<Progress> progress;
     if (options.progress) progress = std::make_unique<Progress>("rendering", frames);
+    mStop = options.stop;
+    struct ClearStop {
+        std::function<bool()>& stop;
+        ~ClearStop() { stop = nullptr; }
+    } clearStop{mStop};
     VkCommandBuffer cmd = mCtx.allocateCommandBuffer();
     for (mFrame = 0; mFrame < frames; ++mFrame) {
         auto recordStart = Clock::now();

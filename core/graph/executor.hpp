@@ -110,6 +110,7 @@ private:
     MemoryStats mMemory;
     double mPipelineMs = 0.0;
     uint32_t mFrame = 0;
+    std::function<bool()> mStop;          // RunOptions::stop of the run in progress (ExecuteContext::stopRequested)
     std::vector<GpuBuffer> mFrameStaging; // uploads recorded this frame
     ShaderCompiler& mShaders;
     // setUniforms() data: one host-visible buffer per executor, rewound every frame (one frame in

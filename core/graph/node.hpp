@@ -102,6 +102,9 @@ public:
     virtual VkCommandBuffer cmd() = 0;
     virtual uint32_t frameIndex() const = 0;
     virtual const Params& params() const = 0;
+    // True once the run was asked to stop (Ctrl-C in `vitrine run`: RunOptions::stop). The run ends after this frame;
+    // long work inside it (render.pathtrace converging) may end early and keep what it has.
+    virtual bool stopRequested() const { return false; }
     virtual bool hasInput(const std::string& port) const = 0;
     // False when the input reads `x@prev` and no previous frame exists yet (it reads zeros).
     virtual bool inputValid(const std::string& port) const = 0;

@@ -161,7 +161,7 @@ void TwinNode::executeConverge(ExecuteContext& ctx) {
     hashParams(hasher, p);
     const BakeKey key{"reference", hasher.result()};
     if (!mConvergedKey || *mConvergedKey != key.hash) {
-        if (!loadConverged(key, mTwin.type, w, h, mAccumulation)) {
+        {
             ConvergeRun run;
             run.node = mTwin.type;
             run.what = mTwin.what;
@@ -173,9 +173,9 @@ void TwinNode::executeConverge(ExecuteContext& ctx) {
             run.batch = static_cast<uint32_t>(p.getInt("spp"));
             run.seed = static_cast<uint32_t>(p.getInt("seed"));
             run.report = p.getBool("report");
-            if (convergeAccumulation(run, mAccumulation,
-                                     [&](uint32_t spp, uint32_t seed, uint32_t) { traceBatch(ctx, sky, spp, seed); }))
-                storeConverged(key, mTwin.type, mAccumulation);
+            run.stop = [&ctx] { return ctx.stopRequested(); };
+            convergeCached(key, run, mAccumulation,
+                           [&](uint32_t spp, uint32_t seed, uint32_t) { traceBatch(ctx, sky, spp, seed); });
         }
         mConvergedKey = key.hash;
     }

@@ -64,7 +64,7 @@ const CpuAccumulation& TwinTracer::run(ExecuteContext& ctx, const std::string& n
         key.value(p.getFloat("target_noise"));
         const BakeKey bakeKey{"reference", key.result()};
         if (!mConvergedKey || *mConvergedKey != bakeKey.hash) {
-            if (!loadConverged(bakeKey, node, s.width, s.height, mAccumulation)) {
+            {
                 ConvergeRun run;
                 run.node = node;
                 run.what = "estimating " + node;
@@ -76,13 +76,13 @@ const CpuAccumulation& TwinTracer::run(ExecuteContext& ctx, const std::string& n
                 run.batch = spp;
                 run.seed = seed;
                 run.report = report;
-                const bool converged = convergeAccumulation(run, mAccumulation, [&](uint32_t n, uint32_t batchSeed, uint32_t) {
+                run.stop = [&ctx] { return ctx.stopRequested(); };
+                convergeCached(bakeKey, run, mAccumulation, [&](uint32_t n, uint32_t batchSeed, uint32_t) {
                     CpuTraceSettings b = s;
                     b.spp = n;
                     b.seed = batchSeed;
                     cpu.estimate(b, sky, mAccumulation, sample);
                 });
-                if (converged) storeConverged(bakeKey, node, mAccumulation);
             }
             mConvergedKey = bakeKey.hash;
         }

@@ -8,7 +8,10 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <memory>
+#include <optional>
 
 namespace vitrine {
 
@@ -39,16 +42,16 @@ void appendConvergeParams(std::vector<ParamSpec>& params) {
                       1e7,
                       {},
                       "With target_noise: stop after this long even if the target is not reached (0: no limit); a "
-                      "result stopped early is not cached"});
+                      "result stopped early (or by Ctrl-C) is kept in the bake cache as a partial result that the next "
+                      "run with the same inputs resumes"});
 }
 
 uint32_t convergeBatchSeed(uint32_t seed, uint32_t b) { return (seed * 0x85EBCA6Bu + 0x27D4EB2Fu) ^ (b * 0x9E3779B9u); }
 
-bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
-                          const std::function<void(uint32_t, uint32_t, uint32_t)>& traceBatch) {
+ConvergeProgress convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc, const TraceBatchFn& traceBatch) {
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-    acc.reset(run.width, run.height);
+    if (run.firstBatch == 0) acc.reset(run.width, run.height);
     std::unique_ptr<Progress> bar;
     if (run.report) {
         char label[200];
@@ -57,15 +60,20 @@ bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
         bar = std::make_unique<Progress>(label, 1000);
     }
     size_t shown = 0;
-    double samples = 0.0, noise = 1.0, p90 = 0.0;
+    // samples: in the accumulation (a resumed run's included); traced: by this run.
+    double samples = double(run.firstBatch) * run.batch, traced = 0.0, noise = 1.0, p90 = 0.0;
     double firstBatchEnd = 0.0; // seconds: the first batch carries one-off costs (pipelines, first touches of memory)
-    bool announced = false, converged = false;
-    for (uint32_t b = 0;; ++b) {
+    bool announced = false;
+    ConvergeProgress progress;
+    const char* stoppedBy = "max_seconds ran out";
+    uint32_t b = run.firstBatch;
+    for (;; ++b) {
         traceBatch(run.batch, convergeBatchSeed(run.seed, b), b);
         samples += run.batch;
+        traced += run.batch;
         noise = acc.relativeNoise(&p90);
         const double t = elapsed();
-        if (b == 0) firstBatchEnd = t;
+        if (b == run.firstBatch) firstBatchEnd = t;
         // Noise falls as 1 / sqrt(samples): the samples the target needs, and the time that takes.
         const double needed = std::max(run.minSpp, samples * (noise / run.target) * (noise / run.target));
         {
@@ -80,14 +88,14 @@ bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
         // target 0.036, lavapipe's CPU tracer): after the first 16 spp it predicted 6,574 spp and 204 s for what took
         // 11,520 spp and 90 s; announced at 64 spp, 9,189 spp and 69 s for a run of 11,520 spp and 85 s. The progress
         // bar's time left follows the rate as it goes.
-        if (run.report && !announced && b > 0 && (samples >= run.minSpp || noise <= run.target)) {
-            const double perSample = (t - firstBatchEnd) / (samples - run.batch);
+        if (run.report && !announced && b > run.firstBatch && (samples >= run.minSpp || noise <= run.target)) {
+            const double perSample = (t - firstBatchEnd) / (traced - run.batch);
             char line[280];
             std::snprintf(line, sizeof line,
                           "%s: %.0f spp in %.1f s, standard error %.1f %% (median); the target %.2f %% needs about "
                           "%.0f spp: about %.0f s on this machine (estimates from few samples tend to be low)",
-                          run.node.c_str(), samples, t, noise * 100.0, run.target * 100.0, needed,
-                          t + std::max(0.0, needed - samples) * perSample);
+                          run.node.c_str(), samples, run.secondsBefore + t, noise * 100.0, run.target * 100.0, needed,
+                          run.secondsBefore + t + std::max(0.0, needed - samples) * perSample);
             std::fprintf(stderr, "\n");
             logInfo(line);
             announced = true;
@@ -98,28 +106,47 @@ bool convergeAccumulation(const ConvergeRun& run, CpuAccumulation& acc,
             shown = std::max(shown, now);
         }
         if (samples >= run.minSpp && noise <= run.target) {
-            converged = true;
+            progress.converged = true;
             break;
         }
         if (run.maxSeconds > 0.0 && t >= run.maxSeconds) break;
+        if (run.stop && run.stop()) {
+            stoppedBy = "asked to stop";
+            break;
+        }
     }
     if (bar) {
         bar->advance(1000 - shown);
         bar.reset();
     }
-    char line[280];
-    std::snprintf(line, sizeof line,
-                  "%s: %s after %.0f spp in %.1f s: standard error %.2f %% of the pixel's mean (median), %.2f %% "
-                  "(p90)%s",
-                  run.node.c_str(), converged ? "converged" : "stopped at max_seconds", samples, elapsed(),
-                  noise * 100.0, p90 * 100.0, converged ? "; stored in the bake cache" : ", above the target: not cached");
-    if (converged) logInfo(line);
-    else logWarning(line);
-    return converged;
+    progress.batches = b + 1;
+    progress.seconds = run.secondsBefore + elapsed();
+    char line[320];
+    if (progress.converged)
+        std::snprintf(line, sizeof line,
+                      "%s: converged after %.0f spp in %.1f s%s: standard error %.2f %% of the pixel's mean (median), "
+                      "%.2f %% (p90)",
+                      run.node.c_str(), samples, progress.seconds, run.firstBatch > 0 ? " (over several runs)" : "",
+                      noise * 100.0, p90 * 100.0);
+    else
+        std::snprintf(line, sizeof line,
+                      "%s: stopped (%s) after %.0f spp in %.1f s: standard error %.2f %% of the pixel's mean (median), "
+                      "%.2f %% (p90), above the target %.2f %%",
+                      run.node.c_str(), stoppedBy, samples, progress.seconds, noise * 100.0, p90 * 100.0,
+                      run.target * 100.0);
+    (progress.converged ? logInfo : logWarning)(line);
+    return progress;
 }
 
-bool loadConverged(const BakeKey& key, const std::string& node, int width, int height, CpuAccumulation& acc) {
-    const BakeCache cache(defaultCacheDir());
+BakeKey partialKey(const BakeKey& key) {
+    return BakeKey{key.kind + "_partial", key.hash};
+}
+
+namespace {
+
+// The converged result under `key`, if the bake cache has one of this size (logs the load time and its noise).
+bool loadConverged(const BakeCache& cache, const BakeKey& key, const std::string& node, int width, int height,
+                   CpuAccumulation& acc) {
     const auto loadStart = std::chrono::steady_clock::now();
     std::optional<std::vector<uint8_t>> bytes = cache.get(key);
     if (!bytes || !acc.deserialize(*bytes, width, height)) return false;
@@ -136,10 +163,83 @@ bool loadConverged(const BakeKey& key, const std::string& node, int width, int h
     return true;
 }
 
-void storeConverged(const BakeKey& key, const std::string& node, const CpuAccumulation& acc) {
+// A partial result: the accumulation's bytes, then this trailer.
+struct PartialTrailer {
+    uint32_t magic = 0x54524150u; // "PART"
+    uint32_t batches = 0;         // batches 0 .. batches - 1 are in the accumulation
+    uint32_t batch = 0;           // samples per pixel per batch (also in the key: a check)
+    uint32_t reserved = 0;
+    double seconds = 0.0; // what they took, over every run so far
+};
+
+std::vector<uint8_t> serializePartial(const CpuAccumulation& acc, const ConvergeProgress& progress, uint32_t batch) {
+    std::vector<uint8_t> bytes = acc.serialize();
+    PartialTrailer trailer;
+    trailer.batches = progress.batches;
+    trailer.batch = batch;
+    trailer.seconds = progress.seconds;
+    const size_t at = bytes.size();
+    bytes.resize(at + sizeof trailer);
+    std::memcpy(bytes.data() + at, &trailer, sizeof trailer);
+    return bytes;
+}
+
+// The partial result under partialKey(key) into acc and its trailer; nullopt (acc unchanged) when there is none, or
+// it is of another size, batch or format.
+std::optional<PartialTrailer> loadPartial(const BakeCache& cache, const BakeKey& key, const ConvergeRun& run,
+                                          CpuAccumulation& acc) {
+    std::optional<std::vector<uint8_t>> bytes = cache.get(partialKey(key));
+    if (!bytes || bytes->size() < sizeof(PartialTrailer)) return std::nullopt;
+    PartialTrailer trailer;
+    std::memcpy(&trailer, bytes->data() + bytes->size() - sizeof trailer, sizeof trailer);
+    if (trailer.magic != PartialTrailer{}.magic || trailer.batch != run.batch || trailer.batches == 0)
+        return std::nullopt;
+    bytes->resize(bytes->size() - sizeof trailer);
+    if (!acc.deserialize(*bytes, run.width, run.height)) return std::nullopt;
+    return trailer;
+}
+
+} // namespace
+
+bool convergeCached(const BakeKey& key, const ConvergeRun& runIn, CpuAccumulation& acc, const TraceBatchFn& traceBatch,
+                    const ConvergeHooks& hooks) {
     const BakeCache cache(defaultCacheDir());
-    if (!cache.put(key, acc.serialize()))
-        logWarning(node + ": could not write the converged result to the bake cache under " + cache.dir().string());
+    if (loadConverged(cache, key, runIn.node, runIn.width, runIn.height, acc)) return true;
+    ConvergeRun run = runIn;
+    run.firstBatch = 0;
+    run.secondsBefore = 0.0;
+    if (std::optional<PartialTrailer> partial = loadPartial(cache, key, run, acc)) {
+        run.firstBatch = partial->batches;
+        run.secondsBefore = partial->seconds;
+        double p90 = 0.0;
+        const double noise = acc.relativeNoise(&p90);
+        char line[280];
+        std::snprintf(line, sizeof line,
+                      "%s: resuming the partial result an earlier run stopped with (%.0f spp in %.1f s, standard "
+                      "error %.2f %% (median)): %s",
+                      run.node.c_str(), double(run.firstBatch) * run.batch, run.secondsBefore, noise * 100.0,
+                      cache.pathOf(partialKey(key)).string().c_str());
+        logInfo(line);
+        if (hooks.resumed) hooks.resumed(acc);
+    }
+    const ConvergeProgress progress = convergeAccumulation(run, acc, traceBatch);
+    if (hooks.finished) hooks.finished(acc);
+    if (progress.converged) {
+        if (!cache.put(key, acc.serialize()))
+            logWarning(run.node + ": could not write the converged result to the bake cache under " +
+                       cache.dir().string());
+        std::error_code ec;
+        std::filesystem::remove(cache.pathOf(partialKey(key)), ec);
+        return true;
+    }
+    if (cache.put(partialKey(key), serializePartial(acc, progress, run.batch)))
+        logWarning(run.node +
+                   ": kept the partial result in the bake cache; the next run with the same inputs resumes "
+                   "from it (" +
+                   cache.pathOf(partialKey(key)).string() + ")");
+    else
+        logWarning(run.node + ": could not write the partial result to the bake cache under " + cache.dir().string());
+    return false;
 }
 
 void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFrame& cam, const CpuSky& sky, int width,

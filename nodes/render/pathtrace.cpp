@@ -264,17 +264,16 @@ private:
         const CpuSky sky = readCpuSky(ctx);
         const BakeKey key = referenceKey(ctx, cpu, sky, out);
         if (!mConvergedKey || *mConvergedKey != key.hash) {
-            const int w = static_cast<int>(out.width), h = static_cast<int>(out.height);
-            if (!loadConverged(key, "render.pathtrace", w, h, mAccumulation) && converge(ctx, cpu, sky, out))
-                storeConverged(key, "render.pathtrace", mAccumulation);
+            converge(ctx, cpu, sky, out, key);
             mConvergedKey = key.hash;
         }
         mUpload.upload(ctx, mStorePipeline, mAccumulation);
     }
 
-    // Traces batches of `spp` samples into mAccumulation until the target and min_spp hold (true) or max_seconds
-    // ran out (false).
-    bool converge(ExecuteContext& ctx, bool cpu, const CpuSky& sky, const ImageDesc& out) {
+    // The converged result under `key` from the cache, or traced in batches of `spp` samples into mAccumulation (from
+    // a stopped run's partial result if the cache has one) until the target and min_spp hold (true) or max_seconds
+    // ran out or the run was asked to stop (false).
+    bool converge(ExecuteContext& ctx, bool cpu, const CpuSky& sky, const ImageDesc& out, const BakeKey& key) {
         const Params& p = ctx.params();
         ConvergeRun run;
         run.node = "render.pathtrace";
@@ -288,21 +287,30 @@ private:
         run.batch = static_cast<uint32_t>(p.getInt("spp"));
         run.seed = static_cast<uint32_t>(p.getInt("seed"));
         run.report = p.getBool("report");
-        const bool converged = convergeAccumulation(run, mAccumulation, [&](uint32_t spp, uint32_t seed, uint32_t b) {
-            if (cpu) {
-                traceCpuBatch(ctx, sky, out, spp, seed);
-            } else {
-                recordGpuSamples(ctx, spp, b * 1024u, b > 0, true, seed);
-                ctx.splitSubmission();
-                const Image stats = readImage(ctx.gpu(), ctx.output("stats"), VK_IMAGE_LAYOUT_GENERAL);
-                std::memcpy(mAccumulation.stats.data(), stats.pixels.data(), stats.pixels.size() * sizeof(float));
-            }
-        });
+        run.stop = [&ctx] { return ctx.stopRequested(); };
+        ConvergeHooks hooks;
         if (!cpu) {
-            const Image color = readImage(ctx.gpu(), ctx.output("color"), VK_IMAGE_LAYOUT_GENERAL);
-            std::memcpy(mAccumulation.color.data(), color.pixels.data(), color.pixels.size() * sizeof(float));
+            // The GPU tracer accumulates in its outputs: a resumed partial result goes there first (its first batch
+            // b > 0 continues what they hold, after a barrier), and the colour comes back from there at the end.
+            hooks.resumed = [&](const CpuAccumulation& acc) { mUpload.upload(ctx, mStorePipeline, acc); };
+            hooks.finished = [&](CpuAccumulation& acc) {
+                const Image color = readImage(ctx.gpu(), ctx.output("color"), VK_IMAGE_LAYOUT_GENERAL);
+                std::memcpy(acc.color.data(), color.pixels.data(), color.pixels.size() * sizeof(float));
+            };
         }
-        return converged;
+        return convergeCached(
+            key, run, mAccumulation,
+            [&](uint32_t spp, uint32_t seed, uint32_t b) {
+                if (cpu) {
+                    traceCpuBatch(ctx, sky, out, spp, seed);
+                } else {
+                    recordGpuSamples(ctx, spp, b * 1024u, b > 0, true, seed);
+                    ctx.splitSubmission();
+                    const Image stats = readImage(ctx.gpu(), ctx.output("stats"), VK_IMAGE_LAYOUT_GENERAL);
+                    std::memcpy(mAccumulation.stats.data(), stats.pixels.data(), stats.pixels.size() * sizeof(float));
+                }
+            },
+            hooks);
     }
 
     void traceCpuBatch(ExecuteContext& ctx, const CpuSky& sky, const ImageDesc& out, uint32_t spp, uint32_t seed) {

@@ -68,7 +68,7 @@ void GpuTest::TearDown() {
 
 namespace {
 
-std::map<std::string, Image> runCompiled(CompiledGraph graph) {
+std::map<std::string, Image> runCompiled(CompiledGraph graph, std::function<bool()> stop = {}) {
     ShaderCompiler shaders;
     Executor executor(gpu(), graph, shaders);
     std::map<std::string, Image> out;
@@ -76,15 +76,16 @@ std::map<std::string, Image> runCompiled(CompiledGraph graph) {
     options.progress = false;
     options.write = {graph.desc.frame.frames - 1};
     options.onOutput = [&](uint32_t, const std::string& name, const Image& image) { out[name] = image; };
+    options.stop = std::move(stop);
     executor.run(options);
     return out;
 }
 
 } // namespace
 
-std::map<std::string, Image> runGraph(const nlohmann::json& doc) {
+std::map<std::string, Image> runGraph(const nlohmann::json& doc, std::function<bool()> stop) {
     GraphDesc desc = validateGraph(doc, "test-graph.json", NodeRegistry::global());
-    return runCompiled(compileGraph(std::move(desc)));
+    return runCompiled(compileGraph(std::move(desc)), std::move(stop));
 }
 
 std::map<std::string, Image> runGraphFile(const std::string& path, const std::vector<std::string>& sets) {

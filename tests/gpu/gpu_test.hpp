@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -31,8 +32,9 @@ private:
     size_t mMessagesBefore = 0;
 };
 
-// Validates, compiles and runs a graph given as JSON; returns every graph output of the last frame.
-std::map<std::string, Image> runGraph(const nlohmann::json& graph);
+// Validates, compiles and runs a graph given as JSON; returns every graph output of the last frame. stop: the run's
+// RunOptions::stop (what Ctrl-C sets in `vitrine run`).
+std::map<std::string, Image> runGraph(const nlohmann::json& graph, std::function<bool()> stop = {});
 std::map<std::string, Image> runGraphFile(const std::string& path, const std::vector<std::string>& sets = {});
 
 // Finalizes and validates a scene built in a test and writes it as <name>.glb into a scratch folder of

@@ -881,6 +881,58 @@ TEST_F(PathTraceCpu, ConvergedResultIsCachedAndTracedAgainWhenAnInputChanges) {
     std::filesystem::remove_all(cacheDir);
 }
 
+// target_noise in pieces: a run asked to stop (RunOptions::stop, what Ctrl-C sets in `vitrine run`) part way ends after
+// its batch, keeps its partial result in the bake cache (not as converged) and the next run resumes it from there;
+// batch b has the same seed whichever run traces it, so the result is bit for bit that of one run straight through
+// (a second scratch cache). On both tracers: the GPU one gets the partial result uploaded into its outputs first.
+PATHTRACE_TEST(AStoppedConvergenceIsResumedToTheResultOfOneRun) {
+    const int W = 16, H = 16;
+    const auto glb = boxRoom();
+    const json params = {{"spp", 8}, {"seed", 3}, {"target_noise", 0.25}, {"min_spp", 48}};
+    auto inCache = [](const char* name) {
+        const auto dir = std::filesystem::temp_directory_path() / name;
+        std::filesystem::remove_all(dir);
+        setenv("VITRINE_CACHE_DIR", dir.c_str(), 1);
+        return dir;
+    };
+    auto count = [](const std::filesystem::path& dir, const char* kind) {
+        size_t n = 0;
+        std::error_code ec;
+        for (const auto& e : std::filesystem::directory_iterator(dir / "bake" / kind, ec))
+            n += e.path().extension() == ".bin";
+        return n;
+    };
+    const char* old = std::getenv("VITRINE_CACHE_DIR");
+    const std::string saved = old ? old : "";
+    const auto straightDir = inCache("vitrine_test_resume_straight");
+    testing::internal::CaptureStderr();
+    const Image straight = runGraph(traceGraph(glb, uniformSky(glb, 1.0), params, W, H)).at("color");
+    std::string log = testing::internal::GetCapturedStderr();
+    ASSERT_NE(log.find("render.pathtrace: converged after"), std::string::npos) << log;
+    const auto dir = inCache("vitrine_test_resume_pieces");
+    int asked = 0;
+    testing::internal::CaptureStderr();
+    runGraph(traceGraph(glb, uniformSky(glb, 1.0), params, W, H), [&] { return ++asked >= 2; });
+    log = testing::internal::GetCapturedStderr();
+    EXPECT_NE(log.find("stopped (asked to stop) after 16 spp"), std::string::npos) << log;
+    EXPECT_EQ(count(dir, "reference"), 0u) << log;
+    EXPECT_EQ(count(dir, "reference_partial"), 1u) << log;
+    testing::internal::CaptureStderr();
+    const Image resumed = runGraph(traceGraph(glb, uniformSky(glb, 1.0), params, W, H)).at("color");
+    log = testing::internal::GetCapturedStderr();
+    EXPECT_NE(log.find("resuming the partial result an earlier run stopped with (16 spp"), std::string::npos) << log;
+    EXPECT_NE(log.find("render.pathtrace: converged after"), std::string::npos) << log;
+    EXPECT_EQ(resumed.pixels, straight.pixels) << "resumed in pieces differs from one run";
+    EXPECT_EQ(count(dir, "reference"), 1u) << log;
+    EXPECT_EQ(count(dir, "reference_partial"), 0u) << log;
+    if (old)
+        setenv("VITRINE_CACHE_DIR", saved.c_str(), 1);
+    else
+        unsetenv("VITRINE_CACHE_DIR");
+    std::filesystem::remove_all(straightDir);
+    std::filesystem::remove_all(dir);
+}
+
 // Accumulation through color@prev / stats@prev with a still camera: after 16 frames of 4 samples the
 // count is 64, the estimated standard error is ~1/4 of one frame's (1/sqrt(N)), and the means agree (the
 // rough plane has no closed form; one frame's mean over the plane is within 5 % of 16 frames'). With the camera moving

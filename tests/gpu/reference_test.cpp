@@ -187,6 +187,67 @@ TEST_F(Reference, DiffuseIndirectOfAUniformSkyIsPiL) {
     EXPECT_GT(n, 200);
 }
 
+// The twins converge in pieces like render.pathtrace (nodes/render/converge.hpp): stopped part way (RunOptions::stop,
+// what Ctrl-C sets), each keeps a partial result and the next run resumes it to the result of one run straight through,
+// bit for bit. reference.diffuse_indirect (nodes/reference/twin.cpp) and reference.ao (twin_tracer.cpp) under a square
+// occluder, each in its own scratch caches.
+TEST_F(Reference, StoppedTwinsAreResumedToTheResultOfOneRun) {
+    const int W = 24, H = 16;
+    SceneBuilder b("twin_resume");
+    b.node("plane",
+           static_cast<int32_t>(b.mesh("plane", floorQuad(), b.material("floor", glm::vec3(0.5f), 0.0f, 0.5f))));
+    std::vector<Tri> square;
+    addQuad(square, glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0));
+    b.node("square", static_cast<int32_t>(b.mesh("square", square, b.material("grey", glm::vec3(0.3f), 0.0f, 0.5f))));
+    b.camera({0.0f, 0.6f, 3.5f}, {0.0f, 0.0f, 0.0f}, 0.9f);
+    auto glb = b.write();
+    const json converge = {{"spp", 8}, {"target_noise", 0.2}, {"min_spp", 48}, {"report", false}};
+    json diffuse = twinNodes(glb, 100.0);
+    diffuse["twin"] = twinNode("reference.diffuse_indirect", converge);
+    json ao = twinNodes(glb, 100.0);
+    json aoParams = converge;
+    aoParams["radius"] = 1.5;
+    ao["twin"] = {
+        {"type", "reference.ao"}, {"in", {{"scene", "scene.scene"}, {"camera", "scene.camera"}}}, {"params", aoParams}};
+    const char* old = std::getenv("VITRINE_CACHE_DIR");
+    const std::string saved = old ? old : "";
+    for (const json* nodes : {&diffuse, &ao}) {
+        const std::string type = (*nodes)["twin"]["type"];
+        SCOPED_TRACE(type);
+        const json g = graph(*nodes, {{"color", "twin.color"}}, W, H);
+        auto inCache = [&](const std::string& name) {
+            const auto dir = std::filesystem::temp_directory_path() / ("vitrine_test_twin_resume_" + name);
+            std::filesystem::remove_all(dir);
+            setenv("VITRINE_CACHE_DIR", dir.c_str(), 1);
+            return dir;
+        };
+        const auto straightDir = inCache(type + "_straight");
+        testing::internal::CaptureStderr();
+        const Image straight = runGraph(g).at("color");
+        std::string log = testing::internal::GetCapturedStderr();
+        EXPECT_NE(log.find(type + ": converged after"), std::string::npos) << log;
+        const auto dir = inCache(type + "_pieces");
+        int asked = 0;
+        testing::internal::CaptureStderr();
+        runGraph(g, [&] { return ++asked >= 2; });
+        log = testing::internal::GetCapturedStderr();
+        EXPECT_NE(log.find(type + ": stopped (asked to stop) after 16 spp"), std::string::npos) << log;
+        testing::internal::CaptureStderr();
+        const Image resumed = runGraph(g).at("color");
+        log = testing::internal::GetCapturedStderr();
+        EXPECT_NE(log.find(type + ": resuming the partial result an earlier run stopped with (16 spp"),
+                  std::string::npos)
+            << log;
+        EXPECT_EQ(resumed.pixels, straight.pixels) << "resumed in pieces differs from one run";
+        std::filesystem::remove_all(straightDir);
+        std::filesystem::remove_all(dir);
+    }
+    if (old)
+        setenv("VITRINE_CACHE_DIR", saved.c_str(), 1);
+    else
+        unsetenv("VITRINE_CACHE_DIR");
+}
+
 // Under a black square (unlit, double sided: it emits and reflects nothing) of half size 1 at height 1, the floor's
 // irradiance is E = pi C (1 - F), F the form factor to the square. Bounds: the mean ratio over floor pixels within
 // 2 m of the square's centre within 1.5 %, at least 85 % of them within two estimated standard errors.

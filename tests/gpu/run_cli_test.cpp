@@ -198,6 +198,67 @@ TEST_P(RunInterrupted, StopsAtAFrameBoundaryWithExit130) {
     EXPECT_TRUE(temporaryFiles(out).empty()) << temporaryFiles(out).front();
 }
 
+// Ctrl-C while render.pathtrace converges to a target it cannot reach soon (the museum's reference at 32x18, target
+// 0.1 %): the run stops after the batch it is in, exits 130 and keeps its samples in the bake cache as a partial
+// result; the next run resumes from them (and, stopped by max_seconds this time, keeps the larger partial result).
+TEST(RunConverging, CtrlCKeepsThePartialResultAndTheNextRunResumesIt) {
+    const fs::path out = freshDir("run_converging_sigint");
+    const fs::path cache = out / "cache";
+    const char* old = std::getenv("VITRINE_CACHE_DIR");
+    const std::string saved = old ? old : "";
+    setenv("VITRINE_CACHE_DIR", cache.c_str(), 1);
+    const std::vector<std::string> args = {"run",      kSource + "/graphs/variants/museum_reference.json",
+                                           "--set",    "frame.width=32",
+                                           "--set",    "frame.height=18",
+                                           "--set",    "scene.params.texture_size=32",
+                                           "--set",    "pathtrace.params.target_noise=0.001",
+                                           "--verbose"};
+    std::vector<std::string> first = args;
+    first.insert(first.end(), {"--out", (out / "first").string()});
+    const pid_t pid = spawnVitrine(first, out / "first.log");
+    ASSERT_GT(pid, 0);
+    bool tracing = false;
+    for (int i = 0; i < 2400 && !tracing; ++i) {
+        tracing = readFile(out / "first.log").find("render.pathtrace: batch 1:") != std::string::npos;
+        if (!tracing) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    kill(pid, SIGINT);
+    int status = 0;
+    const bool ended = waitFor(pid, 120, status) == 0;
+    const std::string log = readFile(out / "first.log");
+    ASSERT_TRUE(tracing) << "never got to its second batch; log:\n" << log;
+    ASSERT_TRUE(ended) << "still running 120 s after Ctrl-C; log:\n" << log;
+    ASSERT_TRUE(WIFEXITED(status)) << log;
+    EXPECT_EQ(WEXITSTATUS(status), 130) << log;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(log, m, std::regex("stopped \\(asked to stop\\) after (\\d+) spp"))) << log;
+    const int stoppedAt = std::stoi(m[1]);
+    EXPECT_NE(log.find("kept the partial result in the bake cache"), std::string::npos) << log;
+    size_t partials = 0;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(cache / "bake" / "reference_partial", ec))
+        partials += e.path().extension() == ".bin";
+    EXPECT_EQ(partials, 1u) << log;
+
+    std::vector<std::string> second = args;
+    second.insert(second.end(), {"--set", "pathtrace.params.max_seconds=0.5", "--out", (out / "second").string()});
+    const pid_t again = spawnVitrine(second, out / "second.log");
+    ASSERT_GT(again, 0);
+    ASSERT_EQ(waitFor(again, 300, status), 0) << readFile(out / "second.log");
+    const std::string log2 = readFile(out / "second.log");
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << log2;
+    EXPECT_NE(
+        log2.find("resuming the partial result an earlier run stopped with (" + std::to_string(stoppedAt) + " spp"),
+        std::string::npos)
+        << log2;
+    ASSERT_TRUE(std::regex_search(log2, m, std::regex("stopped \\(max_seconds ran out\\) after (\\d+) spp"))) << log2;
+    EXPECT_GT(std::stoi(m[1]), stoppedAt) << log2;
+    if (old)
+        setenv("VITRINE_CACHE_DIR", saved.c_str(), 1);
+    else
+        unsetenv("VITRINE_CACHE_DIR");
+}
+
 INSTANTIATE_TEST_SUITE_P(Signals, RunInterrupted, testing::Values(SIGINT, SIGTERM),
                          [](const testing::TestParamInfo<int>& info) {
                              return std::string(info.param == SIGINT ? "Sigint" : "Sigterm");

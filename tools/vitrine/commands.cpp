@@ -120,10 +120,17 @@ int runCommand(const Args& args) {
     InterruptHandlers interrupts;
     options.stop = [] { return InterruptHandlers::received() != 0; };
     const uint32_t ran = executor.run(options);
-    if (int signal = InterruptHandlers::received(); signal && ran < graph.desc.frame.frames) {
-        logWarning(std::string(signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)") +
-                   ": stopped after " + std::to_string(ran) + " of " + std::to_string(graph.desc.frame.frames) +
-                   " frames; the files of the finished frames are in " + out.dir().string());
+    if (int signal = InterruptHandlers::received(); signal) {
+        // A signal during the last frame still stops what in that frame can stop early (a converging path tracer
+        // keeps its partial result for the next run), so the run did not do all it was asked either.
+        const std::string what = signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)";
+        if (ran < graph.desc.frame.frames)
+            logWarning(what + ": stopped after " + std::to_string(ran) + " of " +
+                       std::to_string(graph.desc.frame.frames) + " frames; the files of the finished frames are in " +
+                       out.dir().string());
+        else
+            logWarning(what + " during the last frame, which finished with what it had; its files are in " +
+                       out.dir().string());
         return kExitInterrupted;
     }
     if (ctx.validationMessageCount() > 0) {

@@ -9,12 +9,14 @@
 #include "core/graph/loader.hpp"
 #include "core/image/io.hpp"
 #include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/interrupt.hpp"
 #include "tools/vitrine/output_dir.hpp"
 #include "tools/vitrine/render_output.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -272,6 +274,9 @@ int compareCommand(const Args& args) {
     std::vector<uint32_t> wanted;
     for (uint32_t f = range.first; f <= range.last; ++f)
         wanted.push_back(f);
+    // Ctrl-C stops the render in progress after its frame (a converging path tracer keeps its partial result in the
+    // bake cache, so the next compare resumes it) and then the comparison.
+    InterruptHandlers interrupts;
     for (Input* in : rendered) {
         if (in->graph) {
             if (!ctx) {
@@ -282,7 +287,15 @@ int compareCommand(const Args& args) {
             logInfo("rendering " + in->role + ": " + in->path.string() + " (output " + in->output + ", " +
                     std::to_string(frameCount) + " frame(s))");
             std::map<uint32_t, Image> frames =
-                renderOutput(*ctx, *shaders, *in->graph, in->output, frameCount, wanted, !args.has("quiet"));
+                renderOutput(*ctx, *shaders, *in->graph, in->output, frameCount, wanted, !args.has("quiet"), nullptr,
+                             [] { return InterruptHandlers::received() != 0; });
+            if (int signal = InterruptHandlers::received()) {
+                logWarning(std::string(signal == SIGINT ? "interrupted (SIGINT)" : "terminated (SIGTERM)") +
+                           " while rendering " + in->role +
+                           ": nothing compared (a converging path tracer kept what "
+                           "it traced in the bake cache; the next compare resumes it)");
+                return kExitInterrupted;
+            }
             for (uint32_t f : wanted)
                 in->frames.push_back(std::move(frames.at(f)));
         } else {

@@ -14,7 +14,8 @@ struct sigaction gPreviousInt, gPreviousTerm;
 extern "C" void onInterrupt(int signal) {
     gReceived = signal;
     // write(2) is async-signal-safe; stdio is not.
-    static const char kMessage[] = "\nvitrine: stopping after this frame (again to quit at once)\n";
+    static const char kMessage[] =
+        "\nvitrine: stopping after this frame (a converging path tracer keeps what it traced; again to quit at once)\n";
     ssize_t ignored = ::write(2, kMessage, sizeof kMessage - 1);
     (void)ignored;
 }

@@ -106,7 +106,7 @@ double sceneBuildMs(const CompiledGraph& graph) {
 
 std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, GraphDesc desc, const std::string& output,
                                        uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress,
-                                       RenderStats* stats) {
+                                       RenderStats* stats, std::function<bool()> stop) {
     using Clock = std::chrono::steady_clock;
     auto ms = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
     std::erase_if(desc.outputs, [&](const OutputDecl& o) { return o.name != output; });
@@ -125,6 +125,7 @@ std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, Gr
     options.write = frames;
     options.progress = progress;
     options.onOutput = [&](uint32_t frame, const std::string&, const Image& image) { images[frame] = image; };
+    options.stop = std::move(stop);
     t = Clock::now();
     executor.run(options);
     if (stats) {

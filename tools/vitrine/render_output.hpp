@@ -9,6 +9,7 @@
 #include "tools/vitrine/cli.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -54,9 +55,10 @@ struct RenderStats {
 double sceneBuildMs(const CompiledGraph& graph);
 
 // Compiles `desc` with only `output` kept (so nodes no other output needs are culled), runs `frameCount` frames and
-// returns the output at each of `frames` (all < frameCount).
+// returns the output at each of `frames` (all < frameCount). stop: the run's RunOptions::stop (Ctrl-C); a stopped run
+// may return fewer frames.
 std::map<uint32_t, Image> renderOutput(Context& ctx, ShaderCompiler& shaders, GraphDesc desc, const std::string& output,
                                        uint32_t frameCount, const std::vector<uint32_t>& frames, bool progress,
-                                       RenderStats* stats = nullptr);
+                                       RenderStats* stats = nullptr, std::function<bool()> stop = {});
 
 } // namespace vitrine::cli
