@@ -284,6 +284,59 @@ TEST_F(LightmapBake, PathsThatStartBehindAWallAreLeftOutOfTheTexelsMean) {
     }
 }
 
+// A closed box standing on the floor (1.5 m square, 1 m tall): the floor's texels under it start every path inside
+// geometry. They are hidden — given their visible neighbours' light by dilation, so that bilinear filtering at the
+// box's foot does not smear their darkness into the texels beside it — not baked black: every texel of the floor,
+// under the box or not, holds light. (Were the hidden ones baked, the 4 x 4 texels wholly under the box would be 0.)
+TEST_F(LightmapBake, TexelsUnderABoxTakeTheirNeighboursLight) {
+    const double C = 1000.0;
+    SceneBuilder b("bake_box_on_floor");
+    std::vector<Tri> floor;
+    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
+    for (Tri& t : floor)
+        for (scene::Vertex* v : {&t.a, &t.b, &t.c})
+            v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
+    const uint32_t floorMaterial = b.material("floor", glm::vec3(0.5f), 0.0f, 0.0f);
+    b.s.materials[floorMaterial].specular = 0.0f;
+    const uint32_t floorMesh = b.mesh("floor", floor, floorMaterial);
+    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
+    b.node("floor", static_cast<int32_t>(floorMesh));
+    // Its sides at 3.25 and 4.75 m: texel edges (4 texels per metre) lie on neither, so its border texels are partly
+    // covered and the 4 x 4 inside them wholly.
+    const uint32_t box = b.mesh("box", boxTris({0.75f, 0.5f, 0.75f}), b.material("box", glm::vec3(0.5f), 0.0f, 0.0f));
+    b.node("box", static_cast<int32_t>(box), {4.0f, 0.5f, 0.0f});
+    b.camera({4.0f, 3.0f, 6.0f}, {4.0f, 0.0f, 0.0f}, 0.9f);
+    b.sun({0.3f, 1.0f, 0.2f});
+    const fs::path glb = b.write();
+    const bake::LightmapRegion r = floorRegion(glb);
+    for (const char* backend : kBackends) {
+        SCOPED_TRACE(backend);
+        testing::internal::CaptureStderr();
+        auto out = runGraph(bakeGraph(glb, uniformSky(glb, C),
+                                      {{"samples", 16}, {"sun_scale", 0.0}, {"filter_iterations", 0}}, backend));
+        const std::string log = testing::internal::GetCapturedStderr();
+        const Image& lightmap = out.at("lightmap");
+        int dark = 0, under = 0;
+        double darkest = 1e30;
+        for (uint32_t j = 0; j < r.size; ++j)
+            for (uint32_t i = 0; i < r.size; ++i) {
+                const double value = lightmap.at(int(r.x + i), int(r.y + j))[0];
+                darkest = std::min(darkest, value);
+                dark += value < 0.1 * kPi * C ? 1 : 0;
+                // Texel centre -> floor position: wholly under the box when its whole footprint is.
+                const double x = ((r.x + i + 0.5) / lightmap.width - r.scaleOffset.z) / r.scaleOffset.x * kFloor;
+                const double z =
+                    ((r.y + j + 0.5) / lightmap.height - r.scaleOffset.w) / r.scaleOffset.y * kFloor - kFloor / 2;
+                under += std::abs(x - 4.0) < 0.75 - 0.125 && std::abs(z) < 0.75 - 0.125 ? 1 : 0;
+            }
+        std::printf("%s: %d texels wholly under the box; darkest floor texel %.0f lux (pi C = %.0f)\n", backend, under,
+                    darkest, kPi * C);
+        EXPECT_GE(under, 16);
+        EXPECT_EQ(dark, 0) << "floor texels baked black (under the box?); darkest " << darkest << "\n" << log;
+        EXPECT_NE(log.find("texels lie inside geometry and take their neighbours' light"), std::string::npos) << log;
+    }
+}
+
 TEST_F(LightmapBake, SunBouncedOffAWhiteWallFollowsTheViewFactor) {
     const glm::vec3 wallBase(0.5f);
     const fs::path glb = floorAndWall("bake_sun_wall", glm::vec3(0.0f), 1.0f, wallBase, 0.0f, {1.0f, 1.0f, 0.3f});
