@@ -17,10 +17,18 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace vitrine::scene {
+
+// Bytes a store hands back: valid while keepAlive lives (a mapped cache file, say).
+struct StoredBytes {
+    std::span<const uint8_t> bytes;
+    std::shared_ptr<const void> keepAlive;
+};
 
 struct MuseumOptions {
     // Changes the procedural textures, painting contents, small placement jitter and the robot's gait.
@@ -34,6 +42,12 @@ struct MuseumOptions {
     // keeps freshly generated ones. scene.museum wires both to the bake cache; without them nothing is stored.
     std::function<std::optional<std::vector<TextureImage>>(uint64_t key)> loadTextures;
     std::function<void(uint64_t key, const std::vector<TextureImage>&)> storeTextures;
+    // Optional store for the generated geometry (vertices, indices, primitives, meshes, nodes, animations: the rest of
+    // a build whose textures are stored), as bytes: `key` hashes the seed and the generator's source files
+    // (museumGeometrySourceHash()). loadGeometry returns the stored bytes (or nothing: the geometry is built; bytes
+    // that do not parse are ignored the same way), storeGeometry keeps those of a fresh build.
+    std::function<std::optional<StoredBytes>(uint64_t key)> loadGeometry;
+    std::function<void(uint64_t key, const std::vector<uint8_t>&)> storeGeometry;
 };
 
 // The default museum's geometry (seed 1: 134,335 vertices, 523,326 indices), which buildMuseum reserves up front:
@@ -46,6 +60,11 @@ inline constexpr size_t kMuseumIndexReserve = 540000;
 // A hash of the source files that generate the museum's textures (computed at build time): part of the texture
 // cache key, so an edit to the generator never loads textures the old code made.
 uint64_t museumTextureSourceHash();
+// The same for the sources that generate the geometry (every file of core/scene/museum, the scene's structures and
+// the store's format): part of the geometry cache key.
+uint64_t museumGeometrySourceHash();
+// The geometry cache key of a museum of this seed (what MuseumOptions::loadGeometry is called with).
+uint64_t museumGeometryKey(uint64_t seed);
 
 // The daylight the museum is lit by: graphs/museum.json's sky.procedural turbidity (Preetham). The scene's sun takes
 // its colour and illuminance from the same model (shading::PreethamSky::sunIlluminance()), so the KHR_lights_punctual

@@ -126,6 +126,20 @@ std::shared_ptr<const scene::Scene> museum(uint64_t seed, uint32_t size) {
             logWarning("scene 'museum': could not store the procedural textures in the bake cache under " +
                        bake.dir().string());
     };
+    // The geometry (most of the rest) comes from the bake cache too, mapped and checked (12 MiB).
+    bool geometryLoaded = false;
+    options.loadGeometry = [&](uint64_t key) -> std::optional<scene::StoredBytes> {
+        std::optional<BakeView> mapped = bake.map(BakeKey{"museum_geometry", key});
+        if (!mapped) return std::nullopt;
+        auto view = std::make_shared<const BakeView>(std::move(*mapped));
+        geometryLoaded = true;
+        return scene::StoredBytes{view->bytes(), view};
+    };
+    options.storeGeometry = [&](uint64_t key, const std::vector<uint8_t>& bytes) {
+        geometryLoaded = false;
+        if (!bake.put(BakeKey{"museum_geometry", key}, bytes))
+            logWarning("scene 'museum': could not store its geometry in the bake cache under " + bake.dir().string());
+    };
     auto s = std::make_shared<const scene::Scene>(scene::buildMuseum(options));
     if (intact.valid() && !intact.get()) {
         logDebug(
@@ -134,9 +148,10 @@ std::shared_ptr<const scene::Scene> museum(uint64_t seed, uint32_t size) {
         loaded = false;
         s = std::make_shared<const scene::Scene>(scene::buildMuseum(options));
     }
-    char line[160];
-    std::snprintf(line, sizeof line, "scene 'museum': built in %.0f ms (procedural textures %s)", ms(),
-                  loaded ? "loaded from the bake cache" : "generated and stored in the bake cache");
+    char line[200];
+    std::snprintf(line, sizeof line, "scene 'museum': built in %.0f ms (procedural textures %s, geometry %s)", ms(),
+                  loaded ? "loaded from the bake cache" : "generated and stored in the bake cache",
+                  geometryLoaded ? "loaded from the bake cache" : "generated and stored in the bake cache");
     logDebug(line);
     slot = s;
     return s;

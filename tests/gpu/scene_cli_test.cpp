@@ -211,10 +211,9 @@ TEST_F(SceneCli, GltfWarningsArePrintedAndStrictRefuses) {
     EXPECT_FALSE(fs::exists(dir / "b.glb"));
 }
 
-
-// scene.museum's procedural textures go into the bake cache (kind museum_textures): the second build of the same
-// museum loads them instead of generating them (what makes a second `run` start quickly), and a damaged entry is
-// generated again without a word to the user beyond the debug log.
+// scene.museum's procedural textures go into the bake cache (kind museum_textures), and its geometry (kind
+// museum_geometry): the second build of the same museum loads them instead of generating them (what makes a second
+// `run` start quickly), and a damaged texture entry is generated again without a word to the user beyond the debug log.
 TEST_F(SceneCli, MuseumTexturesComeFromTheBakeCacheOnTheSecondBuild) {
     const fs::path cache = fs::path(VITRINE_TEST_OUT) / "museum_texture_cache";
     fs::remove_all(cache);
@@ -231,10 +230,16 @@ TEST_F(SceneCli, MuseumTexturesComeFromTheBakeCacheOnTheSecondBuild) {
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
     ASSERT_EQ(files.size(), 1u);
+    EXPECT_NE(first.output.find("geometry generated and stored in the bake cache"), std::string::npos) << first.output;
+    size_t geometryFiles = 0;
+    for (const auto& e : fs::directory_iterator(cache / "bake" / "museum_geometry"))
+        geometryFiles += e.path().extension() == ".bin";
+    EXPECT_EQ(geometryFiles, 1u);
     const CliResult second = vitrine(args, env);
     ASSERT_EQ(second.status, 0) << second.output;
     EXPECT_NE(second.output.find("procedural textures loaded from the bake cache"), std::string::npos)
         << second.output;
+    EXPECT_NE(second.output.find("geometry loaded from the bake cache"), std::string::npos) << second.output;
     // Damaged (truncated): generated again, stored again, no failure.
     fs::resize_file(files[0], fs::file_size(files[0]) / 2);
     const CliResult third = vitrine(args, env);

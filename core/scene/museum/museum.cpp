@@ -4,8 +4,10 @@
 #include "core/scene/museum.hpp"
 
 #include "core/scene/museum/context.hpp"
+#include "core/scene/museum/geometry_store.hpp"
 
 #include "core/base/error.hpp"
+#include "core/scene/hash.hpp"
 #include "core/shading/sky.hpp"
 
 #include <algorithm>
@@ -279,6 +281,14 @@ void addRooms(Scene& scene) {
 
 } // namespace museum
 
+uint64_t museumGeometryKey(uint64_t seed) {
+    Hasher h;
+    h.string("museum geometry");
+    h.value(museumGeometrySourceHash());
+    h.value(seed);
+    return h.result();
+}
+
 Scene buildMuseum(const MuseumOptions& options) {
     using namespace museum;
     uint32_t size = options.textureSize;
@@ -292,12 +302,21 @@ Scene buildMuseum(const MuseumOptions& options) {
     Museum m{scene, {}, {}, Rng(options.seed), 0};
     m.tex = makeTextures(scene, size, m.rng, options);
     m.mat = makeMaterials(scene, m.tex);
-    scene.nodes.push_back(Node{"museum"});
     scene.roots = {0};
-    buildArchitecture(m);
-    buildExhibits(m);
-    buildDecor(m);
-    buildRobot(m);
+    // The geometry depends on the seed and the code only (not the texture size): stored once per seed.
+    const uint64_t geometryKey = museumGeometryKey(options.seed);
+    std::optional<StoredBytes> stored;
+    if (options.loadGeometry) stored = options.loadGeometry(geometryKey);
+    if (!stored || !deserializeGeometry(stored->bytes, scene)) {
+        scene.nodes.push_back(Node{"museum"});
+        buildArchitecture(m);
+        buildExhibits(m);
+        buildDecor(m);
+        buildRobot(m);
+        if (options.storeGeometry)
+            if (std::optional<std::vector<uint8_t>> bytes = serializeGeometry(scene))
+                options.storeGeometry(geometryKey, *bytes);
+    }
     addCameras(scene);
     addRooms(scene);
     placeProbes(scene);

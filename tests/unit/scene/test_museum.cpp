@@ -91,6 +91,78 @@ TEST_F(Museum, TexturesLoadedFromTheStoreBuildTheSameScene) {
     EXPECT_NE(museumTextureSourceHash(), 0u);
 }
 
+// The geometry store (what scene.museum wires to the bake cache, kind museum_geometry): the first build stores its
+// geometry under a key of the seed and the generator's sources, a build that loads it is the same scene (the content
+// hash covers vertices, indices, primitives, meshes, nodes and animations; the bounds and instances finalize() makes
+// from them are compared too), a payload that does not parse is ignored (built and stored again), the key follows the
+// seed and not the texture size.
+TEST_F(Museum, GeometryLoadedFromTheStoreBuildsTheSameScene) {
+    std::map<uint64_t, std::vector<uint8_t>> store;
+    int hits = 0, stores = 0;
+    auto withStore = [&](uint64_t seed, uint32_t size, size_t cut = 0) {
+        MuseumOptions o;
+        o.seed = seed;
+        o.textureSize = size;
+        o.loadGeometry = [&, cut](uint64_t key) -> std::optional<StoredBytes> {
+            auto it = store.find(key);
+            if (it == store.end()) return std::nullopt;
+            ++hits;
+            auto bytes = std::make_shared<std::vector<uint8_t>>(it->second);
+            bytes->resize(bytes->size() - cut);
+            return StoredBytes{*bytes, bytes};
+        };
+        o.storeGeometry = [&](uint64_t key, const std::vector<uint8_t>& bytes) {
+            ++stores;
+            store[key] = bytes;
+        };
+        return buildMuseum(o);
+    };
+    MuseumOptions plain;
+    plain.textureSize = 32;
+    const Scene expected = buildMuseum(plain);
+    auto same = [&](const Scene& s) {
+        EXPECT_EQ(s.contentHash(), expected.contentHash());
+        EXPECT_EQ(s.lightmapHash(), expected.lightmapHash());
+        ASSERT_EQ(s.instances.size(), expected.instances.size());
+        for (size_t i = 0; i < s.instances.size(); ++i) {
+            EXPECT_EQ(s.instances[i].mesh, expected.instances[i].mesh);
+            EXPECT_EQ(s.instances[i].dynamic, expected.instances[i].dynamic) << i;
+            EXPECT_EQ(s.instances[i].world, expected.instances[i].world) << i;
+        }
+        ASSERT_EQ(s.primitives.size(), expected.primitives.size());
+        for (size_t i = 0; i < s.primitives.size(); ++i) {
+            EXPECT_EQ(s.primitives[i].lightmapUvs, expected.primitives[i].lightmapUvs) << i;
+            EXPECT_EQ(s.primitives[i].bounds.min, expected.primitives[i].bounds.min) << i;
+        }
+        ASSERT_EQ(s.meshes.size(), expected.meshes.size());
+        for (size_t i = 0; i < s.meshes.size(); ++i)
+            EXPECT_EQ(s.meshes[i].lightmapChartGap, expected.meshes[i].lightmapChartGap) << i;
+        EXPECT_EQ(s.bounds.max, expected.bounds.max);
+    };
+    same(withStore(1, 32));
+    EXPECT_EQ(stores, 1);
+    EXPECT_EQ(hits, 0);
+    ASSERT_EQ(store.size(), 1u);
+    EXPECT_EQ(store.begin()->first, museumGeometryKey(1));
+    // Loaded: no store, the same scene.
+    same(withStore(1, 32));
+    EXPECT_EQ(hits, 1);
+    EXPECT_EQ(stores, 1);
+    // Truncated (by one byte, and by half): built and stored again, the same scene.
+    same(withStore(1, 32, 1));
+    EXPECT_EQ(stores, 2);
+    same(withStore(1, 32, store.begin()->second.size() / 2));
+    EXPECT_EQ(stores, 3);
+    // The texture size does not change the geometry: the same entry. Another seed: another.
+    withStore(1, 16);
+    EXPECT_EQ(store.size(), 1u);
+    EXPECT_EQ(stores, 3);
+    withStore(2, 32);
+    EXPECT_EQ(store.size(), 2u);
+    EXPECT_NE(museumGeometryKey(1), museumGeometryKey(2));
+    EXPECT_NE(museumGeometrySourceHash(), museumTextureSourceHash());
+}
+
 // scene.museum hands over the loaded textures as views of the mapped cache file (PixelBuffer): the build must read
 // them where they lie. A build that wrote to them, or took a non-const reference, would copy each into fresh memory
 // (the cost the views remove from a warm start) and let go of the mapping.
