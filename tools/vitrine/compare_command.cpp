@@ -274,9 +274,9 @@ int compareCommand(const Args& args) {
     std::vector<uint32_t> wanted;
     for (uint32_t f = range.first; f <= range.last; ++f)
         wanted.push_back(f);
-    // Ctrl-C stops the render in progress after its frame (a converging path tracer keeps its partial result in the
-    // bake cache, so the next compare resumes it) and then the comparison.
-    InterruptHandlers interrupts;
+    // Ctrl-C (handlers installed by the command line's main) stops the render in progress after its frame (a
+    // converging path tracer keeps its partial result in the bake cache, so the next compare resumes it) and then the
+    // comparison.
     for (Input* in : rendered) {
         if (in->graph) {
             if (!ctx) {

@@ -10,8 +10,9 @@ inline constexpr int kExitInterrupted = 130;
 // it too (ExecuteContext::stopRequested): render.pathtrace converging to its target stops after its batch and keeps its
 // partial result in the bake cache for the next run. The handler is one-shot, so a second signal
 // ends the process at once (files are written atomically, so that leaves no half-written file either). The previous
-// handlers come back on destruction. Installed by runCommand and compareCommand (which stops after the render in
-// progress and compares nothing); other commands keep the default behaviour.
+// handlers come back on destruction. Installed by runCommand, and by main around compareCommand (which stops after the
+// render in progress and compares nothing; the Python module calls compareCommand without them); other commands keep
+// the default behaviour.
 class InterruptHandlers {
 public:
     InterruptHandlers();

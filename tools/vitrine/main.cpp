@@ -3,6 +3,7 @@
 #include "core/base/heap.hpp"
 #include "core/base/log.hpp"
 #include "tools/vitrine/cli.hpp"
+#include "tools/vitrine/interrupt.hpp"
 #include "tools/vitrine/version.hpp"
 
 #include <cstdio>
@@ -143,7 +144,12 @@ int main(int argc, char** argv) {
         if (args.command == "bench") return cli::benchCommand(args);
         if (args.command == "graph") return cli::graphCommand(args);
         if (args.command == "devices") return cli::devicesCommand(args);
-        if (args.command == "compare") return cli::compareCommand(args);
+        if (args.command == "compare") {
+            // Ctrl-C stops the render in progress (compareCommand then compares nothing). Only the command line
+            // installs the handlers: the Python module, which calls compareCommand too, keeps Python's own.
+            cli::InterruptHandlers interrupts;
+            return cli::compareCommand(args);
+        }
         if (args.command == "golden") return cli::goldenCommand(args);
         if (args.command == "export-scene") return cli::exportSceneCommand(args);
         if (args.command == "jitter") return cli::jitterCommand(args);
