@@ -39,16 +39,19 @@ NodeSchema schema() {
         {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's `layout` (with `lightmap`)"},
     };
     s.outputs = {
-        attachment("normal", VK_FORMAT_R16G16B16A16_SFLOAT, "x, y: octahedral world normal; z: linear view depth (m); w: shininess"),
+        attachment("normal", VK_FORMAT_R16G16B16A16_SFLOAT,
+                   "x, y: octahedral world normal; z: linear view depth (m); w: shininess"),
         attachment("base_color", VK_FORMAT_R8G8B8A8_UNORM, "rgb: base colour (linear); a: metallic"),
-        attachment("material", VK_FORMAT_R8G8B8A8_UNORM,
-                   "x: base colour alpha (where a sheen is packed: 16 × blue + roughness, 4 bits each); y: 1 − "
-                   "KHR_materials_specular strength (0 without it); z: vertex AO; w: cavity"),
-        attachment("velocity", VK_FORMAT_R16G16_SFLOAT, "Screen motion in pixels, this frame minus last (camera and object, no jitter)"),
+        attachment(
+            "material", VK_FORMAT_R8G8B8A8_UNORM,
+            "x: base colour alpha; y: 1 − KHR_materials_specular strength (0 without it); z: vertex AO; w: cavity"),
+        attachment("velocity", VK_FORMAT_R16G16_SFLOAT,
+                   "Screen motion in pixels, this frame minus last (camera and object, no jitter)"),
         attachment("emissive", VK_FORMAT_R16G16B16A16_SFLOAT,
                    "rgb: emissive radiance plus, where lightmapped, the baked diffuse (linear, cd/m²); a: 1 where "
-                   "lightmapped, else 0, plus 2 × (32 × ⌊31 × clear coat + ½⌋ + ⌊31 × coat roughness + ½⌋); "
-                   "without a coat, a sheen makes it −(1 + flag + 2 × (32 × red + green)), 5 bits each"),
+                   "lightmapped, else 0, plus 2 × (32 × ⌊31 × clear coat + ½⌋ + ⌊31 × coat roughness + ½⌋)"),
+        attachment("sheen", VK_FORMAT_R8G8B8A8_UNORM,
+                   "rgb: KHR_materials_sheen colour (linear); a: sheen roughness (0 without a sheen: no lobe)"),
         attachment("depth", VK_FORMAT_D32_SFLOAT, "Hardware depth, reverse Z (1 near, 0 infinitely far)",
                    Usage::DepthAttachment),
     };
@@ -76,7 +79,7 @@ public:
         const ImageDesc& size = ctx.output("normal").desc();
         VkClearValue zero{};
         std::vector<Attachment> colors;
-        for (const char* port : {"normal", "base_color", "material", "velocity", "emissive"})
+        for (const char* port : {"normal", "base_color", "material", "velocity", "emissive", "sheen"})
             colors.push_back({ctx.output(port).view(), true, zero});
         beginRendering(cmd, {size.width, size.height}, colors, Attachment{ctx.output("depth").view(), true, zero});
         gpu.bindGeometry(cmd);
@@ -181,7 +184,7 @@ private:
         d.pushConstantSize = sizeof(SceneDrawPush);
         d.vertexBindings = GpuScene::vertexBindings();
         d.vertexAttributes = GpuScene::vertexAttributes();
-        for (const char* port : {"normal", "base_color", "material", "velocity", "emissive"})
+        for (const char* port : {"normal", "base_color", "material", "velocity", "emissive", "sheen"})
             d.colorFormats.push_back(ctx.output(port).desc().format);
         d.depthFormat = ctx.output("depth").desc().format;
         mCullBack = RasterPipeline(ctx.gpu(), d);

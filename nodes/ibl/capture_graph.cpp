@@ -138,11 +138,11 @@ std::unique_ptr<CaptureGraph> buildCaptureGraph(std::shared_ptr<const CaptureInp
     out->registry.add(view, [inputs] { return std::make_unique<CaptureView>(inputs); });
 
     json gbufferIn = {{"scene", "view.scene"}};
-    json lightingIn = {{"normal", "gbuffer.normal"},       {"base_color", "gbuffer.base_color"},
-                       {"material", "gbuffer.material"},   {"emissive", "gbuffer.emissive"},
-                       {"depth", "gbuffer.depth"},         {"sky_sh", "view.sky_sh"},
-                       {"sky", "view.sky"},                {"camera", "view.camera"},
-                       {"scene", "view.scene"}};
+    json lightingIn = {{"normal", "gbuffer.normal"},     {"base_color", "gbuffer.base_color"},
+                       {"material", "gbuffer.material"}, {"emissive", "gbuffer.emissive"},
+                       {"sheen", "gbuffer.sheen"},       {"depth", "gbuffer.depth"},
+                       {"sky_sh", "view.sky_sh"},        {"sky", "view.sky"},
+                       {"camera", "view.camera"},        {"scene", "view.scene"}};
     if (baked) {
         gbufferIn["lightmap"] = "view.lightmap";
         gbufferIn["baked"] = "view.baked";

@@ -6,7 +6,6 @@
 #include "common/octahedral.glsl"
 #include "gbuffer/unlit.glsl"
 #include "gbuffer/clearcoat_pack.glsl"
-#include "gbuffer/sheen_pack.glsl"
 
 // The G-buffer of MUSEUM_SPEC §2, written while the material layers are blended per pixel.
 layout(location = 0) in vec3 vNormal;
@@ -23,6 +22,7 @@ layout(location = 1) out vec4 outBase;     // base colour rgb, metallic
 layout(location = 2) out vec4 outMaterial; // base colour alpha, 1 - specular strength, vertex AO, cavity
 layout(location = 3) out vec2 outVelocity; // pixels, current minus previous position
 layout(location = 4) out vec4 outEmissive; // rgb: emissive + baked diffuse radiance; a: 1 where lightmapped
+layout(location = 5) out vec4 outSheen;    // KHR_materials_sheen: colour rgb, roughness (0: no sheen)
 
 #ifdef VITRINE_GBUFFER_LIGHTMAP
 // bake.lightmap's irradiance atlas (lux); draw.lightmap maps uv1 into this instance's region.
@@ -89,7 +89,8 @@ void main() {
     // an unlit surface has no coat.
     vec2 coat = m.optics.z > 0.5 ? vec2(0.0) : materialClearcoat(m, vUv0, vUv1, grads);
     outEmissive = vec4(emissive, packClearcoatAlpha(lightmapped > 0.5, coat));
-    // KHR_materials_sheen in the coat's slot where there is no coat (gbuffer/sheen_pack.glsl); unlit has none.
-    vec4 sheen = m.optics.z > 0.5 ? vec4(0.0) : materialSheen(m, vUv0, vUv1, grads);
-    if (hasSheen(sheen) && sheenFits(outEmissive.a)) packSheen(sheen, lightmapped > 0.5, outEmissive.a, outMaterial.x);
+    // KHR_materials_sheen in its own target, under the coat when there is one too; unlit has none, and a black sheen
+    // is none (0, whatever its roughness).
+    vec4 sheen = m.optics.z > 0.5 ? vec4(0.0) : clamp(materialSheen(m, vUv0, vUv1, grads), 0.0, 1.0);
+    outSheen = hasSheen(sheen) ? sheen : vec4(0.0);
 }

@@ -32,12 +32,12 @@ layout(binding = 12) uniform sampler2D in_ao;
 layout(binding = 13) uniform sampler2D in_ibl_specular;
 layout(binding = 14) uniform sampler2D in_ibl_diffuse;
 layout(binding = 15) writeonly uniform image2D out_diffuse_indirect;
+layout(binding = 16) uniform sampler2D in_sheen;
 #define VITRINE_LIGHTS u.lights
 #define VITRINE_SHADOW u.shadow
 #include "lighting/sun_shadow.glsl"
 #include "lighting/punctual.glsl"
 #include "gbuffer/clearcoat_pack.glsl"
-#include "gbuffer/sheen_pack.glsl"
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -66,13 +66,9 @@ void main() {
     vec3 emissive = emissiveLm.rgb;
     bool lightmapped;
     // KHR_materials_clearcoat (strength, roughness) packed with the flag; the coat shades with the base normal n.
-    // KHR_materials_sheen takes the slot where there is no coat (a < 0; gbuffer/sheen_pack.glsl).
-    vec2 coat = vec2(0.0);
-    vec4 sheen = vec4(0.0);
-    if (emissiveLm.a < 0.0)
-        sheen = unpackSheen(emissiveLm.a, g2.x, lightmapped);
-    else
-        coat = unpackClearcoatAlpha(emissiveLm.a, lightmapped);
+    // KHR_materials_sheen (colour, roughness) from its own target, layered under the coat.
+    vec2 coat = unpackClearcoatAlpha(emissiveLm.a, lightmapped);
+    vec4 sheen = texelFetch(in_sheen, p, 0);
     vec3 n = octDecode(g0.xy);
     float viewDepth = g0.z;
     float roughness = roughnessFromShininess(g0.w);

@@ -199,10 +199,15 @@ double directionalAlbedo(double NoV, int steps,
 }
 
 nlohmann::json lightingNode(nlohmann::json params, bool shadowMap) {
-    nlohmann::json in = {{"normal", "gbuffer.normal"},     {"base_color", "gbuffer.base_color"},
-                         {"material", "gbuffer.material"}, {"emissive", "gbuffer.emissive"},
-                         {"depth", "gbuffer.depth"},       {"sky_sh", "sky.sh"},
-                         {"sky", "sky.cubemap"},           {"camera", "scene.camera"}};
+    nlohmann::json in = {{"normal", "gbuffer.normal"},
+                         {"base_color", "gbuffer.base_color"},
+                         {"material", "gbuffer.material"},
+                         {"emissive", "gbuffer.emissive"},
+                         {"sheen", "gbuffer.sheen"},
+                         {"depth", "gbuffer.depth"},
+                         {"sky_sh", "sky.sh"},
+                         {"sky", "sky.cubemap"},
+                         {"camera", "scene.camera"}};
     if (shadowMap) {
         in["shadow_map"] = "shadow.shadow_map";
         in["cascades"] = "shadow.cascades";

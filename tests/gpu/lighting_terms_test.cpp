@@ -210,25 +210,34 @@ TEST_F(LightingTerms, ClearcoatGroundMatchesTheCpuLayering) {
 }
 
 // KHR_materials_sheen in lighting.deferred: the grazing-sun ground of the coat test, dark grey and rough, under a
-// sheen of colour (1, 16/31, 10/15) and roughness 8/15, values the G-buffer's 5-5-4 + 4-bit packing keeps exactly.
-// Expected: core/shading's brdfCosineSheen (the lobe checked against the spec's formulas and its albedo table against
-// quadrature in shading.Brdf.Sheen*) x E. Low sun and a camera looking along the ground: the Charlie lobe's grazing
-// retro-reflection lights it several times the bare ground's. Bound 2 % as above; the sheen must matter.
-TEST_F(LightingTerms, SheenGroundMatchesTheCpuLayering) {
+// sheen of colour (1, 128/255, 170/255) and roughness 136/255 (= 8/15), values the G-buffer's 8-bit sheen target keeps
+// exactly, and, when `coat` is given, a clear coat over the sheen. Expected: core/shading's brdfCosineSheen (the lobe
+// checked against the spec's formulas and its albedo table against quadrature in shading.Brdf.Sheen*, the layering in
+// shading.Brdf.SheenLayeringKeepsEnergy) x E. Low sun and a camera looking along the ground: the Charlie lobe's
+// grazing retro-reflection lights it several times the bare ground's. Bound 2 % as above. Returned: how much the
+// sheen adds (the largest ratio to the same material without it) and how much the coat changes (with / without it).
+struct SheenGround {
+    int checked = 0;
+    double worst = 0.0, sheenMatters = 0.0, coatMatters = 0.0;
+};
+
+SheenGround sheenGround(const char* name, glm::vec2 coat) {
     const int W = 64, H = 64;
     const float shininess = 0.3f;
-    const glm::vec4 sheen(1.0f, 16.0f / 31.0f, 10.0f / 15.0f, 8.0f / 15.0f);
+    const glm::vec4 sheen(1.0f, 128.0f / 255.0f, 170.0f / 255.0f, 136.0f / 255.0f);
     const glm::vec3 base(51.0f / 255.0f);
     const double sunElevation = 12.0 * kPi / 180.0;
     const double sunScale = 0.1;
     const float groundHalf = 40.0f;
 
-    SceneBuilder b("grazing_sheen");
+    SceneBuilder b(name);
     std::vector<Tri> quad;
     addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
     uint32_t m = b.material("velvet", base, 0.0f, shininess);
     b.s.materials[m].sheenColor = glm::vec3(sheen); // written into the .glb as KHR_materials_sheen and read back
     b.s.materials[m].sheenRoughness = sheen.a;
+    b.s.materials[m].clearcoat = coat.x; // and KHR_materials_clearcoat where coat.x > 0
+    b.s.materials[m].clearcoatRoughness = coat.y;
     b.node("ground", static_cast<int32_t>(b.mesh("ground", quad, m)));
     b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
     b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(std::cos(sunElevation))});
@@ -244,8 +253,7 @@ TEST_F(LightingTerms, SheenGroundMatchesTheCpuLayering) {
     const float roughness = shading::roughnessFromShininess(shininess);
 
     Pinhole cam(b.s, W, H);
-    int checked = 0;
-    double worst = 0.0, sheenMatters = 0.0;
+    SheenGround r;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             glm::dvec3 d = cam.ray(x, y);
@@ -253,22 +261,40 @@ TEST_F(LightingTerms, SheenGroundMatchesTheCpuLayering) {
             glm::dvec3 p = cam.position - cam.position.y / d.y * d;
             if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
             const glm::vec3 n(0, 1, 0), v(-d), lf(l);
-            glm::dvec3 expected = glm::dvec3(shading::brdfCosineSheen(n, n, v, lf, base, 0.0f, roughness, plain,
-                                                                      glm::vec2(0.0f), sheen)) *
-                                  sunE;
+            auto cpu = [&](glm::vec2 c, glm::vec4 s) {
+                return glm::dvec3(shading::brdfCosineSheen(n, n, v, lf, base, 0.0f, roughness, plain, c, s)) * sunE;
+            };
+            glm::dvec3 expected = cpu(coat, sheen);
             if (expected.g < 1.0) continue;
-            ++checked;
+            ++r.checked;
             glm::dvec3 got = rgb(direct, x, y);
             double e = relErr(got, expected);
-            worst = std::max(worst, e);
-            glm::dvec3 bare = cpuSun({0, 1, 0}, v, l, base, 0.0f, shininess, sunE);
-            sheenMatters = std::max(sheenMatters, expected.r / std::max(bare.r, 1e-6));
-            EXPECT_LT(e, 0.02) << "pixel " << x << "," << y << ": " << got.r << " vs " << expected.r;
+            r.worst = std::max(r.worst, e);
+            r.sheenMatters = std::max(r.sheenMatters, expected.r / std::max(cpu(coat, glm::vec4(0.0f)).r, 1e-6));
+            glm::dvec3 uncoated = cpu(glm::vec2(0.0f), sheen);
+            r.coatMatters = std::max(r.coatMatters, std::max(expected.g / uncoated.g, uncoated.g / expected.g));
+            EXPECT_LT(e, 0.02) << name << " pixel " << x << "," << y << ": " << got.r << " vs " << expected.r;
         }
-    std::printf("KHR_materials_sheen ground: %d pixels, max relative error %.2g, with / without sheen up to %.1f\n",
-                checked, worst, sheenMatters);
-    EXPECT_GE(checked, 300);
-    EXPECT_GT(sheenMatters, 1.5);
+    std::printf("%s: %d pixels, max relative error %.2g, with / without sheen up to %.2f, coat changes it up to "
+                "%.2fx\n",
+                name, r.checked, r.worst, r.sheenMatters, r.coatMatters);
+    EXPECT_GE(r.checked, 300);
+    return r;
+}
+
+TEST_F(LightingTerms, SheenGroundMatchesTheCpuLayering) {
+    SheenGround r = sheenGround("grazing_sheen", glm::vec2(0.0f));
+    EXPECT_GT(r.sheenMatters, 1.5);
+}
+
+// The same sheen under a clear coat of strength 16/31 and roughness 8/31 (values the 5-bit coat packing keeps): both
+// lobes reach lighting.deferred through the G-buffer together (the sheen in its own target), layered as the path
+// tracers and forward.transparent layer them. Both must matter: the sheen against the coat alone, the coat against
+// the sheen alone.
+TEST_F(LightingTerms, CoatOverSheenGroundMatchesTheCpuLayering) {
+    SheenGround r = sheenGround("grazing_coat_over_sheen", glm::vec2(16.0f / 31.0f, 8.0f / 31.0f));
+    EXPECT_GT(r.sheenMatters, 1.3);
+    EXPECT_GT(r.coatMatters, 1.3);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -43,6 +43,7 @@ TEST_F(MuseumGlass, GlassCasesPassTheMuseumImageStatistics) {
               {"base_color", "gbuffer.base_color"},
               {"material", "gbuffer.material"},
               {"emissive", "gbuffer.emissive"},
+              {"sheen", "gbuffer.sheen"},
               {"depth", "gbuffer.depth"},
               {"shadow_map", "shadow.shadow_map"},
               {"cascades", "shadow.cascades"},
