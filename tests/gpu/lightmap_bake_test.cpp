@@ -70,15 +70,24 @@ constexpr float kFloor = 8.0f;     // the floor spans x in [0, 8], z in [-4, 4]
 constexpr float kWallHeight = 2.0f; // the wall's face is the plane x = 0, y in [0, 2], z in [-100, 100]
 constexpr float kTexelsPerMeter = 4.0f;
 
+// The lightmapped floor of these scenes: kFloor square at y = 0, x in [0, kFloor], uv1 = (x / kFloor, (z + kFloor / 2)
+// / kFloor), of `material`.
+void addLightmappedFloor(SceneBuilder& b, uint32_t material) {
+    std::vector<Tri> floor;
+    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
+    for (Tri& t : floor)
+        for (scene::Vertex* v : {&t.a, &t.b, &t.c})
+            v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
+    const uint32_t mesh = b.mesh("floor", floor, material);
+    b.s.primitives[b.s.meshes[mesh].firstPrimitive].lightmapUvs = true;
+    b.node("floor", static_cast<int32_t>(mesh));
+}
+
 // A lightmapped floor (uv1 = (x / 8, (z + 4) / 8)) beside a long wall without lightmap UVs.
 fs::path floorAndWall(const std::string& name, glm::vec3 floorBase, float floorMetallic, glm::vec3 wallBase,
                       float wallMetallic, glm::vec3 toSun, float wallShininess = 0.0f, float wallCoat = 0.0f,
                       float wallCoatRoughness = 0.0f) {
     SceneBuilder b(name);
-    std::vector<Tri> floor;
-    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
-    for (Tri& t : floor)
-        for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
     // Lambertian surfaces (KHR_materials_specular's strength 0 takes the dielectric's specular lobe away), so that
     // the view-factor cases stay exact now that bake paths reflect with the full material.
     const uint32_t floorMaterial = b.material("floor", floorBase, floorMetallic, 0.0f);
@@ -87,9 +96,7 @@ fs::path floorAndWall(const std::string& name, glm::vec3 floorBase, float floorM
     b.s.materials[wallMaterial].specular = 0.0f;
     b.s.materials[wallMaterial].clearcoat = wallCoat;
     b.s.materials[wallMaterial].clearcoatRoughness = wallCoatRoughness;
-    const uint32_t floorMesh = b.mesh("floor", floor, floorMaterial);
-    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
-    b.node("floor", static_cast<int32_t>(floorMesh));
+    addLightmappedFloor(b, floorMaterial);
     const uint32_t wall = b.mesh("wall", boxTris({0.1f, kWallHeight / 2, 100.0f}), wallMaterial);
     b.node("wall", static_cast<int32_t>(wall), {-0.1f, kWallHeight / 2, 0.0f});
     b.camera({4.0f, 3.0f, 6.0f}, {4.0f, 0.0f, 0.0f}, 0.9f);
@@ -261,13 +268,8 @@ TEST_F(LightmapBake, AutoTracesOnTheCpuOfACpuDevice) {
 TEST_F(LightmapBake, PathsThatStartBehindAWallAreLeftOutOfTheTexelsMean) {
     const double C = 1000.0;
     SceneBuilder b("bake_back_wall");
-    std::vector<Tri> floor, wall;
-    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
-    for (Tri& t : floor)
-        for (scene::Vertex* v : {&t.a, &t.b, &t.c}) v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
-    const uint32_t floorMesh = b.mesh("floor", floor, b.material("floor", glm::vec3(0.5f), 0.0f, 0.0f));
-    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
-    b.node("floor", static_cast<int32_t>(floorMesh));
+    addLightmappedFloor(b, b.material("floor", glm::vec3(0.5f), 0.0f, 0.0f));
+    std::vector<Tri> wall;
     addQuad(wall, {0, kWallHeight / 2, 0}, {0, kWallHeight / 2, 0}, {0, 0, 100.0f}, {-1, 0, 0});
     b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, b.material("wall", glm::vec3(0.0f), 0.0f, 0.0f))));
     b.camera({4.0f, 3.0f, 6.0f}, {4.0f, 0.0f, 0.0f}, 0.9f);
@@ -291,16 +293,9 @@ TEST_F(LightmapBake, PathsThatStartBehindAWallAreLeftOutOfTheTexelsMean) {
 TEST_F(LightmapBake, TexelsUnderABoxTakeTheirNeighboursLight) {
     const double C = 1000.0;
     SceneBuilder b("bake_box_on_floor");
-    std::vector<Tri> floor;
-    addQuad(floor, {kFloor / 2, 0, 0}, {kFloor / 2, 0, 0}, {0, 0, kFloor / 2}, {0, 1, 0});
-    for (Tri& t : floor)
-        for (scene::Vertex* v : {&t.a, &t.b, &t.c})
-            v->uv1 = {v->position.x / kFloor, (v->position.z + kFloor / 2) / kFloor};
     const uint32_t floorMaterial = b.material("floor", glm::vec3(0.5f), 0.0f, 0.0f);
     b.s.materials[floorMaterial].specular = 0.0f;
-    const uint32_t floorMesh = b.mesh("floor", floor, floorMaterial);
-    b.s.primitives[b.s.meshes[floorMesh].firstPrimitive].lightmapUvs = true;
-    b.node("floor", static_cast<int32_t>(floorMesh));
+    addLightmappedFloor(b, floorMaterial);
     // Its sides at 3.25 and 4.75 m: texel edges (4 texels per metre) lie on neither, so its border texels are partly
     // covered and the 4 x 4 inside them wholly.
     const uint32_t box = b.mesh("box", boxTris({0.75f, 0.5f, 0.75f}), b.material("box", glm::vec3(0.5f), 0.0f, 0.0f));

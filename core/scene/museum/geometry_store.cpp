@@ -30,6 +30,11 @@ public:
         value(static_cast<uint64_t>(s.size()));
         bytes.insert(bytes.end(), s.begin(), s.end());
     }
+    // The count of a list whose elements follow one by one.
+    template <typename T> bool sequence(const std::vector<T>& v, size_t) {
+        value(static_cast<uint64_t>(v.size()));
+        return true;
+    }
     std::vector<uint8_t> bytes;
 };
 
@@ -63,10 +68,13 @@ public:
         }
         s.assign(reinterpret_cast<const char*>(mBytes.data() + mAt - n), n);
     }
-    // A count of elements that each take at least `minBytes`: refused when the bytes cannot hold them.
-    bool count(uint64_t& n, size_t minBytes) {
+    // The count of a list whose elements follow one by one, each taking at least `minBytes`: `v` is sized to it, or
+    // the read fails when the bytes left cannot hold that many.
+    template <typename T> bool sequence(std::vector<T>& v, size_t minBytes) {
+        uint64_t n = 0;
         value(n);
         if (ok && n > (mBytes.size() - mAt) / minBytes) ok = false;
+        if (ok) v.resize(n);
         return ok;
     }
     bool atEnd() const { return ok && mAt == mBytes.size(); }
@@ -82,6 +90,48 @@ private:
     size_t mAt = 0;
 };
 
+// One description of the format for both directions: IO is Writer (S = const Scene) or Reader (S = Scene). Every
+// element of a list takes at least 8 bytes (a string's or an array's count).
+template <typename IO, typename S> bool transferGeometry(IO& io, S& s) {
+    io.array(s.vertices);
+    io.array(s.indices);
+    io.array(s.primitives);
+    if (!io.sequence(s.meshes, 8)) return false;
+    for (auto& m : s.meshes) {
+        io.string(m.name);
+        io.value(m.firstPrimitive);
+        io.value(m.primitiveCount);
+        io.value(m.bounds);
+        io.array(m.weights);
+        io.value(m.lightmapChartGap);
+    }
+    if (!io.sequence(s.nodes, 8)) return false;
+    for (auto& node : s.nodes) {
+        io.string(node.name);
+        io.value(node.local);
+        io.value(node.parent);
+        io.array(node.children);
+        io.value(node.mesh);
+        io.value(node.camera);
+        io.value(node.skin);
+        io.value(node.dynamic);
+    }
+    if (!io.sequence(s.animations, 8)) return false;
+    for (auto& a : s.animations) {
+        io.string(a.name);
+        if (!io.sequence(a.samplers, 8)) return false;
+        for (auto& sampler : a.samplers) {
+            io.value(sampler.interpolation);
+            io.array(sampler.times);
+            io.array(sampler.values);
+            io.value(sampler.width);
+        }
+        io.array(a.channels);
+        io.value(a.loop);
+    }
+    return true;
+}
+
 } // namespace
 
 std::optional<std::vector<uint8_t>> serializeGeometry(const Scene& s) {
@@ -89,42 +139,7 @@ std::optional<std::vector<uint8_t>> serializeGeometry(const Scene& s) {
     if (!s.skins.empty() || !s.skinVertices.empty() || !s.morphDeltas.empty()) return std::nullopt;
     Writer w;
     w.value(kMagic);
-    w.array(s.vertices);
-    w.array(s.indices);
-    w.array(s.primitives);
-    w.value(static_cast<uint64_t>(s.meshes.size()));
-    for (const Mesh& m : s.meshes) {
-        w.string(m.name);
-        w.value(m.firstPrimitive);
-        w.value(m.primitiveCount);
-        w.value(m.bounds);
-        w.array(m.weights);
-        w.value(m.lightmapChartGap);
-    }
-    w.value(static_cast<uint64_t>(s.nodes.size()));
-    for (const Node& n : s.nodes) {
-        w.string(n.name);
-        w.value(n.local);
-        w.value(n.parent);
-        w.array(n.children);
-        w.value(n.mesh);
-        w.value(n.camera);
-        w.value(n.skin);
-        w.value(n.dynamic);
-    }
-    w.value(static_cast<uint64_t>(s.animations.size()));
-    for (const Animation& a : s.animations) {
-        w.string(a.name);
-        w.value(static_cast<uint64_t>(a.samplers.size()));
-        for (const AnimationSampler& sampler : a.samplers) {
-            w.value(sampler.interpolation);
-            w.array(sampler.times);
-            w.array(sampler.values);
-            w.value(sampler.width);
-        }
-        w.array(a.channels);
-        w.value(a.loop);
-    }
+    transferGeometry(w, s);
     return std::move(w.bytes);
 }
 
@@ -134,48 +149,7 @@ bool deserializeGeometry(std::span<const uint8_t> bytes, Scene& s) {
     r.value(magic);
     if (!r.ok || magic != kMagic) return false;
     Scene g; // read aside, so that a refused payload leaves `s` as it was
-    r.array(g.vertices);
-    r.array(g.indices);
-    r.array(g.primitives);
-    uint64_t n = 0;
-    if (!r.count(n, 8)) return false;
-    g.meshes.resize(n);
-    for (Mesh& m : g.meshes) {
-        r.string(m.name);
-        r.value(m.firstPrimitive);
-        r.value(m.primitiveCount);
-        r.value(m.bounds);
-        r.array(m.weights);
-        r.value(m.lightmapChartGap);
-    }
-    if (!r.count(n, 8)) return false;
-    g.nodes.resize(n);
-    for (Node& node : g.nodes) {
-        r.string(node.name);
-        r.value(node.local);
-        r.value(node.parent);
-        r.array(node.children);
-        r.value(node.mesh);
-        r.value(node.camera);
-        r.value(node.skin);
-        r.value(node.dynamic);
-    }
-    if (!r.count(n, 8)) return false;
-    g.animations.resize(n);
-    for (Animation& a : g.animations) {
-        r.string(a.name);
-        uint64_t samplers = 0;
-        if (!r.count(samplers, 8)) return false;
-        a.samplers.resize(samplers);
-        for (AnimationSampler& sampler : a.samplers) {
-            r.value(sampler.interpolation);
-            r.array(sampler.times);
-            r.array(sampler.values);
-            r.value(sampler.width);
-        }
-        r.array(a.channels);
-        r.value(a.loop);
-    }
+    if (!transferGeometry(r, g)) return false;
     if (!r.atEnd()) return false;
     s.vertices = std::move(g.vertices);
     s.indices = std::move(g.indices);
