@@ -31,6 +31,10 @@ struct BvhBuildOptions {
     // Levels of nodes at most, <= kMaxDepth (the traversal stack). Binned SAH stays far below it on real
     // scenes (the museum: 24); subtrees that would go deeper switch to object-median splits.
     uint32_t maxDepth = kMaxDepth;
+    // Whether transparent primitives (alpha blend, KHR_materials_transmission: scene::Material::transparent()) are in
+    // it. Left out by default, as the shadow maps leave them: the bake and the twins see through glass untouched.
+    // render.pathtrace's `transparent` traces them (shaders/pathtrace/surface.glsl pathSeeThrough).
+    bool transparent = false;
 
     bool operator==(const BvhBuildOptions&) const = default;
 };

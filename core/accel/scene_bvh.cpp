@@ -10,13 +10,13 @@ namespace {
 
 // Appends the triangles of every primitive of mesh, transformed by world (object space: identity).
 void gather(const scene::Scene& scene, uint32_t mesh, const glm::mat4& world, bool transform, uint32_t instance,
-            std::vector<BvhBuildTriangle>& out) {
+            bool transparent, std::vector<BvhBuildTriangle>& out) {
     const scene::Mesh& m = scene.meshes[mesh];
     for (uint32_t p = m.firstPrimitive; p < m.firstPrimitive + m.primitiveCount; ++p) {
         const scene::Primitive& prim = scene.primitives[p];
-        // Transparent primitives (alpha blend, glass) are left out: the tracers know no transmission, and an
-        // opaque pane would shut whatever it covers in a box.
-        if (scene.materials[prim.material].transparent()) continue;
+        // Transparent primitives (alpha blend, glass) are left out unless asked for (BvhBuildOptions::transparent):
+        // the tracers that read this BVH without seeing through surfaces would take a pane for a wall.
+        if (!transparent && scene.materials[prim.material].transparent()) continue;
         for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
             glm::vec3 v[3];
             for (uint32_t k = 0; k < 3; ++k) {
@@ -42,7 +42,7 @@ SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& optio
     std::vector<BvhBuildTriangle> triangles;
     for (uint32_t i = 0; i < scene.instances.size(); ++i) {
         const scene::MeshInstance& inst = scene.instances[i];
-        if (!inst.dynamic) gather(scene, inst.mesh, inst.world, true, i, triangles);
+        if (!inst.dynamic) gather(scene, inst.mesh, inst.world, true, i, options.transparent, triangles);
     }
     bvh.mLevels.push_back(buildBottomLevel(triangles, options, bvh.mArrays));
 
@@ -53,7 +53,7 @@ SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& optio
         auto [it, added] = levelOfMesh.try_emplace(inst.mesh, static_cast<uint32_t>(bvh.mLevels.size()));
         if (added) {
             triangles.clear();
-            gather(scene, inst.mesh, glm::mat4(1.0f), false, kNone, triangles);
+            gather(scene, inst.mesh, glm::mat4(1.0f), false, kNone, options.transparent, triangles);
             bvh.mLevels.push_back(buildBottomLevel(triangles, options, bvh.mArrays));
         }
         bvh.mDynamic.push_back({i, it->second, inst.world});

@@ -33,7 +33,7 @@ inline glm::vec3 transformPoint(const glm::mat4& m, const glm::vec3& p) {
 class SceneBvh {
 public:
     // Bumped whenever the builder or the byte format changes, so caches of older builds are not used.
-    static constexpr uint32_t kVersion = 2; // 2: transparent primitives left out
+    static constexpr uint32_t kVersion = 3; // 2: transparent primitives left out; 3: unless options.transparent
 
     static SceneBvh build(const scene::Scene& scene, const BvhBuildOptions& options = {});
 

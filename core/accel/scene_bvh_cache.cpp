@@ -20,8 +20,9 @@ struct Header {
     float traversalCost;
     uint32_t maxDepth;
     uint32_t nodes, triangles, refs, primitives, levels, dynamics;
+    uint32_t transparent, reserved;
 };
-static_assert(sizeof(Header) == 56);
+static_assert(sizeof(Header) == 64);
 
 template <typename T> void append(std::vector<uint8_t>& out, const std::vector<T>& v) {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -50,6 +51,7 @@ BakeKey SceneBvh::cacheKey(const scene::Scene& scene, const BvhBuildOptions& opt
     h.value(options.maxLeafSize);
     h.value(options.traversalCost);
     h.value(options.maxDepth);
+    h.value(options.transparent);
     return {"bvh", h.result()};
 }
 
@@ -62,6 +64,7 @@ std::vector<uint8_t> SceneBvh::serialize() const {
     h.maxLeafSize = mOptions.maxLeafSize;
     h.traversalCost = mOptions.traversalCost;
     h.maxDepth = mOptions.maxDepth;
+    h.transparent = mOptions.transparent ? 1u : 0u;
     h.nodes = static_cast<uint32_t>(mArrays.nodes.size());
     h.triangles = static_cast<uint32_t>(mArrays.triangles.size());
     h.refs = static_cast<uint32_t>(mArrays.refs.size());
@@ -86,7 +89,7 @@ std::optional<SceneBvh> SceneBvh::deserialize(std::span<const uint8_t> bytes) {
     if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0 || h.version != kVersion) return std::nullopt;
     SceneBvh bvh;
     bvh.mSceneHash = h.sceneHash;
-    bvh.mOptions = {h.bins, h.maxLeafSize, h.traversalCost, h.maxDepth};
+    bvh.mOptions = {h.bins, h.maxLeafSize, h.traversalCost, h.maxDepth, h.transparent != 0u};
     size_t offset = sizeof h;
     if (!take(bytes, offset, h.nodes, bvh.mArrays.nodes) || !take(bytes, offset, h.triangles, bvh.mArrays.triangles) ||
         !take(bytes, offset, h.refs, bvh.mArrays.refs) || !take(bytes, offset, h.primitives, bvh.mPrimitives) ||

@@ -40,26 +40,40 @@ SceneObject::SceneObject(std::shared_ptr<const scene::Scene> scene) : mScene(std
 SceneObject::~SceneObject() = default;
 
 void SceneObject::releaseGpu() {
-    mGpuBvh.reset();
+    for (auto& b : mGpuBvh)
+        b.reset();
     mGpu.reset();
 }
 
-GpuBvh& SceneObject::bvh(Context& ctx) {
-    if (!mGpuBvh) {
-        if (!mBvh) {
+GpuBvh& SceneObject::bvh(Context& ctx, bool transparent) {
+    const int i = transparent ? 1 : 0;
+    if (!mGpuBvh[i]) {
+        if (!mBvh[i]) {
             accel::SceneBvh::CacheStatus status;
-            mBvh = std::make_unique<accel::SceneBvh>(accel::SceneBvh::loadOrBuild(*mScene, BakeCache(defaultCacheDir()), {}, &status));
+            accel::BvhBuildOptions options;
+            options.transparent = transparent;
+            mBvh[i] = std::make_unique<accel::SceneBvh>(
+                accel::SceneBvh::loadOrBuild(*mScene, BakeCache(defaultCacheDir()), options, &status));
             mBvhFromCache = status.fromCache;
-            if (status.fromCache) logInfo("scene '" + mScene->name + "': BVH loaded from the bake cache");
-            else logInfo("scene '" + mScene->name + "': BVH built in " + std::to_string(static_cast<int>(mBvh->buildMs())) + " ms");
+            const std::string what = transparent ? "BVH with transparent surfaces" : "BVH";
+            if (status.fromCache)
+                logInfo("scene '" + mScene->name + "': " + what + " loaded from the bake cache");
+            else
+                logInfo("scene '" + mScene->name + "': " + what + " built in " +
+                        std::to_string(static_cast<int>(mBvh[i]->buildMs())) + " ms");
             if (!status.fromCache && !status.stored)
                 logWarning("scene '" + mScene->name + "': could not write the BVH to the bake cache under " +
                            defaultCacheDir().string());
         }
-        mGpuBvh = std::make_unique<GpuBvh>(ctx, *mBvh, mScene->name);
-        mGpuBvh->update(pose);
+        mGpuBvh[i] = std::make_unique<GpuBvh>(ctx, *mBvh[i], mScene->name);
+        mGpuBvh[i]->update(pose);
     }
-    return *mGpuBvh;
+    return *mGpuBvh[i];
+}
+
+void SceneObject::reposeBvh(const scene::ScenePose& p) {
+    for (auto& b : mGpuBvh)
+        if (b) b->update(p);
 }
 
 const StorageBufferSet& GpuScene::geometrySet() {

@@ -169,10 +169,13 @@ public:
 
     // The scene's ray-tracing BVH on the GPU (core/accel/gpu_bvh.hpp), for passes that trace rays. The
     // first call loads it from the bake cache ($VITRINE_CACHE_DIR/bake/bvh), or builds and stores it, and
-    // uploads it posed at `pose`; the scene node re-poses it every frame after that.
-    GpuBvh& bvh(Context& ctx);
-    bool hasBvh() const { return mGpuBvh != nullptr; }
+    // uploads it posed at `pose`; the scene node re-poses it every frame after that (repose()). `transparent`: the BVH
+    // that also holds the transparent primitives (accel::BvhBuildOptions::transparent), a second one.
+    GpuBvh& bvh(Context& ctx, bool transparent = false);
+    bool hasBvh() const { return mGpuBvh[0] != nullptr || mGpuBvh[1] != nullptr; }
     bool bvhFromCache() const { return mBvhFromCache; }
+    // Every uploaded BVH's top level at `pose`.
+    void reposeBvh(const scene::ScenePose& pose);
     void releaseGpu() override;
 
     // The pose of this frame and the last one (set by the scene node every frame).
@@ -183,8 +186,9 @@ public:
 private:
     std::shared_ptr<const scene::Scene> mScene;
     std::unique_ptr<GpuScene> mGpu;
-    std::unique_ptr<accel::SceneBvh> mBvh; // CPU copy, kept across releaseGpu()
-    std::unique_ptr<GpuBvh> mGpuBvh;
+    // [0] without, [1] with the transparent primitives.
+    std::unique_ptr<accel::SceneBvh> mBvh[2]; // CPU copy, kept across releaseGpu()
+    std::unique_ptr<GpuBvh> mGpuBvh[2];
     bool mBvhFromCache = false;
 };
 

@@ -131,6 +131,16 @@ NodeSchema schema() {
          2147483647.0,
          {},
          "Random sequence (independent estimates for noise measurements)"},
+        {"transparent",
+         ParamType::Bool,
+         true,
+         {},
+         {},
+         {},
+         "Trace what forward.transparent draws: alpha-blended surfaces by their coverage, alpha masks cut away, and "
+         "KHR_materials_transmission as thin-walled glass (straight on, tinted by the base colour and "
+         "KHR_materials_volume's attenuation), for paths and shadow rays alike (off: those surfaces are left out "
+         "of the scene, as for the bake and the twins, and masks are opaque)"},
         {"backend",
          ParamType::Enum,
          "auto",
@@ -145,6 +155,15 @@ NodeSchema schema() {
     return s;
 }
 
+// Whether any primitive lets light pass where the rasteriser draws it: an alpha mask, blending or transmission.
+bool seesThroughAnything(const scene::Scene& scene) {
+    for (const scene::Primitive& p : scene.primitives) {
+        const scene::Material& m = scene.materials[p.material];
+        if (m.transparent() || m.alphaMode == scene::AlphaMode::Mask) return true;
+    }
+    return false;
+}
+
 class Pathtrace final : public Node {
 public:
     void setup(SetupContext& ctx) override {
@@ -157,6 +176,7 @@ public:
         mPipeline =
             ctx.computePipeline("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 3);
         mStorePipeline = ctx.computePipeline("render/pathtrace_store.comp", {}, 1);
+        mSceneSeesThrough = seesThroughAnything(mScene->scene());
     }
 
     void execute(ExecuteContext& ctx) override {
@@ -191,7 +211,8 @@ private:
     void recordGpuSamples(ExecuteContext& ctx, uint32_t spp, uint32_t firstChunk, bool continueFrame, bool reset,
                           uint32_t seed, bool progress = false) {
         GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
-        GpuBvh& bvh = mScene->bvh(ctx.gpu());
+        const bool through = seeThrough(ctx.params());
+        GpuBvh& bvh = mScene->bvh(ctx.gpu(), through);
         const StorageBufferSet& geometry = gpu.geometrySet();
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
@@ -200,7 +221,7 @@ private:
         push.cameraPos = glm::vec4(cam.state.position, 0.0f);
         push.scales = {p.getFloat("sun_scale"), p.getFloat("sky_scale"), p.getFloat("emissive_scale"), 0.0f};
         uint32_t flags = (reset ? PATHTRACE_RESET : 0u) | (ctx.hasInput("env_cdf") ? PATHTRACE_ENV_CDF : 0u) |
-                         (p.getBool("antialias") ? PATHTRACE_ANTIALIAS : 0u);
+                         (p.getBool("antialias") ? PATHTRACE_ANTIALIAS : 0u) | (through ? PATHTRACE_SEE_THROUGH : 0u);
         const ImageDesc& out = ctx.output("color").desc();
         const uint32_t chunks = (spp + PATHTRACE_SAMPLES_PER_DISPATCH - 1) / PATHTRACE_SAMPLES_PER_DISPATCH;
         const uint32_t every = std::max(1u, chunks / 10);
@@ -244,6 +265,7 @@ private:
         for (const char* name : {"spp", "max_bounces", "seed", "min_spp"}) h.value(p.getInt(name));
         for (const char* name : {"sun_scale", "sky_scale", "emissive_scale", "target_noise"}) h.value(p.getFloat(name));
         h.value(p.getBool("antialias"));
+        if (seeThrough(p)) h.string("see through v1"); // keys of scenes traced as before are unchanged
         if (cpu) {
             h.string("cpu");
             h.value(kCpuTracerVersion);
@@ -316,8 +338,9 @@ private:
     void traceCpuBatch(ExecuteContext& ctx, const CpuSky& sky, const ImageDesc& out, uint32_t spp, uint32_t seed) {
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
-        if (!mCpu || mScene->pose.instanceWorld != mCpuPose) {
-            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld);
+        if (!mCpu || mScene->pose.instanceWorld != mCpuPose || mCpuSeesThrough != seeThrough(p)) {
+            mCpuSeesThrough = seeThrough(p);
+            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld, mCpuSeesThrough);
             mCpuPose = mScene->pose.instanceWorld;
         }
         CpuTraceSettings s;
@@ -333,6 +356,7 @@ private:
         s.emissiveScale = p.getFloat("emissive_scale");
         s.antialias = p.getBool("antialias");
         s.envSampling = ctx.hasInput("env_cdf");
+        s.seeThrough = mCpuSeesThrough;
         const CpuTraceCounters c = mCpu->trace(s, sky, mAccumulation);
         mLastPathsPerSecond = static_cast<double>(c.paths) / std::max(c.seconds, 1e-9);
         mLastRaysPerSecond = static_cast<double>(c.rays) / std::max(c.seconds, 1e-9);
@@ -349,7 +373,7 @@ private:
     void executeCpu(ExecuteContext& ctx) {
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
-        const bool posed = mCpu && mScene->pose.instanceWorld == mCpuPose;
+        const bool posed = mCpu && mScene->pose.instanceWorld == mCpuPose && mCpuSeesThrough == seeThrough(p);
         bool moved = cam.viewProjNoJitter != mLastViewProj || !posed;
         bool reset = !ctx.hasInput("history") || !ctx.inputValid("history") || moved;
         mLastViewProj = cam.viewProjNoJitter;
@@ -358,7 +382,8 @@ private:
         ctx.splitSubmission(); // the sky nodes' work of this frame is done before it is read back
         const CpuSky sky = readCpuSky(ctx);
         if (!posed) {
-            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld);
+            mCpuSeesThrough = seeThrough(p);
+            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld, mCpuSeesThrough);
             mCpuPose = mScene->pose.instanceWorld;
         }
         const ImageDesc& out = ctx.output("color").desc();
@@ -379,6 +404,7 @@ private:
         s.emissiveScale = p.getFloat("emissive_scale");
         s.antialias = p.getBool("antialias");
         s.envSampling = ctx.hasInput("env_cdf");
+        s.seeThrough = mCpuSeesThrough;
 
         const bool report = p.getBool("report");
         std::unique_ptr<Progress> bar;
@@ -456,8 +482,13 @@ private:
         logInfo(summaryLine(samples, seconds, relative) + rate);
     }
 
+    // `transparent`, where the scene has anything to see through (else the opaque scene, traced as without it).
+    bool seeThrough(const Params& p) const { return mSceneSeesThrough && p.getBool("transparent"); }
+
     std::shared_ptr<SceneObject> mScene;
     std::shared_ptr<CameraObject> mCamera;
+    bool mSceneSeesThrough = false;
+    bool mCpuSeesThrough = false; // what mCpu was built for
     PipelineId mPipeline = 0, mStorePipeline = 0;
     glm::mat4 mLastViewProj{0.0f};
     // The CPU tracer: its Embree scene (of the pose it was built at), its accumulation and the result buffer.

@@ -6,6 +6,7 @@
 #include "core/base/error.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "core/shading/brdf.hpp"
+#include "shaders/render/pathtrace.h"
 #include "shaders/scene/scene.h"
 
 #include <embree3/rtcore.h>
@@ -458,6 +459,13 @@ struct Materials {
         return glm::clamp(s, 0.0f, 1.0f);
     }
 
+    // scene.glsl materialThickness: KHR_materials_volume's thickness in the mesh's units (0: thin-walled).
+    float materialThickness(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
+        float t = m.optics.w;
+        if (m.thicknessRef.info.x >= 0) t *= sampleRef(m.thicknessRef, uv0, uv1).g;
+        return std::max(t, 0.0f);
+    }
+
     // scene.glsl materialSpecular: KHR_materials_specular's colour (rgb) and strength (a).
     vec4 materialSpecular(const GpuMaterial& m, vec2 uv0, vec2 uv1) const {
         vec4 s = m.specular;
@@ -545,15 +553,14 @@ struct CpuPathTracer::Impl {
     std::vector<glm::vec3> worldPositions; // 3 per triangle (the shading's geometric normal uses world positions)
     RTCDevice device = nullptr;
     RTCScene rtc = nullptr;
+    RTCScene rtcOpaque = nullptr; // with `transparent`: the triangles no light passes
 
-    Impl(const scene::Scene& s, const std::vector<glm::mat4>& instanceWorld) : scene(s), world(instanceWorld) {
+    Impl(const scene::Scene& s, const std::vector<glm::mat4>& instanceWorld, bool transparent)
+        : scene(s), world(instanceWorld) {
         packMaterials(s, materials.materials, materials.layers);
         materials.pool = packTexelPool(s);
         device = rtcNewDevice("threads=1"); // our own threads call into it; its builder uses one
         if (!device) throw InternalError("render.pathtrace: Embree could not create a device");
-        rtc = rtcNewScene(device);
-        rtcSetSceneFlags(rtc, RTC_SCENE_FLAG_ROBUST);
-        rtcSetSceneBuildQuality(rtc, RTC_BUILD_QUALITY_HIGH);
         for (size_t i = 0; i < s.instances.size(); ++i) {
             const glm::mat4& w = i < world.size() ? world[i] : s.instances[i].world;
             if (i >= world.size()) world.push_back(w);
@@ -561,8 +568,8 @@ struct CpuPathTracer::Impl {
             const scene::Mesh& mesh = s.meshes[s.instances[i].mesh];
             for (uint32_t p = mesh.firstPrimitive; p < mesh.firstPrimitive + mesh.primitiveCount; ++p) {
                 const scene::Primitive& prim = s.primitives[p];
-                // As the GPU BVH (core/accel/scene_bvh.cpp): transparent primitives are left out.
-                if (s.materials[prim.material].transparent()) continue;
+                // As the GPU BVH (core/accel/scene_bvh.cpp): transparent primitives are left out unless asked for.
+                if (!transparent && s.materials[prim.material].transparent()) continue;
                 for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
                     for (uint32_t k = 0; k < 3; ++k) {
                         const scene::Vertex& v = s.vertices[s.indices[prim.firstIndex + 3 * t + k] + prim.vertexOffset];
@@ -572,26 +579,47 @@ struct CpuPathTracer::Impl {
                 }
             }
         }
+        rtc = newScene(worldPositions);
+        if (transparent) {
+            // The triangles that stop every shadow ray (neither masked nor transparent): a shadow ray that one of them
+            // blocks needs no walk over the surfaces it would otherwise pass (shadowTransmittance).
+            std::vector<glm::vec3> opaque;
+            for (size_t t = 0; t < refs.size(); ++t) {
+                const scene::Material& m = s.materials[refs[t].material];
+                if (m.transparent() || m.alphaMode == scene::AlphaMode::Mask) continue;
+                opaque.insert(opaque.end(), worldPositions.begin() + 3 * t, worldPositions.begin() + 3 * t + 3);
+            }
+            rtcOpaque = newScene(opaque);
+        }
+    }
+
+    // An Embree scene of the triangles whose corners are positions[3 t + 0..2].
+    RTCScene newScene(const std::vector<glm::vec3>& positions) const {
+        RTCScene scene = rtcNewScene(device);
+        rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+        rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
         RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        const size_t triangles = refs.size();
+        const size_t triangles = positions.size() / 3;
         float* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                                3 * sizeof(float), std::max<size_t>(1, 3 * triangles)));
         uint32_t* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                      3 * sizeof(uint32_t), triangles));
-        for (size_t i = 0; i < worldPositions.size(); ++i) {
-            vb[3 * i] = worldPositions[i].x;
-            vb[3 * i + 1] = worldPositions[i].y;
-            vb[3 * i + 2] = worldPositions[i].z;
+        for (size_t i = 0; i < positions.size(); ++i) {
+            vb[3 * i] = positions[i].x;
+            vb[3 * i + 1] = positions[i].y;
+            vb[3 * i + 2] = positions[i].z;
         }
         for (size_t i = 0; i < 3 * triangles; ++i) ib[i] = static_cast<uint32_t>(i);
         rtcCommitGeometry(geom);
-        rtcAttachGeometry(rtc, geom);
+        rtcAttachGeometry(scene, geom);
         rtcReleaseGeometry(geom);
-        rtcCommitScene(rtc);
+        rtcCommitScene(scene);
+        return scene;
     }
 
     ~Impl() {
         if (rtc) rtcReleaseScene(rtc);
+        if (rtcOpaque) rtcReleaseScene(rtcOpaque);
         if (device) rtcReleaseDevice(device);
     }
 
@@ -625,6 +653,9 @@ struct CpuPathTracer::Impl {
     }
 
     bool occluded(vec3 o, vec3 d, uint64_t& rays, float tmax = kInfinity) const {
+        return occludedIn(rtc, o, d, rays, tmax);
+    }
+    bool occludedIn(RTCScene scene, vec3 o, vec3 d, uint64_t& rays, float tmax = kInfinity) const {
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
         RTCRay r{};
@@ -637,9 +668,63 @@ struct CpuPathTracer::Impl {
         r.tnear = 0.0f;
         r.tfar = tmax;
         r.mask = ~0u;
-        rtcOccluded1(rtc, &context, &r);
+        rtcOccluded1(scene, &context, &r);
         ++rays;
         return r.tfar < 0.0f;
+    }
+
+    // pathtrace.comp's dielectricThrough: what a thin-walled transmissive dielectric lets pass straight on.
+    static vec3 dielectricThrough(const PathSurface& s, vec3 v) {
+        float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
+        vec3 t =
+            (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
+        if (hasSheen(s.sheen)) t *= sheenScaling(vec3(s.sheen), NoV, s.sheen.a);
+        return clearcoatLayer(t, s.coat.x, glm::dot(s.coatNormal, v), vec3(0.0f));
+    }
+
+    // pathtrace.comp's pathPassing: what passes s on a shadow ray (0 for an opaque surface).
+    static vec3 pathPassing(const PathSurface& s, vec3 v) {
+        vec3 through =
+            s.transmission > 0.0f ? s.transmission * (1.0f - s.metallic) * dielectricThrough(s, v) : vec3(0.0f);
+        return vec3(1.0f - s.coverage) + s.coverage * through;
+    }
+
+    // pathtrace.comp's shadowTransmittance: 0 behind anything opaque, 1 with nothing in the way; with seeThrough the
+    // product of pathPassing over every surface crossed (at most PATHTRACE_MAX_PASSES).
+    vec3 shadowTransmittance(vec3 o, vec3 d, bool seeThrough, uint64_t& rays) const {
+        if (!seeThrough) return occluded(o, d, rays) ? vec3(0.0f) : vec3(1.0f);
+        // First against what no light passes (the GPU tracer walks the surfaces only: one BVH there); then every hit
+        // left is one to pass.
+        if (rtcOpaque && occludedIn(rtcOpaque, o, d, rays)) return vec3(0.0f);
+        vec3 T(1.0f);
+        float tmin = 0.0f;
+        for (uint32_t i = 0; i < PATHTRACE_MAX_PASSES; ++i) {
+            Hit hit;
+            if (!closest(o, d, tmin, hit, rays)) return T;
+            T *= pathPassing(pathSurface(hit, o, d), -d);
+            if (std::max(std::max(T.r, T.g), T.b) <= 0.0f) return vec3(0.0f);
+            tmin = std::nextafter(hit.t, kInfinity); // Embree's tnear is inclusive, the GLSL test strict
+        }
+        return vec3(0.0f);
+    }
+
+    // pathtrace.comp's drawTransmission: one component of KHR_materials_transmission's mixture; true when the path
+    // passes (throughput scaled), else s is the drawn component's reflecting surface.
+    static bool drawTransmission(PathSurface& s, vec3 v, vec3& throughput, uint32_t& rng) {
+        float u = rngNext(rng), metallic = s.metallic;
+        s.metallic = u < metallic ? 1.0f : 0.0f;
+        if (u < metallic + (1.0f - metallic) * (1.0f - s.transmission)) return false;
+        vec3 through = dielectricThrough(s, v);
+        float reflected = luminance(
+            schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f)));
+        float pass = std::clamp(luminance(through) / std::max(luminance(through) + reflected, 1e-6f), 0.05f, 0.95f);
+        if (rngNext(rng) < pass) {
+            throughput *= through / pass;
+            return true;
+        }
+        throughput /= 1.0f - pass;
+        s.baseColor = vec3(0.0f);
+        return false;
     }
 
     // pathCulled: the back of a single-sided material's triangle, which the rasteriser culls.
@@ -745,6 +830,22 @@ struct CpuPathTracer::Impl {
         s.roughness = roughnessFromShininess(std::clamp(l.shininess, 0.0f, 1.0f));
         s.cavity = std::clamp(l.cavity, 0.0f, 1.0f);
         s.dielectric = dielectricSpecular(0.04f, materials.materialSpecular(m, uv0, uv1));
+        // surface.glsl's PATHTRACE_SEE_THROUGH_SURFACE part: coverage, transmission and the volume's attenuation.
+        s.coverage = m.info.z == 1u   ? (l.albedo.a < m.emissive.a ? 0.0f : 1.0f)
+                     : m.info.z == 2u ? std::clamp(l.albedo.a, 0.0f, 1.0f)
+                                      : 1.0f;
+        s.transmission = m.optics.x;
+        if (s.transmission > 0.0f) {
+            s.dielectric = dielectricSpecular(m.optics.y, materials.materialSpecular(m, uv0, uv1));
+            const float thickness = materials.materialThickness(m, uv0, uv1);
+            if (thickness > 0.0f && m.volume.a > 0.0f) {
+                const vec3 modelScale(glm::length(w[0]), glm::length(w[1]), glm::length(w[2]));
+                const float r = std::sqrt(m.optics.y);
+                const vec3 refracted = glm::normalize(glm::refract(direction, N, (1.0f - r) / (1.0f + r)));
+                s.attenuation =
+                    glm::pow(vec3(m.volume), vec3(glm::length(refracted * thickness * modelScale) / m.volume.a));
+            }
+        }
         s.emissive = vec3(m.emissive);
         if (m.emissiveRef.info.x >= 0) s.emissive *= vec3(materials.sampleRef(m.emissiveRef, uv0, uv1));
         if (m.optics.z > 0.5f) {
@@ -762,6 +863,8 @@ struct CpuPathTracer::Impl {
         vec3 radiance{0.0f}, throughput{1.0f};
         float brdfPdfPrev = 0.0f;
         uint32_t rng = 0, bounce = 0;
+        uint32_t passes = 0; // surfaces passed through (seeThrough; not bounces)
+        bool ended = false;  // passed through more than PATHTRACE_MAX_PASSES
         Hit hit{};
     };
     struct PathLights {
@@ -775,6 +878,24 @@ struct CpuPathTracer::Impl {
         l.sunDir = glm::normalize(env.sky->sunDirection);
         l.sun = l.sunE.x > 0.0f || l.sunE.y > 0.0f || l.sunE.z > 0.0f;
         return l;
+    }
+
+    // pathtrace.comp's tracePath at a surface found along p.dir: alpha coverage, then (where covered) the emission and
+    // the transmission's component. True when the path passes through it (p moved past it, not a bounce); false when
+    // s reflects (p.radiance has its emission) or the path ends (p.passes over the limit).
+    bool passSurface(PathState& p, PathSurface& s, const CpuTraceSettings& st) const {
+        bool pass = st.seeThrough && s.coverage < 1.0f && rngNext(p.rng) >= s.coverage;
+        if (!pass) {
+            p.radiance += p.throughput * s.emissive * st.emissiveScale;
+            if (st.seeThrough && s.transmission > 0.0f) pass = drawTransmission(s, -p.dir, p.throughput, p.rng);
+        }
+        if (!pass) return false;
+        if (++p.passes > PATHTRACE_MAX_PASSES) {
+            p.ended = true;
+            return false;
+        }
+        p.origin = offsetRay(s.position, s.geometricNormal, p.dir);
+        return true;
     }
 
     // The path left the scene: the sky it sees, MIS-weighted against the sky's own sampling after a bounce.
@@ -802,9 +923,10 @@ struct CpuPathTracer::Impl {
             const vec2 coat(s.coat.x, regularizedRoughness(s.coat.y, st.causticFootprint, s.t));
             vec3 f = brdfCosineSheen(n, s.coatNormal, v, lights.sunDir, s.baseColor, s.metallic, roughness,
                                      s.dielectric, coat, s.sheen);
-            if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) &&
-                !occluded(offsetRay(s.position, ng, lights.sunDir), lights.sunDir, rays))
-                p.radiance += weight * f * lights.sunE;
+            if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
+                p.radiance +=
+                    weight * f * lights.sunE *
+                    shadowTransmittance(offsetRay(s.position, ng, lights.sunDir), lights.sunDir, st.seeThrough, rays);
         }
         if (lights.envSampling) {
             float a = rngNext(p.rng);
@@ -814,8 +936,10 @@ struct CpuPathTracer::Impl {
             if (glm::dot(ng, l) > 0.0f && pdf > 0.0f) {
                 vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
-                if ((f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) && !occluded(offsetRay(s.position, ng, l), l, rays))
-                    p.radiance += weight * f * env.radiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
+                if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
+                    p.radiance += weight * f * env.radiance(l) *
+                                  shadowTransmittance(offsetRay(s.position, ng, l), l, st.seeThrough, rays) *
+                                  powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
         }
 
@@ -866,7 +990,11 @@ struct CpuPathTracer::Impl {
                     break;
                 }
                 s = pathSurface(p.hit, p.origin, p.dir);
-                p.radiance += p.throughput * s.emissive * st.emissiveScale;
+                if (passSurface(p, s, st)) {
+                    --p.bounce; // passing is not a bounce (the loop's ++ gives it back)
+                    continue;
+                }
+                if (p.ended) break;
             }
             if (!shadeVertex(p, s, st, env, lights, rays)) break;
         }
@@ -901,8 +1029,11 @@ struct CpuPathTracer::Impl {
             for (size_t a = 0; a < alive; ++a) {
                 PathState& p = paths[live[a]];
                 PathSurface s = pathSurface(p.hit, p.origin, p.dir);
-                p.radiance += p.throughput * s.emissive * st.emissiveScale;
-                if (!shadeVertex(p, s, st, env, lights, rays)) continue;
+                if (passSurface(p, s, st)) { // on through it, the same bounce
+                    live[kept++] = live[a];
+                    continue;
+                }
+                if (p.ended || !shadeVertex(p, s, st, env, lights, rays)) continue;
                 ++p.bounce;
                 live[kept++] = live[a];
             }
@@ -984,8 +1115,8 @@ struct CpuPathTracer::Impl {
     }
 };
 
-CpuPathTracer::CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld)
-    : mImpl(std::make_unique<Impl>(scene, instanceWorld)) {}
+CpuPathTracer::CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld, bool transparent)
+    : mImpl(std::make_unique<Impl>(scene, instanceWorld, transparent)) {}
 
 CpuPathTracer::~CpuPathTracer() = default;
 

@@ -40,6 +40,9 @@ struct CpuTraceSettings {
     // Metres over which the sun's reflection by a glossy lobe is spread (regularizedRoughness; the lightmap bake's
     // caustic_footprint). 0, the path tracer's: exact.
     float causticFootprint = 0.0f;
+    // render.pathtrace's `transparent` on a tracer built with its transparent primitives: paths and shadow rays pass
+    // alpha coverage and KHR_materials_transmission (pathtrace.comp's PATHTRACE_SEE_THROUGH).
+    bool seeThrough = false;
 };
 
 // Per-pixel accumulation, the layout of the node's outputs: color (mean rgb, 1) and stats (count, mean luminance,
@@ -73,6 +76,11 @@ struct CpuSurface {
     glm::vec3 coatNormal{0.0f};
     // KHR_materials_sheen: colour (rgb) and perceptual roughness (a); 0 without it.
     glm::vec4 sheen{0.0f};
+    // What lets light pass (read only with CpuTraceSettings::seeThrough): 0 where an alpha mask cuts the surface away,
+    // a blended surface's alpha, else 1; KHR_materials_transmission's factor; KHR_materials_volume's Beer attenuation
+    // over the refracted path through the thickness (1 without).
+    float coverage = 1.0f, transmission = 0.0f;
+    glm::vec3 attenuation{1.0f};
 };
 
 class CpuPathTracer;
@@ -131,8 +139,9 @@ struct CpuTraceCounters {
 
 class CpuPathTracer {
 public:
-    // Builds the Embree scene of every instance at `instanceWorld` (the pose of the frame).
-    CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld);
+    // Builds the Embree scene of every instance at `instanceWorld` (the pose of the frame); with `transparent` it holds
+    // the transparent primitives too (alpha blend, transmission), for CpuTraceSettings::seeThrough.
+    CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld, bool transparent = false);
     ~CpuPathTracer();
     CpuPathTracer(const CpuPathTracer&) = delete;
     CpuPathTracer& operator=(const CpuPathTracer&) = delete;

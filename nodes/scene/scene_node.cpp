@@ -247,7 +247,7 @@ void SceneNode::execute(ExecuteContext& ctx) {
     c.time = t;
     c.frame = frame;
     gpu.update(mScene->pose, mScene->previousPose, c);
-    if (mScene->hasBvh()) mScene->bvh(ctx.gpu()).update(mScene->pose);
+    mScene->reposeBvh(mScene->pose);
 }
 
 } // namespace vitrine

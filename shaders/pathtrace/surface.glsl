@@ -32,6 +32,12 @@ struct PathSurface {
     vec2 coat;       // KHR_materials_clearcoat: strength, perceptual roughness (0, 0 without it)
     vec4 sheen;      // KHR_materials_sheen: colour (rgb), perceptual roughness (a); 0 without it
     vec3 coatNormal; // the coat's shading normal (its own normal map, else the vertex normal); `normal` without a coat
+#ifdef PATHTRACE_SEE_THROUGH_SURFACE
+    // What lets light pass (render.pathtrace's `transparent`: render/pathtrace.comp; the bake does not see through):
+    float coverage;     // 0 where an alpha mask cuts the surface away, a blended surface's alpha, else 1
+    float transmission; // KHR_materials_transmission's factor (0: opaque)
+    vec3 attenuation;   // KHR_materials_volume: Beer's law over the refracted path through the thickness; 1 without
+#endif
 };
 
 vec3 vertexVec3(uint v, uint offset) {
@@ -140,6 +146,24 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     // KHR_materials_specular over the fixed dielectric F0 of specularF0 (the tracer, like the G-buffer path, does
     // not read KHR_materials_ior).
     s.dielectric = dielectricSpecular(0.04, materialSpecular(m, uv0, uv1, lod0));
+#ifdef PATHTRACE_SEE_THROUGH_SURFACE
+    // As forward.transparent draws them: a mask's cut-off and a blend's alpha (the layers' alpha, not the vertex
+    // colour's), and for transmission the dielectric's F0 from KHR_materials_ior and the volume's Beer attenuation
+    // attenuationColor^(d / attenuationDistance) over d = |refracted direction x thickness x the instance's scale|.
+    s.coverage = m.info.z == 1u ? (l.albedo.a < m.emissive.a ? 0.0 : 1.0) : m.info.z == 2u ? clamp(l.albedo.a, 0.0, 1.0) : 1.0;
+    s.transmission = m.optics.x;
+    s.attenuation = vec3(1.0);
+    if (s.transmission > 0.0) {
+        s.dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, uv0, uv1, lod0));
+        float thickness = materialThickness(m, uv0, uv1, lod0);
+        if (thickness > 0.0 && m.volume.a > 0.0) {
+            vec3 modelScale = vec3(length(world[0]), length(world[1]), length(world[2]));
+            float r = sqrt(m.optics.y); // 1/ior = (1 - sqrt(F0)) / (1 + sqrt(F0))
+            vec3 refracted = normalize(refract(direction, N, (1.0 - r) / (1.0 + r)));
+            s.attenuation = pow(m.volume.rgb, vec3(length(refracted * thickness * modelScale) / m.volume.a));
+        }
+    }
+#endif
     s.emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) s.emissive *= sampleRef(m.emissiveRef, uv0, uv1, lod0).rgb;
     // KHR_materials_unlit, as gbuffer/unlit.glsl: the colour is emitted and nothing is reflected (cavity 0).

@@ -6,13 +6,17 @@
 // texel 9) by next-event estimation, the sky cube map as an environment light (importance sampled with
 // sky.env_cdf and combined with BRDF sampling by the power heuristic), emissive surfaces hit by BRDF
 // sampling. Russian roulette after the third surface; at most `max_bounces` surfaces reflect light.
+// With `transparent` (PATHTRACE_SEE_THROUGH) the BVH also holds forward.transparent's surfaces and light passes them
+// as it passes there: alpha coverage, and KHR_materials_transmission as thin-walled glass (straight on, tinted by the
+// base colour and KHR_materials_volume's attenuation), for paths and shadow rays alike.
 #define VITRINE_BVH_SET 1
 #define VITRINE_SCENE_SET 2
 #define VITRINE_GEOMETRY_SET 3
 #define VITRINE_SCENE_TEXEL_POOL // one buffer for all textures: no walk over the sampler array per sample
+#include "render/pathtrace.h"
+#define PATHTRACE_SEE_THROUGH_SURFACE // PathSurface's coverage, transmission and attenuation
 #include "pathtrace/sampling.glsl"
 #include "pathtrace/surface.glsl"
-#include "render/pathtrace.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform samplerCube in_sky;
@@ -33,6 +37,61 @@ vec3 offsetRay(vec3 p, vec3 ng, vec3 dir) {
     return p + ng * (dot(ng, dir) >= 0.0 ? scale : -scale);
 }
 
+// KHR_materials_transmission's thin-walled dielectric (forward.transparent's `through`): what it does not reflect,
+// 1 - F(n.v), tinted by the base colour and the volume's attenuation, then scaled by the sheen's albedo and seen
+// through the coat, 1 - c Fc(nc.v). Straight on: no refraction offset, no blur by roughness.
+vec3 dielectricThrough(PathSurface s, vec3 v) {
+    float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
+    vec3 t = (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
+    if (hasSheen(s.sheen)) t *= sheenScaling(s.sheen.rgb, NoV, s.sheen.a);
+    return clearcoatLayer(t, s.coat.x, dot(s.coatNormal, v), vec3(0.0));
+}
+
+// What passes surface s seen along -v on a shadow ray: its uncovered share, plus where it is covered the transmissive
+// dielectric's share (1 - metallic) transmission of dielectricThrough. 0 for an opaque surface.
+vec3 pathPassing(PathSurface s, vec3 v) {
+    vec3 through = s.transmission > 0.0 ? s.transmission * (1.0 - s.metallic) * dielectricThrough(s, v) : vec3(0.0);
+    return vec3(1.0 - s.coverage) + s.coverage * through;
+}
+
+// The light a shadow ray from origin along dir brings through what lies in its way: 0 behind anything opaque (either
+// side, as shadow.directional draws both); with seeThrough the product of pathPassing over every surface it crosses.
+vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough) {
+    if (!seeThrough) return bvhTraceAny(origin, dir, 0.0, kInfinity) ? vec3(0.0) : vec3(1.0);
+    vec3 T = vec3(1.0);
+    float tmin = 0.0;
+    for (uint i = 0u; i < PATHTRACE_MAX_PASSES; ++i) {
+        BvhHit hit;
+        if (!bvhTraceClosest(origin, dir, tmin, kInfinity, hit)) return T;
+        T *= pathPassing(pathSurface(hit, origin, dir), -dir);
+        if (max(max(T.r, T.g), T.b) <= 0.0) return vec3(0.0);
+        tmin = hit.t;
+    }
+    return vec3(0.0);
+}
+
+// KHR_materials_transmission as the glTF spec mixes it, one component drawn per surface: the metal (probability
+// metallic), the opaque dielectric ((1 - metallic)(1 - transmission)) and the transmissive one ((1 - metallic)
+// transmission), whose reflection is its specular alone and which lets dielectricThrough pass straight on. Each is
+// drawn with its own probability and weighted 1, so the estimate is the mixture's. Inside the transmissive one,
+// passing is chosen in proportion to what passes against what is reflected (clamped to [0.05, 0.95]) and weighted by
+// its inverse. True when the path passes (throughput scaled); else s is the drawn component's reflecting surface.
+bool drawTransmission(inout PathSurface s, vec3 v, inout vec3 throughput, inout uint rng) {
+    float u = rngNext(rng), metallic = s.metallic;
+    s.metallic = u < metallic ? 1.0 : 0.0;
+    if (u < metallic + (1.0 - metallic) * (1.0 - s.transmission)) return false;
+    vec3 through = dielectricThrough(s, v);
+    float reflected = luminance(schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, clamp(dot(s.normal, v), 0.0, 1.0)));
+    float pass = clamp(luminance(through) / max(luminance(through) + reflected, 1e-6), 0.05, 0.95);
+    if (rngNext(rng) < pass) {
+        throughput *= through / pass;
+        return true;
+    }
+    throughput /= 1.0 - pass;
+    s.baseColor = vec3(0.0); // no diffuse: the transmissive dielectric reflects by its specular only
+    return false;
+}
+
 vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     bool envSampling = (push.counts.w & PATHTRACE_ENV_CDF) != 0u && push.scales.y > 0.0;
     int envSize = textureSize(in_sky, 0).x;
@@ -40,11 +99,13 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     vec3 sunE = texelFetch(in_sky_sh, ivec2(9, 0), 0).rgb * push.scales.x;
     vec3 sunDir = normalize(texelFetch(in_sky_sh, ivec2(10, 0), 0).xyz);
     bool sun = any(greaterThan(sunE, vec3(0.0)));
+    bool seeThrough = (push.counts.w & PATHTRACE_SEE_THROUGH) != 0u;
 
     vec3 radiance = vec3(0.0), throughput = vec3(1.0);
     float brdfPdfPrev = 0.0; // density of the last BRDF-sampled direction (0: a camera ray)
     uint maxBounces = push.counts.y;
-    for (uint bounce = 0u;; ++bounce) {
+    uint passes = 0u; // surfaces passed through (not bounces)
+    for (uint bounce = 0u;;) {
         BvhHit hit;
         if (!pathTraceVisible(origin, dir, hit)) {
             float w = bounce == 0u || !envSampling ? 1.0 : powerHeuristic(brdfPdfPrev, envPdf(in_env_cdf, envSize, dir));
@@ -52,8 +113,18 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
             break;
         }
         PathSurface s = pathSurface(hit, origin, dir);
-        // Emitters are not sampled as lights: what BRDF sampling finds counts in full.
-        radiance += throughput * s.emissive * push.scales.z;
+        // Alpha coverage: the uncovered share lets the path on, untouched (an alpha mask's cut-away part always).
+        bool pass = seeThrough && s.coverage < 1.0 && rngNext(rng) >= s.coverage;
+        if (!pass) {
+            // Emitters are not sampled as lights: what BRDF sampling finds counts in full.
+            radiance += throughput * s.emissive * push.scales.z;
+            if (seeThrough && s.transmission > 0.0) pass = drawTransmission(s, -dir, throughput, rng);
+        }
+        if (pass) { // straight on from the far side; the direction's density (for MIS at the sky) is unchanged
+            if (++passes > PATHTRACE_MAX_PASSES) break;
+            origin = offsetRay(s.position, s.geometricNormal, dir);
+            continue;
+        }
         if (bounce >= maxBounces) break;
 
         vec3 v = -dir, n = s.normal, ng = s.geometricNormal;
@@ -68,8 +139,8 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         if (sun && dot(ng, sunDir) > 0.0) {
             vec3 f = brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
-            if (any(greaterThan(f, vec3(0.0))) && !bvhTraceAny(offsetRay(s.position, ng, sunDir), sunDir, 0.0, kInfinity))
-                radiance += weight * f * sunE;
+            if (any(greaterThan(f, vec3(0.0))))
+                radiance += weight * f * sunE * shadowTransmittance(offsetRay(s.position, ng, sunDir), sunDir, seeThrough);
         }
         // Sky: a direction from its luminance table, weighted against BRDF sampling (power heuristic).
         if (envSampling) {
@@ -78,8 +149,9 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
             if (dot(ng, l) > 0.0 && pdf > 0.0) {
                 vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
-                if (any(greaterThan(f, vec3(0.0))) && !bvhTraceAny(offsetRay(s.position, ng, l), l, 0.0, kInfinity))
-                    radiance += weight * f * skyRadiance(l) * powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
+                if (any(greaterThan(f, vec3(0.0))))
+                    radiance += weight * f * skyRadiance(l) * shadowTransmittance(offsetRay(s.position, ng, l), l, seeThrough) *
+                                powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
         }
 
@@ -100,6 +172,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         }
         origin = offsetRay(s.position, ng, l);
         dir = l;
+        ++bounce;
     }
     return radiance;
 }

@@ -18,6 +18,11 @@ VITRINE_PUSH_END(push)
 #define PATHTRACE_ENV_CDF 2u    // sky.env_cdf is connected: sample the environment as a light (with MIS)
 #define PATHTRACE_ANTIALIAS 4u  // jitter the primary rays over the pixel (off: through the pixel centre)
 #define PATHTRACE_CONTINUE 8u   // a later dispatch of the frame: add to the outputs (not to the history)
+#define PATHTRACE_SEE_THROUGH 16u // `transparent` and the BVH holds surfaces that let light pass (mask, blend, transmission)
+
+// Surfaces a path or a shadow ray passes through at most (alpha-cut, uncovered or transmitting), counted apart from
+// the bounces; a shadow ray with more is taken as blocked, a path with more ends.
+#define PATHTRACE_MAX_PASSES 16u
 
 // Samples per dispatch. Lavapipe (gallivm) stops every loop of an invocation once the invocation has run
 // 65535 loop iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS, a guard against infinite loops): BVH traversal,

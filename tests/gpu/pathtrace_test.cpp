@@ -1007,5 +1007,244 @@ PATHTRACE_TEST(AccumulationConvergesAndRestartsWhenTheCameraMoves) {
     EXPECT_EQ(still.at("stats").at(W / 2, H - 2)[0], 12.0f);
 }
 
+// --- render.pathtrace's `transparent`: what forward.transparent draws, traced (alpha coverage, KHR_materials_
+// transmission as thin-walled glass, KHR_materials_volume's attenuation), for paths and shadow rays ---
+
+// A pane facing +z, 3 m in front of the camera (which looks at it obliquely, so the pixels see it at 0-40 degrees),
+// under a uniform sky C, traced through pixel centres. `materials` makes the pane's material(s); with two, the left
+// half (x < 0) gets the first. Returns every pixel whose ray crosses the pane at least 1 m inside its edges, with its
+// unit ray, in `pixels` (left half) and `right`.
+struct PaneTrace {
+    std::map<std::string, Image> out;
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> pixels, right;
+};
+
+PaneTrace tracePane(const std::string& name, double C, json params,
+                    const std::function<std::vector<uint32_t>(SceneBuilder&)>& materials,
+                    glm::vec3 scale = glm::vec3(1.0f)) {
+    const int W = 40, H = 30;
+    const float half = 10.0f, depth = 3.0f;
+    SceneBuilder b(name);
+    const std::vector<uint32_t> m = materials(b);
+    for (size_t i = 0; i < m.size(); ++i) {
+        std::vector<Tri> quad;
+        const float w = m.size() == 1 ? half : half / 2.0f, cx = m.size() == 1 ? 0.0f : (i == 0 ? -w : w);
+        addQuad(quad, glm::vec3(cx / scale.x, 0, 0), glm::vec3(w / scale.x, 0, 0), glm::vec3(0, half / scale.y, 0),
+                glm::vec3(0, 0, 1));
+        b.node("pane" + std::to_string(i), static_cast<int32_t>(b.mesh("pane" + std::to_string(i), quad, m[i])),
+               glm::vec3(0, 0, -depth));
+        b.s.nodes.back().local.scale = scale;
+    }
+    b.camera({0.0f, 0.0f, 0.0f}, {0.4f, 0.3f, -depth}, 1.2f);
+    auto glb = b.write();
+    params["antialias"] = false;
+    PaneTrace t;
+    t.out = runGraph(traceGraph(glb, uniformSky(glb, C), params, W, H));
+    Pinhole cam(b.s, W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.z >= 0.0) continue;
+            glm::dvec3 p = d * (-depth / d.z);
+            if (std::abs(p.x) > half - 1.0 || std::abs(p.y) > half - 1.0 || (m.size() > 1 && std::abs(p.x) < 1.0))
+                continue;
+            (m.size() > 1 && p.x > 0.0 ? t.right : t.pixels).push_back({{x, y}, d});
+        }
+    return t;
+}
+
+// Per channel, the mean over the pixels of traced / expected(ray); the largest departure from 1 is returned.
+double meanRatioError(const Image& traced, const std::vector<std::pair<glm::ivec2, glm::dvec3>>& pixels,
+                      const std::function<glm::dvec3(glm::dvec3)>& expected, const char* what) {
+    glm::dvec3 sum(0.0);
+    for (const auto& [px, d] : pixels)
+        sum += rgb(traced, px.x, px.y) / expected(d);
+    const glm::dvec3 mean = sum / static_cast<double>(pixels.size());
+    std::printf("%s tracer, %s: %zu pixels, mean traced / expected per channel %.4f %.4f %.4f\n", gBackend, what,
+                pixels.size(), mean.r, mean.g, mean.b);
+    return std::max({std::abs(mean.r - 1.0), std::abs(mean.g - 1.0), std::abs(mean.b - 1.0)});
+}
+
+// KHR_materials_transmission: smooth (shininess 1) tinted glass panes of base colour c under a uniform sky C. On the
+// left, transmission 1: its specular reflects C F(NoV) (Schlick, F0 0.04 from the IOR 1.5: the uniform sky through a
+// mirror lobe, see the top of the file) and it lets (1 - F(NoV)) c of the sky behind pass, so every pixel is
+// C (F + (1 - F) c) per channel. On the right, transmission t = 0.6, metallic m = 0.3 and IOR 2 (F0 1/9): the glTF
+// spec's mixture of the metal (m: C Schlick(c, NoV)), the opaque dielectric ((1 - m)(1 - t): C (c + F), its diffuse
+// lit by the sky over the front) and the transmissive one ((1 - m) t: as on the left). Bound: the mean over each pane's pixels within 1 %
+// per channel (dropping 1 - F moves the left's red by 4 %, a swapped channel by far more).
+PATHTRACE_TEST(ThinGlassPaneReflectsFresnelAndPassesTheRestTinted) {
+    const double C = 100.0, t = 0.6, m = 0.3;
+    const glm::vec3 c(1.0f, 0.5f, 0.25f);
+    const PaneTrace p = tracePane("pt_glass", C, {{"spp", 64}}, [&](SceneBuilder& b) {
+        uint32_t glass = b.material("glass", c, 0.0f, 1.0f);
+        b.s.materials[glass].transmission = 1.0f;
+        uint32_t mixed = b.material("mixed", c, static_cast<float>(m), 1.0f);
+        b.s.materials[mixed].transmission = static_cast<float>(t);
+        b.s.materials[mixed].ior = 2.0f;
+        return std::vector<uint32_t>{glass, mixed};
+    });
+    const glm::dvec3 cd(c);
+    auto transmissive = [&](double F) { return C * (F + (1.0 - F) * cd); };
+    const double err = meanRatioError(
+        p.out.at("color"), p.pixels, [&](glm::dvec3 d) { return transmissive(schlick(0.04, -d.z)); }, "thin glass");
+    const double errMixed = meanRatioError(
+        p.out.at("color"), p.right,
+        [&](glm::dvec3 d) {
+            const double F = schlick(1.0 / 9.0, -d.z); // KHR_materials_ior 2: F0 = ((2 - 1) / (2 + 1))^2
+            const glm::dvec3 metal = C * glm::dvec3(schlick(cd.r, -d.z), schlick(cd.g, -d.z), schlick(cd.b, -d.z));
+            return m * metal + (1.0 - m) * (1.0 - t) * C * (cd + F) + (1.0 - m) * t * transmissive(F);
+        },
+        "glass, metal and opaque dielectric mixed");
+    EXPECT_GE(p.pixels.size(), 150u);
+    EXPECT_GE(p.right.size(), 150u);
+    EXPECT_LT(err, 0.01);
+    EXPECT_LT(errMixed, 0.01);
+}
+
+// KHR_materials_volume: a clear pane (base white, transmission 1) of thicknessFactor 0.25 in a node scaled (2, 2, 1),
+// attenuationColor a = (0.25, 0.5, 1), attenuationDistance 0.25. The light passing has crossed
+// d = |refract(ray, n, 1/1.5) x 0.25 x (2, 2, 1)| (the Sample Viewer's path length, as forward.transparent) and keeps
+// a^(d / 0.25) of itself (Beer's law): C (F + (1 - F) a^(d / 0.25)), d computed here per pixel with glm::refract.
+// Bound 1 % per channel of the mean over the pane.
+PATHTRACE_TEST(VolumeAttenuatesTheLightPassingByBeersLaw) {
+    const double C = 100.0;
+    const glm::vec3 a(0.25f, 0.5f, 1.0f), scale(2.0f, 2.0f, 1.0f);
+    const float thickness = 0.25f, distance = 0.25f;
+    const PaneTrace t = tracePane(
+        "pt_volume", C, {{"spp", 64}},
+        [&](SceneBuilder& b) {
+            uint32_t m = b.material("volume", glm::vec3(1.0f), 0.0f, 1.0f);
+            b.s.materials[m].transmission = 1.0f;
+            b.s.materials[m].thickness = thickness;
+            b.s.materials[m].attenuationColor = a;
+            b.s.materials[m].attenuationDistance = distance;
+            return std::vector<uint32_t>{m};
+        },
+        scale);
+    const double err = meanRatioError(
+        t.out.at("color"), t.pixels,
+        [&](glm::dvec3 d) {
+            const double F = schlick(0.04, -d.z);
+            const glm::dvec3 refracted = glm::normalize(glm::refract(d, glm::dvec3(0, 0, 1), 1.0 / 1.5));
+            const double length = glm::length(refracted * double(thickness) * glm::dvec3(scale));
+            return C * (F + (1.0 - F) * glm::pow(glm::dvec3(a), glm::dvec3(length / distance)));
+        },
+        "volume");
+    EXPECT_GE(t.pixels.size(), 300u);
+    EXPECT_LT(err, 0.01);
+}
+
+// Alpha blending: a grey (0.5) smooth pane of alpha 0.3 covers 30 % of the sky behind it, so C ((1 - a) + a (0.5 +
+// F)) (the covered part is a diffuse + mirror dielectric under the uniform sky, as in DiffusePlaneUnderUniformSky...).
+// With `transparent` off the pane is left out of the scene: every pixel is the sky, C. Bounds 1 %.
+PATHTRACE_TEST(BlendedPaneCoversByItsAlphaAndIsLeftOutWithoutTransparent) {
+    const double C = 100.0, alpha = 0.3, grey = 0.5;
+    auto material = [&](SceneBuilder& b) {
+        uint32_t m = b.material("blend", glm::vec3(static_cast<float>(grey)), 0.0f, 1.0f);
+        b.s.materials[m].layers[0].albedo.factor.a = static_cast<float>(alpha);
+        b.s.materials[m].alphaMode = scene::AlphaMode::Blend;
+        return std::vector<uint32_t>{m};
+    };
+    const PaneTrace t = tracePane("pt_blend", C, {{"spp", 64}}, material);
+    const double err = meanRatioError(
+        t.out.at("color"), t.pixels,
+        [&](glm::dvec3 d) { return glm::dvec3(C * ((1.0 - alpha) + alpha * (grey + schlick(0.04, -d.z)))); },
+        "alpha blend");
+    EXPECT_GE(t.pixels.size(), 400u);
+    EXPECT_LT(err, 0.01);
+    const PaneTrace off = tracePane("pt_blend_off", C, {{"spp", 4}, {"transparent", false}}, material);
+    const double errOff = meanRatioError(
+        off.out.at("color"), off.pixels, [&](glm::dvec3) { return glm::dvec3(C); }, "alpha blend, transparent off");
+    EXPECT_LT(errOff, 1e-4);
+}
+
+// Alpha masks: two grey smooth panes with alphaMode MASK (cut-off 0.5), alpha 0.3 on the left (cut away: the sky C in
+// every sample) and 0.7 on the right (drawn: C (0.5 + F)). Bounds 1e-4 on the left (no sample may differ), 1 % on
+// the right.
+PATHTRACE_TEST(AlphaMaskCutsAwayWhatIsBelowItsCutoff) {
+    const double C = 100.0, grey = 0.5;
+    const PaneTrace t = tracePane("pt_mask", C, {{"spp", 32}}, [&](SceneBuilder& b) {
+        std::vector<uint32_t> m;
+        for (float alpha : {0.3f, 0.7f}) {
+            m.push_back(b.material("mask", glm::vec3(static_cast<float>(grey)), 0.0f, 1.0f));
+            b.s.materials[m.back()].layers[0].albedo.factor.a = alpha;
+            b.s.materials[m.back()].alphaMode = scene::AlphaMode::Mask;
+        }
+        return m;
+    });
+    const double cut = meanRatioError(
+        t.out.at("color"), t.pixels, [&](glm::dvec3) { return glm::dvec3(C); }, "mask, alpha below the cut-off");
+    const double kept = meanRatioError(
+        t.out.at("color"), t.right, [&](glm::dvec3 d) { return glm::dvec3(C * (grey + schlick(0.04, -d.z))); },
+        "mask, alpha above the cut-off");
+    EXPECT_GE(t.pixels.size(), 150u);
+    EXPECT_GE(t.right.size(), 150u);
+    EXPECT_LT(cut, 1e-4);
+    EXPECT_LT(kept, 0.01);
+}
+
+// Shadow rays through glass: traceSunlitGround's ground (grey 0.5, roughness 1) under a horizontal tinted glass roof
+// (base c, alpha-blended with alpha a = 0.9, transmission t = 0.8, metallic m = 0.25, smooth) 3 m up, wider than the
+// view's shadow. The sun's light reaches the ground through it: core/shading's sun radiance of the ground
+// (shadeDirectional, the base unquantised) times (1 - a) + a t (1 - m) (1 - F(n.l)) c per channel (the roof's normal
+// is the ground's; sky off, one bounce). With `transparent` off the roof is left out: shadeDirectional alone. Bound 1 %
+// per pixel, both.
+PATHTRACE_TEST(SunThroughAGlassRoofIsTintedByItsTransmittance) {
+    const glm::vec3 c(1.0f, 0.5f, 0.25f);
+    const double alpha = 0.9, transmission = 0.8, metallic = 0.25;
+    for (bool transparent : {true, false}) {
+        const float groundHalf = 40.0f;
+        const double sunElevation = 60.0 * kPi / 180.0, sunScale = 0.1;
+        SceneBuilder b(transparent ? "pt_roof" : "pt_roof_off");
+        std::vector<Tri> ground, roof;
+        addQuad(ground, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
+        addQuad(roof, glm::vec3(0.0f, 3.0f, 0.0f), glm::vec3(3 * groundHalf, 0, 0), glm::vec3(0, 0, 3 * groundHalf),
+                glm::vec3(0, 1, 0));
+        b.node("ground",
+               static_cast<int32_t>(b.mesh("ground", ground, b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f))));
+        uint32_t glass = b.material("glass", c, static_cast<float>(metallic), 1.0f);
+        b.s.materials[glass].transmission = static_cast<float>(transmission);
+        b.s.materials[glass].alphaMode = scene::AlphaMode::Blend;
+        b.s.materials[glass].layers[0].albedo.factor.a = static_cast<float>(alpha);
+        b.node("roof", static_cast<int32_t>(b.mesh("roof", roof, glass)));
+        b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
+        b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
+        auto glb = b.write();
+        json nodes = baseNodes(glb);
+        nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
+        nodes["pt"] = pathtraceNode({{"spp", 16},
+                                     {"max_bounces", 1},
+                                     {"sky_scale", 0.0},
+                                     {"sun_scale", sunScale},
+                                     {"antialias", false},
+                                     {"transparent", transparent}});
+        const int W = 48, H = 48;
+        auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
+        const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+        const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+        const glm::dvec3 through = transparent ? (1.0 - alpha) + alpha * transmission * (1.0 - metallic) *
+                                                                     (1.0 - schlick(0.04, toSun.y)) * glm::dvec3(c)
+                                               : glm::dvec3(1.0);
+        std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+        Pinhole cam(b.s, W, H);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                glm::dvec3 d = cam.ray(x, y);
+                if (d.y >= 0.0) continue;
+                glm::dvec3 p = cam.position - cam.position.y / d.y * d;
+                if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
+                expected.push_back(
+                    {{x, y},
+                     glm::dvec3(shading::shadeDirectional(glm::vec3(0, 1, 0), glm::vec3(-d), glm::vec3(toSun),
+                                                          glm::vec3(0.5f), 0.0f, 1.0f, glm::vec3(sunE / kPi))) *
+                         through});
+            }
+        const auto [checked, worst] = expectPixels(out.at("pt"), expected, 0.01);
+        std::printf("%s tracer, sun through a glass roof (transparent %d): %d pixels, worst relative error %.4f\n",
+                    gBackend, transparent ? 1 : 0, checked, worst);
+        EXPECT_GE(checked, 300);
+    }
+}
+
 } // namespace
 } // namespace vitrine::test
