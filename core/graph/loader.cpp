@@ -15,6 +15,34 @@ namespace {
 
 nlohmann::json mergeWithBases(nlohmann::json doc, const fs::path& file, std::vector<fs::path>& chain);
 
+// A graph's relative `path`-typed params resolve from its own folder. The merged document of a variant resolves them
+// from the variant's, so a base's are rewritten relative to that folder first (`from`: the base's folder, `to`: the
+// variant's; both absolute). A bare file name that is not beside the base is left as it is: a node may look it up
+// elsewhere (color.grade's `lut` in data/luts/).
+void rebasePaths(nlohmann::json& base, const fs::path& from, const fs::path& to) {
+    if (from == to) return;
+    auto nodes = base.find("nodes");
+    if (nodes == base.end() || !nodes->is_object()) return;
+    for (auto& [name, node] : nodes->items()) {
+        if (!node.is_object()) continue;
+        auto type = node.find("type");
+        auto params = node.find("params");
+        if (type == node.end() || !type->is_string() || params == node.end() || !params->is_object()) continue;
+        const NodeSchema* schema = NodeRegistry::global().find(type->get<std::string>());
+        if (!schema) continue;
+        for (const ParamSpec& spec : schema->params) {
+            if (spec.type != ParamType::Path) continue;
+            auto value = params->find(spec.name);
+            if (value == params->end() || !value->is_string()) continue;
+            const fs::path path(value->get<std::string>());
+            if (path.empty() || path.is_absolute()) continue;
+            std::error_code ec;
+            if (!path.has_parent_path() && !fs::exists(from / path, ec)) continue;
+            *value = (from / path).lexically_normal().lexically_relative(to).generic_string();
+        }
+    }
+}
+
 nlohmann::json loadWithBases(const fs::path& file, std::vector<fs::path>& chain) {
     return mergeWithBases(readJsonFile(file), file, chain);
 }
@@ -37,6 +65,10 @@ nlohmann::json mergeWithBases(nlohmann::json doc, const fs::path& file, std::vec
     if (!fs::is_regular_file(base, ec))
         throw UserError(file.string() + ": /extends: base graph " + base.string() + " does not exist");
     nlohmann::json merged = loadWithBases(base, chain);
+    fs::path baseCanonical = fs::weakly_canonical(base, ec);
+    if (ec) baseCanonical = fs::absolute(base).lexically_normal();
+    rebasePaths(merged, baseCanonical.parent_path(),
+                canonical.is_absolute() ? canonical.parent_path() : fs::absolute(canonical).parent_path());
     doc.erase("extends");
     merged.merge_patch(doc);
     return merged;

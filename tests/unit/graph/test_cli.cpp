@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -200,6 +201,27 @@ TEST(GraphCli, ShippedGraphsValidate) {
     CliResult set = vitrine("validate " + quote(kSource + "/graphs/fxaa_zoneplate.json") +
                             " --set tonemap.params.exposure=1.5 --set frame.width=320");
     EXPECT_EQ(set.status, 0) << set.output;
+}
+
+// A base's relative `path` params resolve from the base's own folder, whatever folder the variant is in; the variant's
+// own from the variant's.
+TEST(GraphCli, VariantsResolveTheBasesPathsFromItsFolder) {
+    CliResult shipped = vitrine("validate " + quote(kSource + "/graphs/variants/gltf_reference.json"));
+    EXPECT_EQ(shipped.status, 0) << shipped.output;
+
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "vitrine_variant_paths" / "a" / "b";
+    std::filesystem::create_directories(dir);
+    const std::string base = kSource + "/graphs/gltf.json";
+    std::ofstream(dir / "deep.json") << R"({"format": "vitrine-graph/1", "extends": ")" + base + R"("})";
+    CliResult deep = vitrine("validate " + quote((dir / "deep.json").string()));
+    EXPECT_EQ(deep.status, 0) << deep.output;
+
+    std::ofstream(dir / "own.json") << R"({"format": "vitrine-graph/1", "extends": ")" + base +
+                                           R"(", "nodes": {"sky": {"params": {"path": "missing.hdr"}}}})";
+    CliResult own = vitrine("validate " + quote((dir / "own.json").string()));
+    EXPECT_EQ(own.status, 1) << own.output;
+    EXPECT_NE(own.output.find((dir / "missing.hdr").string()), std::string::npos) << own.output;
+    std::filesystem::remove_all(dir.parent_path().parent_path());
 }
 
 TEST(GraphCli, RunWithMissingGraphExitsOne) {
