@@ -342,10 +342,12 @@ struct SunlitGround {
     std::vector<std::pair<glm::ivec2, glm::dvec3>> pixels;
 };
 
+// `material` makes the ground's material (and may add more to the scene); `params` adds to or overrides the tracer's.
 SunlitGround traceSunlitGround(const std::string& name, int W, int H,
-                               const std::function<uint32_t(SceneBuilder&)>& material) {
+                               const std::function<uint32_t(SceneBuilder&)>& material,
+                               const json& params = json::object(), double sunElevationDegrees = 12.0) {
     const float groundHalf = 40.0f;
-    const double sunElevation = 12.0 * kPi / 180.0, sunScale = 0.1;
+    const double sunElevation = sunElevationDegrees * kPi / 180.0, sunScale = 0.1;
     SceneBuilder b(name);
     std::vector<Tri> quad;
     addQuad(quad, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
@@ -356,8 +358,9 @@ SunlitGround traceSunlitGround(const std::string& name, int W, int H,
     auto glb = b.write();
     json nodes = baseNodes(glb);
     nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
-    nodes["pt"] = pathtraceNode(
-        {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
+    json ptParams = {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}};
+    ptParams.update(params);
+    nodes["pt"] = pathtraceNode(ptParams);
     SunlitGround g;
     g.out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
     g.toSun = glm::normalize(rgb(g.out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
@@ -1234,9 +1237,9 @@ PATHTRACE_TEST(AlphaMaskCutsAwayWhatIsBelowItsCutoff) {
     EXPECT_LT(kept, 0.01);
 }
 
-// Shadow rays through glass: traceSunlitGround's ground (grey 0.5, roughness 1) under a horizontal tinted glass roof
-// (base c, alpha-blended with alpha a = 0.9, transmission t = 0.8, metallic m = 0.25, smooth) 3 m up, wider than the
-// view's shadow. The sun's light reaches the ground through it: core/shading's sun radiance of the ground
+// Shadow rays through glass: traceSunlitGround's ground (grey 0.5, roughness 1; the sun 60 degrees up) under a glass
+// roof (tinted c, alpha-blended with alpha a = 0.9, transmission t = 0.8, metallic m = 0.25, smooth) 3 m up, wider than
+// the view's shadow. The sun's light reaches the ground through it: core/shading's sun radiance of the ground
 // (shadeDirectional, the base unquantised) times (1 - a) + a t (1 - m) (1 - F(n.l)) c per channel (the roof's normal
 // is the ground's; sky off, one bounce). With `transparent` off the roof is left out: shadeDirectional alone. Bound 1 %
 // per pixel, both.
@@ -1244,53 +1247,30 @@ PATHTRACE_TEST(SunThroughAGlassRoofIsTintedByItsTransmittance) {
     const glm::vec3 c(1.0f, 0.5f, 0.25f);
     const double alpha = 0.9, transmission = 0.8, metallic = 0.25;
     for (bool transparent : {true, false}) {
-        const float groundHalf = 40.0f;
-        const double sunElevation = 60.0 * kPi / 180.0, sunScale = 0.1;
-        SceneBuilder b(transparent ? "pt_roof" : "pt_roof_off");
-        std::vector<Tri> ground, roof;
-        addQuad(ground, glm::vec3(0.0f), glm::vec3(groundHalf, 0, 0), glm::vec3(0, 0, groundHalf), glm::vec3(0, 1, 0));
-        addQuad(roof, glm::vec3(0.0f, 3.0f, 0.0f), glm::vec3(3 * groundHalf, 0, 0), glm::vec3(0, 0, 3 * groundHalf),
-                glm::vec3(0, 1, 0));
-        b.node("ground",
-               static_cast<int32_t>(b.mesh("ground", ground, b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f))));
-        uint32_t glass = b.material("glass", c, static_cast<float>(metallic), 1.0f);
-        b.s.materials[glass].transmission = static_cast<float>(transmission);
-        b.s.materials[glass].alphaMode = scene::AlphaMode::Blend;
-        b.s.materials[glass].layers[0].albedo.factor.a = static_cast<float>(alpha);
-        b.node("roof", static_cast<int32_t>(b.mesh("roof", roof, glass)));
-        b.camera({0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, -4.7f}, 0.8f);
-        b.sun({0.0f, static_cast<float>(std::sin(sunElevation)), static_cast<float>(-std::cos(sunElevation))});
-        auto glb = b.write();
-        json nodes = baseNodes(glb);
-        nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
-        nodes["pt"] = pathtraceNode({{"spp", 16},
-                                     {"max_bounces", 1},
-                                     {"sky_scale", 0.0},
-                                     {"sun_scale", sunScale},
-                                     {"antialias", false},
-                                     {"transparent", transparent}});
-        const int W = 48, H = 48;
-        auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
-        const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-        const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+        const SunlitGround g = traceSunlitGround(
+            transparent ? "pt_roof" : "pt_roof_off", 48, 48,
+            [&](SceneBuilder& b) {
+                std::vector<Tri> roof;
+                addQuad(roof, glm::vec3(0.0f, 3.0f, 0.0f), glm::vec3(120, 0, 0), glm::vec3(0, 0, 120),
+                        glm::vec3(0, 1, 0));
+                uint32_t glass = b.material("glass", c, static_cast<float>(metallic), 1.0f);
+                b.s.materials[glass].transmission = static_cast<float>(transmission);
+                b.s.materials[glass].alphaMode = scene::AlphaMode::Blend;
+                b.s.materials[glass].layers[0].albedo.factor.a = static_cast<float>(alpha);
+                b.node("roof", static_cast<int32_t>(b.mesh("roof", roof, glass)));
+                return b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f);
+            },
+            {{"spp", 16}, {"transparent", transparent}}, 60.0);
         const glm::dvec3 through = transparent ? (1.0 - alpha) + alpha * transmission * (1.0 - metallic) *
-                                                                     (1.0 - schlick(0.04, toSun.y)) * glm::dvec3(c)
+                                                                     (1.0 - schlick(0.04, g.toSun.y)) * glm::dvec3(c)
                                                : glm::dvec3(1.0);
         std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
-        Pinhole cam(b.s, W, H);
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                glm::dvec3 d = cam.ray(x, y);
-                if (d.y >= 0.0) continue;
-                glm::dvec3 p = cam.position - cam.position.y / d.y * d;
-                if (std::abs(p.x) > groundHalf - 1.0 || std::abs(p.z) > groundHalf - 1.0) continue;
-                expected.push_back(
-                    {{x, y},
-                     glm::dvec3(shading::shadeDirectional(glm::vec3(0, 1, 0), glm::vec3(-d), glm::vec3(toSun),
-                                                          glm::vec3(0.5f), 0.0f, 1.0f, glm::vec3(sunE / kPi))) *
+        for (const auto& [px, d] : g.pixels)
+            expected.push_back(
+                {px, glm::dvec3(shading::shadeDirectional(glm::vec3(0, 1, 0), glm::vec3(-d), glm::vec3(g.toSun),
+                                                          glm::vec3(0.5f), 0.0f, 1.0f, glm::vec3(g.sunE / kPi))) *
                          through});
-            }
-        const auto [checked, worst] = expectPixels(out.at("pt"), expected, 0.01);
+        const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
         std::printf("%s tracer, sun through a glass roof (transparent %d): %d pixels, worst relative error %.4f\n",
                     gBackend, transparent ? 1 : 0, checked, worst);
         EXPECT_GE(checked, 300);
