@@ -9,6 +9,7 @@
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "nodes/bake/baked_lighting.hpp"
+#include "nodes/depth/mip_atlas.hpp"
 #include "nodes/lighting/punctual_lights.hpp"
 #include "nodes/shadow/cascades.hpp"
 
@@ -31,7 +32,9 @@ NodeSchema schema() {
         "colour: sorted back to front per primitive, depth-tested against the G-buffer without writing depth, lit by "
         "lighting.deferred's terms (sun with cascaded shadows, point and spot lights, sky ambient and Fresnel "
         "reflection, emissive); glass tints what lies behind it (dual-source blending), attenuated through a "
-        "KHR_materials_volume by Beer's law (no refraction offset).";
+        "KHR_materials_volume by Beer's law. With a `background` (color.pyramid of the opaque colour), transmission "
+        "reads what lies behind from it as the glTF Sample Viewer does: refracted through the volume's thickness and "
+        "blurred by roughness.";
     s.pass = PassKind::Raster;
     auto tex = [](const char* name, const char* doc, std::vector<VkFormat> formats = {}) {
         return InputPort{name, PortKind::Texture, std::move(formats), false, Usage::Sampled, doc};
@@ -51,9 +54,24 @@ NodeSchema schema() {
         tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
         tex("sky", "A sky node's cube map (reflections)"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera (the sort's eye point)"},
-        {"volume", PortKind::Texture, {}, true, Usage::Sampled,
+        {"volume",
+         PortKind::Texture,
+         {},
+         true,
+         Usage::Sampled,
          "bake.lightmap's irradiance volume: the ambient terms lighting.deferred uses for what has no lightmap"},
         {"baked", PortKind::Buffer, {}, true, Usage::Sampled, "bake.lightmap's `layout` (with `volume`)"},
+        {"background",
+         PortKind::Texture,
+         {},
+         true,
+         Usage::Sampled,
+         "color.pyramid of `color` (the opaque colour of this frame, not a history): transmission then reads what "
+         "lies behind from it, where the ray refracted through KHR_materials_volume's thickness leaves the volume "
+         "(straight behind when thin-walled), blurred over the share of the screen the Sample Viewer's 1024^2 "
+         "transmission framebuffer blurs (level log2(larger side) - 10 (1 - roughness x clamp(2 ior - 2, 0, 1))); "
+         "transparent surfaces farther back are then not seen "
+         "through glass. Without it, glass tints the pixel straight behind (dual-source blending), unblurred"},
     };
     OutputPort color;
     color.name = "color";
@@ -94,8 +112,9 @@ bool linearFilterable(Context& ctx, VkFormat format) {
 }
 
 // Set 0 of the pipelines (set 1 is the scene's): binding 0 the uniforms, 1-5 the sampled inputs. Without a
-// volume, binding 5 holds sky_sh instead (the shader never reads it when the volume's counts are zero).
-constexpr std::array<const char*, 5> kSampled = {"shadow_map", "sky_sh", "sky", "color", "volume"};
+// volume, binding 5 holds sky_sh instead (the shader never reads it when the volume's counts are zero); without a
+// background, binding 6 holds color (never read when the background flag is 0).
+constexpr std::array<const char*, 6> kSampled = {"shadow_map", "sky_sh", "sky", "color", "volume", "background"};
 // The samplers of the node's DescriptorSets.
 enum SamplerIndex : size_t { kLinear = 0, kNearest };
 
@@ -109,6 +128,17 @@ public:
         if (ctx.hasInput("volume") != ctx.hasInput("baked"))
             ctx.failParam("sky_ambient", "connect both volume and baked (bake.lightmap's volume and layout), or neither");
         if (ctx.hasInput("baked")) mBaked = ctx.objectAs<BakedLightingObject>("baked");
+        mBackground = ctx.hasInput("background");
+        if (mBackground) {
+            const ImageDesc& color = ctx.input("color");
+            const ImageDesc& atlas = ctx.input("background");
+            if (atlas.width != mipAtlasWidth(color.width, color.height) ||
+                atlas.height != mipAtlasHeight(color.width, color.height))
+                throw UserError("forward.transparent: input background is " + std::to_string(atlas.width) + "x" +
+                                std::to_string(atlas.height) + ", not the mip atlas of color (" +
+                                std::to_string(color.width) + "x" + std::to_string(color.height) +
+                                "): connect a color.pyramid of the opaque colour");
+        }
         warnLightCount(mScene->scene(), "forward.transparent");
     }
 
@@ -195,14 +225,23 @@ private:
             u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
             u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
         }
+        if (mBackground) {
+            const ImageDesc& color = ctx.input("color").desc();
+            u.background = glm::uvec4(1u, color.width, color.height, mipAtlasLevels(color.width, color.height));
+        }
         std::memcpy(mUniforms.mapped(), &u, sizeof(u));
 
         DescriptorWrites w(mSet);
         w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, {mUniforms.buffer(), 0, sizeof(TransparentUniforms)});
         for (uint32_t i = 0; i < kSampled.size(); ++i) {
-            const std::string port = std::string(kSampled[i]) == "volume" && !mBaked ? "sky_sh" : kSampled[i];
+            const std::string name = kSampled[i];
+            const std::string port = name == "volume" && !mBaked            ? "sky_sh"
+                                     : name == "background" && !mBackground ? "color"
+                                                                            : name;
             const GpuImage& image = ctx.input(port);
-            const bool linear = std::string(kSampled[i]) == "sky" && linearFilterable(ctx.gpu(), image.desc().format);
+            // The background's levels are read bilinearly (shaders/common/mip_atlas.glsl).
+            const bool linear = (name == "sky" || (name == "background" && mBackground)) &&
+                                linearFilterable(ctx.gpu(), image.desc().format);
             w.image(
                 i + 1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                 {mSets.sampler(linear ? kLinear : kNearest), image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
@@ -277,6 +316,7 @@ private:
     std::shared_ptr<ShadowCascadesObject> mCascades;
     std::shared_ptr<BakedLightingObject> mBaked;
     bool mSort = true;
+    bool mBackground = false;
     VkDevice mDevice = VK_NULL_HANDLE;
     DescriptorSets mSets;
     VkDescriptorSet mSet = VK_NULL_HANDLE;

@@ -10,6 +10,7 @@
 #include "forward/transparent.h"
 #include "lighting/ambient.glsl"
 #include "bake/irradiance_volume.glsl"
+#include "common/mip_atlas.glsl"
 
 // Set 0: the node's uniforms and inputs; set 1: the scene (VITRINE_SCENE_SET, defined by the node).
 // forward.transparent: alpha-blended and transmissive (thin glass) surfaces over the lit opaque colour, lit by
@@ -18,7 +19,10 @@
 // pane can tint what lies behind it per channel:
 //   outColor    = alpha × lit colour (reflection, the diffuse left by transmission, emission)
 //   outTransmit = (1 − alpha) + alpha × transmission × (1 − F(NoV)) × base colour × volume attenuation
-// With no transmission this is the usual "over" of the lit colour with its coverage alpha.
+// With no transmission this is the usual "over" of the lit colour with its coverage alpha. With a `background`
+// (color.pyramid of the opaque colour), transmission instead reads what lies behind from it, as the glTF Sample
+// Viewer reads its transmission framebuffer: refracted through the volume's thickness and blurred by roughness;
+// outTransmit is then 1 − alpha and that light is in outColor.
 layout(set = 0, binding = 0) uniform Uniforms { TransparentUniforms u; };
 #define VITRINE_LIGHTS u.lights
 #define VITRINE_SHADOW u.shadow
@@ -28,6 +32,7 @@ layout(set = 0, binding = 1) uniform sampler2D in_shadow_map;
 layout(set = 0, binding = 2) uniform sampler2D in_sky_sh;
 layout(set = 0, binding = 3) uniform samplerCube in_sky;
 layout(set = 0, binding = 5) uniform sampler2D in_volume; // bound to another image, never read, without a volume
+layout(set = 0, binding = 6) uniform sampler2D in_background; // the same without a background
 
 layout(location = 0) in vec3 vNormal;
 layout(location = 1) in vec4 vTangent;
@@ -88,22 +93,21 @@ void main() {
                     occlusion;
     vec3 lit = direct + diffuse + specular + emissive * u.params.w;
 
-    // Thin glass: what the surface does not reflect passes straight through, tinted by the base colour
-    // (no refraction offset, no blur by roughness).
+    // Thin glass: what the surface does not reflect passes through, tinted by the base colour.
     vec3 through = transmission * (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * baseColor;
-    // KHR_materials_volume as the Sample Viewer: the light has crossed d = |refracted direction x thickness x the
-    // node's scale| (getVolumeTransmissionRay; thickness x scale for a uniform scale) of a medium that keeps
-    // attenuationColor^(d / attenuationDistance) of it (Beer's law, applyVolumeAttenuation). Not refracted: the blend
-    // multiplies the pixel behind, with no background image to offset. Thickness 0 (thin-walled) or an infinite
-    // distance (volume.a 0) leave `through` untouched.
+    // KHR_materials_volume as the Sample Viewer: the light crosses the volume along transmissionRay, the unit
+    // refracted direction (Snell's law at the IOR) times the thickness times the node's scale, the lengths of its
+    // model matrix's columns (getVolumeTransmissionRay; thickness x scale long for a uniform scale), and a medium
+    // keeps attenuationColor^(length / attenuationDistance) of it (Beer's law, applyVolumeAttenuation). Thickness 0
+    // (thin-walled) crosses nothing; an infinite distance (volume.a 0) attenuates nothing.
+    float sqrtF0 = sqrt(m.optics.y); // 1/ior = (1 - sqrt(F0)) / (1 + sqrt(F0)), and 0 for KHR_materials_ior's 0
     float thickness = materialThickness(m, vUv0, vUv1, grads);
-    if (thickness > 0.0 && m.volume.a > 0.0) {
+    vec3 transmissionRay = vec3(0.0);
+    if (thickness > 0.0) {
         mat4 model = instances[draw.instance].world;
         vec3 modelScale = vec3(length(model[0].xyz), length(model[1].xyz), length(model[2].xyz));
-        float s = sqrt(m.optics.y); // 1/ior = (1 - sqrt(F0)) / (1 + sqrt(F0)), and 0 for KHR_materials_ior's 0
-        vec3 refracted = normalize(refract(-v, N, (1.0 - s) / (1.0 + s)));
-        float d = length(refracted * thickness * modelScale);
-        through *= pow(m.volume.rgb, vec3(d / m.volume.a));
+        transmissionRay = normalize(refract(-v, N, (1.0 - sqrtF0) / (1.0 + sqrtF0))) * thickness * modelScale;
+        if (m.volume.a > 0.0) through *= pow(m.volume.rgb, vec3(length(transmissionRay) / m.volume.a));
     }
     // KHR_materials_sheen over the reflected light (as lighting.deferred: emission not scaled, the sky or volume
     // through the lobe's albedo times the irradiance) and over what passes through.
@@ -134,6 +138,21 @@ void main() {
     }
     if (m.optics.z > 0.5) { // KHR_materials_unlit: the colour is the radiance, as through the G-buffer's emissive
         lit = baseColor * u.params.w;
+        through = vec3(0.0);
+    }
+    // What lies behind, with a background: the opaque colour where the transmission ray leaves the volume,
+    // projected to the screen (straight behind for thin-walled glass), blurred as the Sample Viewer blurs it. Its
+    // getTransmissionSample reads a 1024^2 framebuffer at level log2(1024) x r with r = roughness x clamp(2 ior - 2,
+    // 0, 1) (applyIorToRoughness: no blur at IOR 1, all of it from 1.5 on), a footprint of 2^(10 r) / 1024 of the
+    // screen; the same share of this pyramid's larger side is level log2(side) - 10 (1 - r). It replaces the
+    // dual-source tint of the pixel behind.
+    if (u.background.x != 0u && any(greaterThan(through, vec3(0.0)))) {
+        vec4 clip = camera.viewProj * vec4(world + transmissionRay, 1.0);
+        vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
+        ivec2 size0 = ivec2(u.background.yz);
+        float iorScale = clamp(4.0 * sqrtF0 / max(1.0 - sqrtF0, 1e-6), 0.0, 1.0); // 2 ior - 2, ior = (1 + sqrtF0) / (1 - sqrtF0)
+        float lod = log2(float(max(size0.x, size0.y))) - 10.0 * (1.0 - roughness * iorScale);
+        lit += through * mipSample(in_background, size0, int(u.background.w), uv, lod).rgb;
         through = vec3(0.0);
     }
     outColor = vec4(min(lit, vec3(kHalfMax)) * alpha, alpha);

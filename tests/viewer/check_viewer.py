@@ -20,7 +20,8 @@ Each pair goes through `vitrine compare` (LDR-FLIP, 16x16-pixel block luminance 
 thresholds below, set from what was measured (README "Viewing any glTF file"); the two renderers differ in IBL
 prefiltering, shadows (the viewer has none) and anti-aliasing, so they are loose. Two deliberate mismatches, rendered by
 the viewer and compared with vitrine's unchanged images, must fail them: the white sphere at exposure +1 stop, and the
-gold spheres with the base colour's red and blue swapped. Fails (never skips) when Chromium, the viewer or
+gold spheres with the base colour's red and blue swapped; and one rendered by vitrine, the glass case without
+forward.transparent's background (no refraction, no blur). Fails (never skips) when Chromium, the viewer or
 playwright-core is missing.
 Usage: check_viewer.py VITRINE SOURCE_DIR OUT_DIR [--sheet PNG]
 """
@@ -32,7 +33,13 @@ import subprocess
 import sys
 import time
 
-CASES = ["white_sphere", "metal_spheres", "textured", "unlit"]
+CASES = ["white_sphere", "metal_spheres", "textured", "unlit", "glass"]
+# Cases rendered without the file's light by both (vitrine: the sun it takes from the file at 0 lux; the viewer:
+# lightScale 0). glass: the Sample Viewer adds a transmission lobe of every punctual light to rough glass, for a light
+# in front of the pane too (its getPunctualRadianceTransmission mirrors the light through the surface whichever side
+# it is on), which vitrine does not draw; under the environment alone the case checks what it is for, the refraction
+# offset and the blur of what is seen through the glass.
+NO_LIGHT = {"glass"}
 # Thresholds: FLIP mean at most, share of 16x16 blocks within +-15 % luminance at least, mean |log2 block ratio| at
 # most, whole-image mean luminance ratio within [1 / r, r], and (colour, which the luminance measures cannot see) the
 # mean over 16x16 blocks of the largest |difference| of the block's chromaticity r, g, b / (r + g + b) at most.
@@ -170,16 +177,28 @@ def main():
     graph = os.path.join(src, "graphs", "gltf.json")
     t0 = time.time()
 
+    def render(name, graph_path, out_dir):
+        unlit = ["--set", "sky.params.sun_illuminance=0"] if name in NO_LIGHT else []
+        run([vitrine, "run", graph_path, "--scene", os.path.join(scenes, name + ".gltf"), "--set",
+             f"frame.width={SIZE}", "--set", f"frame.height={SIZE}", "--exr", "none", "--out", out_dir] + unlit)
+
     for name in CASES:
-        run([vitrine, "run", graph, "--scene", os.path.join(scenes, name + ".gltf"), "--set", f"frame.width={SIZE}",
-             "--set", f"frame.height={SIZE}", "--exr", "none", "--out", os.path.join(out, "vitrine", name)])
+        render(name, graph, os.path.join(out, "vitrine", name))
+    # A mismatch on vitrine's side: the glass without forward.transparent's background (the pixel straight behind,
+    # tinted: no refraction offset, no blur), which must fail against the viewer's glass.
+    no_background = os.path.join(out, "mutated", "gltf_no_background.json")
+    with open(no_background, "w") as f:
+        json.dump({"format": "vitrine-graph/1", "extends": graph,
+                   "nodes": {"background": None, "transparent": {"in": {"background": None}}}}, f)
+    render("glass", no_background, os.path.join(out, "mutated", "glass_without_background"))
     t1 = time.time()
 
     swapped = os.path.join(out, "mutated", "metal_spheres_swapped.gltf")
     swapped_red_blue(os.path.join(scenes, "metal_spheres.gltf"), swapped)
     base = {"exposure": 1.0, "iblIntensity": 10000.0 * EXPOSURE_SCALE, "lightScale": EXPOSURE_SCALE,
             "environmentRotation": 270}
-    jobs = [dict(base, gltf=os.path.join(scenes, n + ".gltf"), out=os.path.join(out, "viewer", n + ".raw.png"))
+    jobs = [dict(base, gltf=os.path.join(scenes, n + ".gltf"), out=os.path.join(out, "viewer", n + ".raw.png"),
+                 **({"lightScale": 0.0} if n in NO_LIGHT else {}))
             for n in CASES]
     mutants = {"white_sphere_plus_1_stop": ("white_sphere", dict(base, exposure=2.0,
                                                                   gltf=os.path.join(scenes, "white_sphere.gltf"))),
@@ -215,6 +234,13 @@ def main():
         print(f"mismatch {key}: {describe(m)}  -> {'fails as it must: ' + '; '.join(v) if v else 'PASSES'}")
         if not v:
             bad.append(f"{key} (a deliberate mismatch the thresholds do not catch)")
+    m = compare(vitrine, os.path.join(out, "mutated", "glass_without_background", "final.png"),
+                os.path.join(out, "viewer", "glass.png"), os.path.join(out, "compare", "glass_without_background"))
+    v = violations(m)
+    print(f"mismatch glass_without_background (vitrine's side): {describe(m)}  -> "
+          f"{'fails as it must: ' + '; '.join(v) if v else 'PASSES'}")
+    if not v:
+        bad.append("glass_without_background (a deliberate mismatch the thresholds do not catch)")
     if sheet:
         contact_sheet(out, sheet)
         print(f"wrote {sheet}")
@@ -222,7 +248,8 @@ def main():
           f"compare {time.time() - t2:.1f} s")
     if bad:
         fail("outside the thresholds: " + ", ".join(bad))
-    print(f"gltf.sample_viewer: {len(CASES)} files within the thresholds, {len(mutants)} deliberate mismatches caught")
+    print(f"gltf.sample_viewer: {len(CASES)} files within the thresholds, {len(mutants) + 1} deliberate mismatches "
+          "caught")
 
 
 main()

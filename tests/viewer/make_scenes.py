@@ -17,6 +17,10 @@ Files:
                      roughness 0.6: texture decoding, sRGB and UV orientation (a swapped channel or a flipped V shows).
   unlit.gltf         an orange KHR_materials_unlit quad (left) and a black quad with emissiveFactor (0.2, 0.5, 1.0)
                      (right): display-referred colours that must reach the PNG as authored.
+  glass.gltf         textured.gltf's 2x2 texture on an upright quad behind two glass panes (KHR_materials_transmission
+                     1, KHR_materials_ior 1.5, KHR_materials_volume thickness 0.8) across its vertical edges, turned
+                     35 deg about the vertical: a smooth one at the top (the refraction offset moves the edge) and one
+                     of roughness 0.6 at the bottom (the blur of the transmission framebuffer).
 Regenerate after editing: python3 tests/viewer/make_scenes.py [OUT_DIR] (ctest data.viewer_scenes writes them to the
 build tree and compares them byte for byte with the committed ones).
 """
@@ -76,7 +80,9 @@ def sphere_mesh(b, center, radius, material, name, rings=24, segments=48):
     return len(b.doc["meshes"]) - 1
 
 
-def finish(b, meshes, name, distance=3.6, mesh_rotation=None):
+def finish(b, meshes, name, distance=3.6, mesh_rotation=None, transforms=None):
+    """Adds the camera, the key light and a node per mesh (each turned by mesh_rotation, or given its entry of
+    transforms: a dict of node fields), and writes the file."""
     b.doc["extensionsUsed"] = sorted(set(b.doc.get("extensionsUsed", []) + ["KHR_lights_punctual"]))
     b.doc.setdefault("extensions", {})["KHR_lights_punctual"] = {
         "lights": [{"name": "key", "type": "directional", "color": [1.0, 1.0, 1.0], "intensity": SUN_LUX}]}
@@ -85,10 +91,12 @@ def finish(b, meshes, name, distance=3.6, mesh_rotation=None):
     b.doc["nodes"] = [{"name": "camera", "camera": 0, "translation": [0.0, 0.0, distance]},
                       {"name": "key_light", "rotation": quat_z_to(to_key_light()),
                        "extensions": {"KHR_lights_punctual": {"light": 0}}}]
-    for m in meshes:
+    for i, m in enumerate(meshes):
         node = {"name": b.doc["meshes"][m]["name"], "mesh": m}
         if mesh_rotation:
             node["rotation"] = mesh_rotation
+        if transforms and transforms[i]:
+            node.update(transforms[i])
         b.doc["nodes"].append(node)
     b.doc["scenes"] = [{"nodes": list(range(len(b.doc["nodes"])))}]
     b.doc["scene"] = 0
@@ -141,12 +149,38 @@ def unlit():
     finish(b, meshes, "unlit.gltf")
 
 
+def glass():
+    b = Builder()
+    b.doc["extensionsUsed"] = ["KHR_materials_ior", "KHR_materials_transmission", "KHR_materials_volume"]
+    glass_extensions = {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                        "KHR_materials_ior": {"ior": 1.5}, "KHR_materials_volume": {"thicknessFactor": 0.8}}
+    b.doc["materials"] = [
+        {"name": "checker", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0,
+                                                     "roughnessFactor": 0.6}},
+        {"name": "glass_smooth", "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+         "extensions": glass_extensions},
+        {"name": "glass_rough", "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.6},
+         "extensions": glass_extensions}]
+    image = png_rgba(2, 2, [[255, 0, 0, 255], [0, 255, 0, 255], [0, 0, 255, 255], [255, 255, 255, 255]])
+    b.doc["images"] = [{"name": "checker", "mimeType": "image/png", "bufferView": b.view(image)}]
+    b.doc["samplers"] = [{"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}]
+    b.doc["textures"] = [{"sampler": 0, "source": 0}]
+    meshes = [quad_mesh(b, [0, 0, -0.8], 1.3, 0, uvs=True, name="backdrop"),
+              quad_mesh(b, [0, 0, 0], 0.5, 1, name="pane_smooth", half_y=0.4),
+              quad_mesh(b, [0, 0, 0], 0.5, 2, name="pane_rough", half_y=0.4)]
+    turn = math.radians(35.0) / 2
+    panes = [{"translation": [0.0, y, 0.3], "rotation": [0.0, math.sin(turn), 0.0, math.cos(turn)]}
+             for y in (0.55, -0.55)]
+    finish(b, meshes, "glass.gltf", transforms=[None] + panes)
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     white_sphere()
     metal_spheres()
     textured()
     unlit()
+    glass()
 
 
 main()
