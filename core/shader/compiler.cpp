@@ -3,6 +3,7 @@
 #include "core/base/error.hpp"
 #include "core/base/paths.hpp"
 #include "core/shader/reflection.hpp"
+#include "core/shader/source_key.hpp"
 
 #include <glslang/Public/ResourceLimits.h>
 #include <glslang/Public/ShaderLang.h>
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <mutex>
 #include <regex>
+#include <set>
 #include <sstream>
 
 namespace vitrine {
@@ -106,6 +108,79 @@ std::string formatLog(const std::string& log) {
     return out.str();
 }
 
+// The SPIR-V and reflection cached under `hex` in cacheDir; false when either is missing or unreadable.
+bool loadCached(const fs::path& cacheDir, const std::string& hex, CompiledShader& result) {
+    const fs::path spvPath = cacheDir / (hex + ".spv");
+    const fs::path reflPath = cacheDir / (hex + ".json");
+    std::error_code existsError;
+    if (!fs::exists(spvPath, existsError) || !fs::exists(reflPath, existsError)) return false;
+    std::ifstream in(spvPath, std::ios::binary | std::ios::ate);
+    size_t bytes = static_cast<size_t>(in.tellg());
+    if (!in || bytes % 4 != 0 || bytes == 0) return false;
+    result.spirv.resize(bytes / 4);
+    in.seekg(0);
+    in.read(reinterpret_cast<char*>(result.spirv.data()), static_cast<std::streamsize>(bytes));
+    if (!in || !reflectionFromJson(readText(reflPath), result.reflection)) return false;
+    result.fromCache = true;
+    return true;
+}
+
+// The file names of a text's `#include "x"` / `#include <x>` lines, in order.
+std::vector<std::string> includeNames(const std::string& text) {
+    std::vector<std::string> names;
+    size_t pos = 0;
+    while (pos < text.size()) {
+        size_t end = text.find('\n', pos);
+        if (end == std::string::npos) end = text.size();
+        size_t i = text.find_first_not_of(" \t", pos);
+        if (i < end && text[i] == '#') {
+            i = text.find_first_not_of(" \t", i + 1);
+            if (i < end && text.compare(i, 7, "include") == 0) {
+                i = text.find_first_not_of(" \t", i + 7);
+                if (i < end && (text[i] == '"' || text[i] == '<')) {
+                    const char close = text[i] == '"' ? '"' : '>';
+                    size_t last = text.find(close, i + 1);
+                    if (last < end) names.push_back(text.substr(i + 1, last - i - 1));
+                }
+            }
+        }
+        pos = end + 1;
+    }
+    return names;
+}
+
+// Adds the files that the include lines of `text` (the file `name`, relative to root) name to the hash, recursively;
+// false when one cannot be read.
+bool hashIncludes(const fs::path& root, const std::string& name, const std::string& text, std::set<std::string>& seen,
+                  uint64_t& hash) {
+    for (const std::string& header : includeNames(text)) {
+        std::optional<std::string> found;
+        const fs::path base = fs::path(name).parent_path();
+        for (const fs::path& candidate : {base / header, fs::path(header)}) {
+            std::error_code ec;
+            if (fs::is_regular_file(root / candidate, ec)) {
+                found = candidate.lexically_normal().generic_string();
+                break;
+            }
+        }
+        // Named but absent: an include the preprocessor skips (`#include <cstdint>` under __cplusplus in the headers
+        // shared with C++), or a missing file, which fails preprocessing, so no key ever points to SPIR-V for it.
+        // Its line is in the including file's bytes; should a file of that name appear, it is hashed from then on.
+        if (!found) continue;
+        if (!seen.insert(*found).second) continue; // once each (include guards are not read: files may cycle)
+        std::string included;
+        try {
+            included = readText(root / *found);
+        } catch (const UserError&) {
+            return false;
+        }
+        hash = fnv1a(*found + '\0' + std::to_string(included.size()) + '\0', hash);
+        hash = fnv1a(included, hash);
+        if (!hashIncludes(root, *found, included, seen, hash)) return false;
+    }
+    return true;
+}
+
 void initGlslang() {
     static std::once_flag once;
     std::call_once(once, [] {
@@ -115,6 +190,18 @@ void initGlslang() {
 }
 
 } // namespace
+
+std::optional<uint64_t> shaderSourceKey(const fs::path& root, const std::string& name, const std::string& source,
+                                        const std::string& preamble, int stage) {
+    std::stringstream head;
+    head << "src1|" << GLSLANG_VERSION_MAJOR << "." << GLSLANG_VERSION_MINOR << "." << GLSLANG_VERSION_PATCH << "|"
+         << stage << "|" << name << '\0' << preamble << '\0' << source.size() << '\0';
+    uint64_t hash = fnv1a(head.str());
+    hash = fnv1a(source, hash);
+    std::set<std::string> seen;
+    if (!hashIncludes(root, name, source, seen, hash)) return std::nullopt;
+    return hash;
+}
 
 ShaderCompiler::ShaderCompiler(fs::path shaderRoot, fs::path cacheDir, bool useCache)
     : mRoot(std::move(shaderRoot)), mCacheDir(std::move(cacheDir) / "spirv"), mUseCache(useCache) {}
@@ -148,7 +235,33 @@ CompiledShader ShaderCompiler::compileSource(const std::string& name, const std:
         shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
     };
 
-    // Preprocess first: the expanded text (all includes and defines applied) is the cache key.
+    // The SPIR-V is cached under a hash of the expanded text (all includes and defines applied). Preprocessing every
+    // shader to find it was most of a warm start's pipeline time (glslang's preprocessor: about 140 of 190 ms for the
+    // Museum's compute shaders on lavapipe's 2-core machine), so a first key read from the sources and the files
+    // they include (shaderSourceKey) points to it: `src-KEY.ref` holds the expanded text's hash.
+    std::optional<uint64_t> sourceKey;
+    fs::path refPath;
+    if (mUseCache) {
+        sourceKey = shaderSourceKey(mRoot, name, source, preamble, static_cast<int>(lang));
+        if (sourceKey) {
+            char key[17];
+            std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(*sourceKey));
+            refPath = mCacheDir / ("src-" + std::string(key) + ".ref");
+            std::error_code ec;
+            if (fs::exists(refPath, ec)) {
+                std::ifstream ref(refPath);
+                std::string hex;
+                ref >> hex;
+                CompiledShader cached;
+                if (hex.size() == 16 && loadCached(mCacheDir, hex, cached)) {
+                    cached.name = name;
+                    ++mHits;
+                    return cached;
+                }
+            }
+        }
+    }
+
     Includer includer(mRoot);
     std::string expanded;
     {
@@ -164,22 +277,23 @@ CompiledShader ShaderCompiler::compileSource(const std::string& name, const std:
     const fs::path spvPath = mCacheDir / (std::string(hex) + ".spv");
     const fs::path reflPath = mCacheDir / (std::string(hex) + ".json");
 
+    // Where the source key will point from now on (written after the SPIR-V, so it never points to nothing).
+    auto writeRef = [&] {
+        if (refPath.empty()) return;
+        std::error_code ec;
+        fs::create_directories(mCacheDir, ec);
+        fs::path tmp = refPath.string() + ".tmp" + std::to_string(::getpid());
+        std::ofstream(tmp) << hex << "\n";
+        fs::rename(tmp, refPath, ec);
+    };
+
     CompiledShader result;
     result.name = name;
-    std::error_code existsError;
-    if (mUseCache && fs::exists(spvPath, existsError) && fs::exists(reflPath, existsError)) {
-        std::ifstream in(spvPath, std::ios::binary | std::ios::ate);
-        size_t bytes = static_cast<size_t>(in.tellg());
-        if (bytes % 4 == 0 && bytes > 0) {
-            result.spirv.resize(bytes / 4);
-            in.seekg(0);
-            in.read(reinterpret_cast<char*>(result.spirv.data()), static_cast<std::streamsize>(bytes));
-            if (in && reflectionFromJson(readText(reflPath), result.reflection)) {
-                result.fromCache = true;
-                ++mHits;
-                return result;
-            }
-        }
+    if (mUseCache && loadCached(mCacheDir, hex, result)) {
+        result.name = name;
+        ++mHits;
+        writeRef();
+        return result;
     }
     ++mMisses;
 
@@ -215,6 +329,7 @@ CompiledShader ShaderCompiler::compileSource(const std::string& name, const std:
         std::ofstream(tmpRefl) << reflectionToJson(result.reflection);
         fs::rename(tmpRefl, reflPath, ec);
         fs::rename(tmpSpv, spvPath, ec);
+        writeRef();
     }
     return result;
 }
