@@ -43,6 +43,31 @@ layout(location = 5) in vec4 vClip;
 layout(location = 6) in vec4 vPrevClip;
 layout(location = 7) in float vViewDepth;
 
+// Light from behind a thin-walled transmissive surface, scattered towards v by its rough surface: the specular BTDF
+// of KHR_materials_transmission for thin walls, the GGX lobe of the light mirrored through the surface to the
+// viewer's side (lm = l - 2 (n.l) n), (1 - F(v.h)) D Vis, times the cosine n.lm (as a reflected light's n.l).
+// 0 for light on the viewer's side. Without the tint (transmission x base colour x the volume's attenuation).
+vec3 thinTransmissionCosine(vec3 n, vec3 v, vec3 l, vec3 f0, float f90, float roughness) {
+    float NoL = -dot(n, l), NoV = dot(n, v);
+    if (NoL <= 0.0 || NoV <= 0.0) return vec3(0.0);
+    vec3 lm = l + 2.0 * NoL * n;
+    vec3 h = normalize(v + lm);
+    float alpha = ggxAlpha(roughness);
+    float NoH = clamp(dot(n, h), 0.0, 1.0), VoH = clamp(dot(v, h), 0.0, 1.0);
+    return (vec3(1.0) - schlickFresnelF90(f0, f90, VoH)) * ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * NoL;
+}
+
+// thinTransmissionCosine x E of every point and spot light (shadePunctual's lights, behind the surface).
+vec3 shadePunctualTransmitted(vec3 p, vec3 n, vec3 v, vec3 f0, float f90, float roughness) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < VITRINE_LIGHTS.count.x; ++i) {
+        vec3 l;
+        vec3 e = punctualIlluminance(VITRINE_LIGHTS.lights[i], p, l);
+        sum += thinTransmissionCosine(n, v, l, f0, f90, roughness) * e;
+    }
+    return sum;
+}
+
 layout(location = 0, index = 0) out vec4 outColor;
 layout(location = 0, index = 1) out vec4 outTransmit;
 
@@ -94,7 +119,7 @@ void main() {
     vec3 lit = direct + diffuse + specular + emissive * u.params.w;
 
     // Thin glass: what the surface does not reflect passes through, tinted by the base colour.
-    vec3 through = transmission * (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * baseColor;
+    vec3 tint = transmission * baseColor;
     // KHR_materials_volume as the Sample Viewer: the light crosses the volume along transmissionRay, the unit
     // refracted direction (Snell's law at the IOR) times the thickness times the node's scale, the lengths of its
     // model matrix's columns (getVolumeTransmissionRay; thickness x scale long for a uniform scale), and a medium
@@ -107,7 +132,16 @@ void main() {
         mat4 model = instances[draw.instance].world;
         vec3 modelScale = vec3(length(model[0].xyz), length(model[1].xyz), length(model[2].xyz));
         transmissionRay = normalize(refract(-v, N, (1.0 - sqrtF0) / (1.0 + sqrtF0))) * thickness * modelScale;
-        if (m.volume.a > 0.0) through *= pow(m.volume.rgb, vec3(length(transmissionRay) / m.volume.a));
+        if (m.volume.a > 0.0) tint *= pow(m.volume.rgb, vec3(length(transmissionRay) / m.volume.a));
+    }
+    vec3 through = (vec3(1.0) - schlickFresnelF90(f0, f90, dot(N, v))) * tint;
+    // The sun and the lights behind the surface, through its transmission lobe (the sun's shadow looked up from the
+    // far side), tinted as what passes; layered under the sheen and the coat with the rest.
+    if (any(greaterThan(tint, vec3(0.0)))) {
+        float behind = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, -N, vViewDepth) : 1.0;
+        vec3 transmitted = thinTransmissionCosine(N, v, l, f0, f90, roughness) * sunE * behind;
+        transmitted += shadePunctualTransmitted(world, N, v, f0, f90, roughness);
+        lit += tint * transmitted;
     }
     // KHR_materials_sheen over the reflected light (as lighting.deferred: emission not scaled, the sky or volume
     // through the lobe's albedo times the irradiance) and over what passes through.

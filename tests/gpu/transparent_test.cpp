@@ -617,6 +617,111 @@ TEST_F(Transparent, BackgroundRefractsThroughTheVolumeAndBlursByRoughness) {
     EXPECT_LT(worst, 0.002);
 }
 
+// The sun and a point light behind rough thin glass shine through it towards the camera by the thin-walled
+// specular BTDF of KHR_materials_transmission, written here from the extension's description: the GGX lobe of the
+// light mirrored through the surface, lm = l − 2 (n·l) n, (1 − F(v·h)) D(n·h) Vis(n·v, n·lm) n·lm with h = |v + lm|
+// (core/shading's D, Vis and Schlick), times the illuminance and the tint (transmission × base colour). A pane of
+// roughness 0.6 at IOR 1.5 facing the camera with nothing behind it but the sky, sky_ambient 0: out = that lobe for
+// the sun (from behind, 14° up) and a point light of 60,000 cd (colour (1, 0.7, 0.4)) 1.5 m behind the pane + the sky
+// behind × (1 − F(NoV)) × tint, 1 % per channel. The lobes must be a good part of the brightest pixel (else the test
+// would not see them); lights in front of the pane add no lobe (ThinGlassReflectsByFresnelAndTintsWhatIsBehind).
+TEST_F(Transparent, LightBehindRoughGlassShinesThroughItsTransmissionLobe) {
+    const int W = 64, H = 64;
+    const glm::vec3 tint(0.9f, 0.7f, 0.5f);
+    const float shininess = 0.4f, ior = 1.5f, pointIntensity = 60000.0f;
+    const glm::dvec3 lamp(0.1, -0.1, -1.0);
+    const glm::vec3 lampColor(1.0f, 0.7f, 0.4f);
+    // occluded: an opaque wall 2 m behind the pane's plane, left of x = 0, shades the pane from the sun left of about
+    // x = 0.2 (its shadow map, read from the pane's far side); the point light, in front of it, is unshadowed.
+    auto render = [&](bool occluded) {
+        SceneBuilder b(occluded ? "glass_backlit_occluded" : "glass_backlit");
+        if (occluded) {
+            std::vector<Tri> wall;
+            addQuad(wall, glm::vec3(-1.5f, 0, -1.5f), glm::vec3(1.5f, 0, 0), glm::vec3(0, 3, 0), glm::vec3(0, 0, 1));
+            b.node("wall",
+                   static_cast<int32_t>(b.mesh("wall", wall, b.material("wall", {0.5f, 0.5f, 0.5f}, 0.0f, 0.3f))));
+        }
+        std::vector<Tri> pane;
+        addQuad(pane, glm::vec3(0.0f), glm::vec3(0.7f, 0, 0), glm::vec3(0, 0.7f, 0), glm::vec3(0, 0, 1));
+        uint32_t m = b.material("pane", tint, 0.0f, shininess);
+        b.s.materials[m].transmission = 1.0f;
+        b.s.materials[m].ior = ior;
+        b.node("pane", static_cast<int32_t>(b.mesh("pane", pane, m)), glm::vec3(0, 0, 0.5f));
+        scene::PunctualLight point;
+        point.intensity = pointIntensity;
+        point.color = lampColor;
+        b.node("lamp", -1, glm::vec3(lamp));
+        point.node = static_cast<uint32_t>(b.s.nodes.size() - 1);
+        b.s.lights = {point};
+        b.camera({0.3f, 0.2f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+        b.sun({-0.1f, 0.25f, -1.0f}); // behind the pane, 14° above the horizon
+        return runGraph(graph(pipeline(b.write(), {{"sky_ambient", 0.0}}, {{"sky_ambient", 0.0}}),
+                              {{"out", "transparent.color"}, {"bg", "lighting.color"}, {"sh", "sky.sh"}}, W, H));
+    };
+    SceneBuilder probe("glass_backlit_probe");
+    probe.camera({0.3f, 0.2f, 3.0f}, {0.0f, 0.0f, 0.0f}, 0.8f);
+    const Pinhole cam(probe.s, W, H);
+    for (bool occluded : {false, true}) {
+        SCOPED_TRACE(occluded ? "the sun occluded left of x = 0.2" : "open");
+        auto out = render(occluded);
+        const glm::dvec3 n(0.0, 0.0, 1.0);
+        const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+        const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0);
+        ASSERT_LT(toSun.z, -0.5) << "the sun must be behind the pane";
+        const double f0 = std::pow((ior - 1.0) / (ior + 1.0), 2.0);
+        const float alpha = shading::ggxAlpha(shading::roughnessFromShininess(shininess));
+        auto lobe = [&](glm::dvec3 v, glm::dvec3 l) {
+            const double NoL = -glm::dot(n, l), NoV = glm::dot(n, v);
+            if (NoL <= 0.0 || NoV <= 0.0) return glm::dvec3(0.0);
+            const glm::dvec3 lm = l - 2.0 * glm::dot(n, l) * n;
+            const glm::dvec3 h = glm::normalize(v + lm);
+            const double F = f0 + (1.0 - f0) * std::pow(1.0 - glm::dot(v, h), 5.0);
+            return glm::dvec3(tint) *
+                   ((1.0 - F) * shading::ggxD(static_cast<float>(glm::dot(n, h)), alpha) *
+                    shading::smithGgxVisibility(static_cast<float>(NoV), static_cast<float>(NoL), alpha) * NoL);
+        };
+        int count = 0, shadedCount = 0;
+        double worst = 0.0, peak = 0.0, peakShare = 0.0, pointPeak = 0.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const glm::dvec3 d = cam.ray(x, y);
+                if (!hitsQuad(cam.position, d, 0.5, 0.0, 0.7, 0.03)) continue;
+                const glm::dvec3 p = cam.position + d * ((0.5 - cam.position.z) / d.z), v = -d;
+                // Where the sun ray from p meets the occluder's plane (z = -1.5): shaded left of x = 0, skipped within
+                // 0.4 m.
+                const double xWall = p.x + toSun.x * (-1.5 - p.z) / toSun.z;
+                if (occluded && std::abs(xWall) < 0.4) continue; // the shadow map's PCF edge
+                const bool shaded = occluded && xWall < 0.0;
+                const glm::dvec3 toLamp = lamp - p;
+                const glm::dvec3 fromSun = shaded ? glm::dvec3(0.0) : lobe(v, toSun) * sunE;
+                const glm::dvec3 fromLamp = lobe(v, glm::normalize(toLamp)) * glm::dvec3(lampColor) *
+                                            (pointIntensity / glm::dot(toLamp, toLamp));
+                const double NoV = glm::dot(n, v), fresnel = f0 + (1.0 - f0) * std::pow(1.0 - NoV, 5.0);
+                const glm::dvec3 expected =
+                    fromSun + fromLamp + rgb(out.at("bg"), x, y) * (1.0 - fresnel) * glm::dvec3(tint);
+                const double e = relErr(rgb(out.at("out"), x, y), expected);
+                worst = std::max(worst, e);
+                EXPECT_LT(e, 0.01) << "pixel " << x << "," << y << ": " << rgb(out.at("out"), x, y).r << " vs "
+                                   << expected.r;
+                if (expected.g > peak) {
+                    peak = expected.g;
+                    peakShare = (fromSun.g + fromLamp.g) / expected.g;
+                }
+                pointPeak = std::max(pointPeak, fromLamp.g / expected.g);
+                shadedCount += shaded;
+                ++count;
+            }
+        std::printf(
+            "light behind rough glass (%s): %d pixels (%d shaded from the sun), max relative error %.2g; at the "
+            "brightest pixel the lobes are %.0f %% of it; the point light up to %.0f %% of a pixel\n",
+            occluded ? "occluded" : "open", count, shadedCount, worst, 100.0 * peakShare, 100.0 * pointPeak);
+        EXPECT_GE(count, 300);
+        EXPECT_GT(peakShare, 0.3);
+        EXPECT_GT(pointPeak, 0.05);
+        if (occluded) EXPECT_GE(shadedCount, 200);
+    }
+}
+
 // A BLEND quad of alpha 1 is lit as lighting.deferred lights the same quad opaque: sun with shadows (half the quad
 // under an occluder), sky ambient diffuse and reflection, a point and a spot light, vertex AO, cavity, emission.
 // Base colour, AO and cavity are multiples of 1/255 so the G-buffer's UNORM8 stores them exactly; 1 % per channel
