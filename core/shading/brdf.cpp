@@ -221,4 +221,15 @@ glm::vec2 envBrdfApprox(float NoV, float roughness) {
     return glm::vec2(-1.04f, 1.04f) * a004 + glm::vec2(r.z, r.w);
 }
 
+glm::vec3 thinTransmissionCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 f0, float f90, float roughness) {
+    float NoL = -glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
+    glm::vec3 lm = l + 2.0f * NoL * n;
+    glm::vec3 h = glm::normalize(v + lm);
+    float alpha = ggxAlpha(roughness);
+    float NoH = std::clamp(glm::dot(n, h), 0.0f, 1.0f), VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+    return (glm::vec3(1.0f) - schlickFresnelF90(f0, f90, VoH)) * ggxD(NoH, alpha) *
+           smithGgxVisibility(NoV, NoL, alpha) * NoL;
+}
+
 } // namespace vitrine::shading

@@ -62,6 +62,9 @@ glm::vec3 brdfCosineSheen(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, g
                           float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen);
 // brdfCosine with the diffuse colour and F0 given apart (shaders/common/brdf.glsl).
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness);
+// shaders/common/thin_transmission.glsl: light from behind a thin transmissive surface through its specular BTDF
+// (the GGX lobe of the light mirrored through the surface), without the tint; 0 for light on v's side.
+glm::vec3 thinTransmissionCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 f0, float f90, float roughness);
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness);
 // intensity = E / pi, E the light's illuminance (lux) on a surface facing it.
 glm::vec3 shadeDirectional(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness,

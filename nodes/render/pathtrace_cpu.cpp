@@ -708,6 +708,21 @@ struct CpuPathTracer::Impl {
         return vec3(0.0f);
     }
 
+    // pathtrace.comp's sunThroughTransmission: the sun behind a thin-walled transmissive dielectric, scattered towards
+    // v through its transmission lobe (core/shading thinTransmissionCosine), tinted, shadowed from the far side.
+    vec3 sunThroughTransmission(const PathSurface& s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough,
+                                uint64_t& rays) const {
+        if (glm::dot(s.geometricNormal, sunDir) >= 0.0f) return vec3(0.0f);
+        vec3 f = thinTransmissionCosine(s.normal, v, sunDir, vec3(s.dielectric), s.dielectric.a, s.roughness);
+        if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return vec3(0.0f);
+        float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
+        vec3 t = s.baseColor * s.attenuation * f;
+        if (hasSheen(s.sheen)) t *= sheenScaling(vec3(s.sheen), NoV, s.sheen.a);
+        t = clearcoatLayer(t, s.coat.x, glm::dot(s.coatNormal, v), vec3(0.0f));
+        return t * sunE *
+               shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, rays);
+    }
+
     // pathtrace.comp's drawTransmission: one component of KHR_materials_transmission's mixture; true when the path
     // passes (throughput scaled), else s is the drawn component's reflecting surface.
     static bool drawTransmission(PathSurface& s, vec3 v, vec3& throughput, uint32_t& rng) {
@@ -883,11 +898,18 @@ struct CpuPathTracer::Impl {
     // pathtrace.comp's tracePath at a surface found along p.dir: alpha coverage, then (where covered) the emission and
     // the transmission's component. True when the path passes through it (p moved past it, not a bounce); false when
     // s reflects (p.radiance has its emission) or the path ends (p.passes over the limit).
-    bool passSurface(PathState& p, PathSurface& s, const CpuTraceSettings& st) const {
+    bool passSurface(PathState& p, PathSurface& s, const CpuTraceSettings& st, const PathLights& lights,
+                     uint64_t& rays) const {
         bool pass = st.seeThrough && s.coverage < 1.0f && rngNext(p.rng) >= s.coverage;
         if (!pass) {
             p.radiance += p.throughput * s.emissive * st.emissiveScale;
-            if (st.seeThrough && s.transmission > 0.0f) pass = drawTransmission(s, -p.dir, p.throughput, p.rng);
+            if (st.seeThrough && s.transmission > 0.0f) {
+                // The transmissive component's share, whichever component drawTransmission then draws.
+                if (lights.sun)
+                    p.radiance += p.throughput * (s.transmission * (1.0f - s.metallic)) *
+                                  sunThroughTransmission(s, -p.dir, lights.sunDir, lights.sunE, st.seeThrough, rays);
+                pass = drawTransmission(s, -p.dir, p.throughput, p.rng);
+            }
         }
         if (!pass) return false;
         if (++p.passes > PATHTRACE_MAX_PASSES) {
@@ -990,7 +1012,7 @@ struct CpuPathTracer::Impl {
                     break;
                 }
                 s = pathSurface(p.hit, p.origin, p.dir);
-                if (passSurface(p, s, st)) {
+                if (passSurface(p, s, st, lights, rays)) {
                     --p.bounce; // passing is not a bounce (the loop's ++ gives it back)
                     continue;
                 }
@@ -1029,7 +1051,7 @@ struct CpuPathTracer::Impl {
             for (size_t a = 0; a < alive; ++a) {
                 PathState& p = paths[live[a]];
                 PathSurface s = pathSurface(p.hit, p.origin, p.dir);
-                if (passSurface(p, s, st)) { // on through it, the same bounce
+                if (passSurface(p, s, st, lights, rays)) { // on through it, the same bounce
                     live[kept++] = live[a];
                     continue;
                 }

@@ -11,6 +11,7 @@
 #include "lighting/ambient.glsl"
 #include "bake/irradiance_volume.glsl"
 #include "common/mip_atlas.glsl"
+#include "common/thin_transmission.glsl"
 
 // Set 0: the node's uniforms and inputs; set 1: the scene (VITRINE_SCENE_SET, defined by the node).
 // forward.transparent: alpha-blended and transmissive (thin glass) surfaces over the lit opaque colour, lit by
@@ -42,20 +43,6 @@ layout(location = 4) in vec4 vColor;
 layout(location = 5) in vec4 vClip;
 layout(location = 6) in vec4 vPrevClip;
 layout(location = 7) in float vViewDepth;
-
-// Light from behind a thin-walled transmissive surface, scattered towards v by its rough surface: the specular BTDF
-// of KHR_materials_transmission for thin walls, the GGX lobe of the light mirrored through the surface to the
-// viewer's side (lm = l - 2 (n.l) n), (1 - F(v.h)) D Vis, times the cosine n.lm (as a reflected light's n.l).
-// 0 for light on the viewer's side. Without the tint (transmission x base colour x the volume's attenuation).
-vec3 thinTransmissionCosine(vec3 n, vec3 v, vec3 l, vec3 f0, float f90, float roughness) {
-    float NoL = -dot(n, l), NoV = dot(n, v);
-    if (NoL <= 0.0 || NoV <= 0.0) return vec3(0.0);
-    vec3 lm = l + 2.0 * NoL * n;
-    vec3 h = normalize(v + lm);
-    float alpha = ggxAlpha(roughness);
-    float NoH = clamp(dot(n, h), 0.0, 1.0), VoH = clamp(dot(v, h), 0.0, 1.0);
-    return (vec3(1.0) - schlickFresnelF90(f0, f90, VoH)) * ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * NoL;
-}
 
 // thinTransmissionCosine x E of every point and spot light (shadePunctual's lights, behind the surface).
 vec3 shadePunctualTransmitted(vec3 p, vec3 n, vec3 v, vec3 f0, float f90, float roughness) {

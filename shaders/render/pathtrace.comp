@@ -17,6 +17,7 @@
 #define PATHTRACE_SEE_THROUGH_SURFACE // PathSurface's coverage, transmission and attenuation
 #include "pathtrace/sampling.glsl"
 #include "pathtrace/surface.glsl"
+#include "common/thin_transmission.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform samplerCube in_sky;
@@ -70,6 +71,22 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough) {
     return vec3(0.0);
 }
 
+// The sun behind a thin-walled transmissive dielectric, scattered towards v by its rough surface
+// (common/thin_transmission.glsl, as forward.transparent draws it), tinted by the base colour and the volume's
+// attenuation under the sheen's scaling and the coat, and shadowed from the far side. The path itself passes such a
+// surface straight on, so it never meets the sun (a delta light) through it: this is the only way that light
+// arrives. 0 with the sun on v's side.
+vec3 sunThroughTransmission(PathSurface s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough) {
+    if (dot(s.geometricNormal, sunDir) >= 0.0) return vec3(0.0);
+    vec3 f = thinTransmissionCosine(s.normal, v, sunDir, s.dielectric.rgb, s.dielectric.a, s.roughness);
+    if (!any(greaterThan(f, vec3(0.0)))) return vec3(0.0);
+    float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
+    vec3 t = s.baseColor * s.attenuation * f;
+    if (hasSheen(s.sheen)) t *= sheenScaling(s.sheen.rgb, NoV, s.sheen.a);
+    t = clearcoatLayer(t, s.coat.x, dot(s.coatNormal, v), vec3(0.0));
+    return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough);
+}
+
 // KHR_materials_transmission as the glTF spec mixes it, one component drawn per surface: the metal (probability
 // metallic), the opaque dielectric ((1 - metallic)(1 - transmission)) and the transmissive one ((1 - metallic)
 // transmission), whose reflection is its specular alone and which lets dielectricThrough pass straight on. Each is
@@ -118,7 +135,14 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         if (!pass) {
             // Emitters are not sampled as lights: what BRDF sampling finds counts in full.
             radiance += throughput * s.emissive * push.scales.z;
-            if (seeThrough && s.transmission > 0.0) pass = drawTransmission(s, -dir, throughput, rng);
+            if (seeThrough && s.transmission > 0.0) {
+                // The transmissive component's share of the mixture, (1 - metallic) transmission, whichever
+                // component drawTransmission then draws.
+                if (sun)
+                    radiance += throughput * (s.transmission * (1.0 - s.metallic)) *
+                                sunThroughTransmission(s, -dir, sunDir, sunE, seeThrough);
+                pass = drawTransmission(s, -dir, throughput, rng);
+            }
         }
         if (pass) { // straight on from the far side; the direction's density (for MIS at the sky) is unchanged
             if (++passes > PATHTRACE_MAX_PASSES) break;

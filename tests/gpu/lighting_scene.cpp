@@ -149,6 +149,16 @@ double hitSphere(glm::dvec3 o, glm::dvec3 d, glm::dvec3 centre, double radius) {
     return disc <= 0.0 ? -1.0 : -b - std::sqrt(disc);
 }
 
+double thinTransmissionLobe(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, double f0, float alpha) {
+    const double NoL = -glm::dot(n, l), NoV = glm::dot(n, v);
+    if (NoL <= 0.0 || NoV <= 0.0) return 0.0;
+    const glm::dvec3 lm = l - 2.0 * glm::dot(n, l) * n;
+    const glm::dvec3 h = glm::normalize(v + lm);
+    const double F = f0 + (1.0 - f0) * std::pow(1.0 - glm::dot(v, h), 5.0);
+    return (1.0 - F) * shading::ggxD(static_cast<float>(glm::dot(n, h)), alpha) *
+           shading::smithGgxVisibility(static_cast<float>(NoV), static_cast<float>(NoL), alpha) * NoL;
+}
+
 glm::dvec3 rgb(const Image& img, int x, int y) {
     const float* p = img.at(x, y);
     return {p[0], p[1], p[2]};

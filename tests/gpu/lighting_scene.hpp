@@ -83,6 +83,12 @@ double relErr(glm::dvec3 a, glm::dvec3 b);
 double directionalAlbedo(double NoV, int steps,
                          const std::function<double(glm::vec3 n, glm::vec3 v, glm::vec3 l)>& brdfCosine);
 
+// KHR_materials_transmission's thin-walled specular BTDF as its description gives it, for light from behind a surface
+// of normal n reaching the viewer at v: the GGX lobe of the light mirrored through the surface, lm = l − 2 (n·l) n,
+// (1 − F(v·h)) D(n·h) Vis(n·v, n·lm) n·lm with h = |v + lm|, F Schlick's of f0 (core/shading's D and Vis); 0 for
+// light on v's side. Written here apart from the renderers' thinTransmissionCosine.
+double thinTransmissionLobe(glm::dvec3 n, glm::dvec3 v, glm::dvec3 l, double f0, float alpha);
+
 // A lighting.deferred node reading the nodes of baseNodes(); shadowMap adds a node "shadow".
 nlohmann::json lightingNode(nlohmann::json params, bool shadowMap);
 // scene (scene.gltf of glb), gbuffer and sky (sky.procedural, 16² faces, no sun disk in the cube map).

@@ -1277,5 +1277,80 @@ PATHTRACE_TEST(SunThroughAGlassRoofIsTintedByItsTransmittance) {
     }
 }
 
+// The sun behind rough thin glass, seen through it: panes of roughness 0.6 (tinted c, IOR 1.5) facing the camera,
+// the sun 19° up behind them, no sky; left pure glass, right a mixture (transmission 0.6, metallic 0.3); an opaque
+// wall 3 m behind shades part of the left pane from the sun. Both tracers pass the glass straight on, so the only
+// light a pixel of a pane shows is the sun scattered towards the camera by the glass's transmission lobe, added at
+// the pane by next-event estimation for the transmissive share (1 − metallic) × transmission: that share × c × the
+// thin-walled BTDF of KHR_materials_transmission (tests/gpu/lighting_scene's thinTransmissionLobe, written from the
+// extension's description) × E, as forward.transparent draws it (Transparent.LightBehindRoughGlassShinesThrough…).
+// Deterministic at 1 spp (the lobe is added whichever component the path then draws): 0.1 % per pixel; the shaded
+// pixels (a band of 0.1 m around the wall's shadow edge left out) black.
+PATHTRACE_TEST(SunBehindRoughGlassShinesThroughItsTransmissionLobe) {
+    const int W = 40, H = 30;
+    const glm::vec3 c(1.0f, 0.5f, 0.25f);
+    const float shininess = 0.4f;
+    const double sunScale = 0.1, share = 0.6 * (1.0 - 0.3), wallX = -0.2;
+    SceneBuilder b("pt_glass_backlit");
+    std::vector<Tri> left, right, wall;
+    addQuad(left, glm::vec3(-1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 2, 0), glm::vec3(0, 0, 1));
+    addQuad(right, glm::vec3(1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 2, 0), glm::vec3(0, 0, 1));
+    addQuad(wall, glm::vec3(-4.1f, 0, 0), glm::vec3(3.9f, 0, 0), glm::vec3(0, 8, 0), glm::vec3(0, 0, 1));
+    uint32_t glass = b.material("glass", c, 0.0f, shininess);
+    b.s.materials[glass].transmission = 1.0f;
+    uint32_t mixed = b.material("mixed", c, 0.3f, shininess);
+    b.s.materials[mixed].transmission = 0.6f;
+    b.node("left", static_cast<int32_t>(b.mesh("left", left, glass)), glm::vec3(0, 0, -3));
+    b.node("right", static_cast<int32_t>(b.mesh("right", right, mixed)), glm::vec3(0, 0, -3));
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, b.material("wall", glm::vec3(0.5f), 0.0f, 0.0f))),
+           glm::vec3(0, 0, -6));
+    b.camera({0.0f, 0.0f, 0.0f}, {0.2f, 0.1f, -3.0f}, 0.8f);
+    b.sun({0.15f, 0.35f, -1.0f});
+    auto glb = b.write();
+    json nodes = baseNodes(glb);
+    nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
+    nodes["pt"] = pathtraceNode(
+        {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
+    auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
+    const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const float alpha = shading::ggxAlpha(shading::roughnessFromShininess(shininess));
+    const glm::dvec3 n(0.0, 0.0, 1.0);
+    Pinhole cam(b.s, W, H);
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    std::vector<glm::ivec2> shaded;
+    int rightCount = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const glm::dvec3 d = cam.ray(x, y);
+            const glm::dvec3 p = d * (-3.0 / d.z);
+            if (d.z >= 0.0 || std::abs(p.x) > 1.9 || std::abs(p.y) > 1.9 || std::abs(p.x) < 0.1) continue;
+            // Where the sun ray from p meets the wall's plane (z = -6).
+            const double xWall = p.x + toSun.x * (-3.0 / toSun.z);
+            if (std::abs(xWall - wallX) < 0.1) continue;
+            if (xWall < wallX) {
+                shaded.push_back({x, y});
+                continue;
+            }
+            rightCount += p.x > 0.0;
+            const double s = p.x > 0.0 ? share : 1.0;
+            expected.push_back({{x, y}, s * glm::dvec3(c) * thinTransmissionLobe(n, -d, toSun, 0.04, alpha) * sunE});
+        }
+    const auto [checked, worst] = expectPixels(out.at("pt"), expected, 0.001);
+    double brightest = 0.0, darkest = 0.0;
+    for (const auto& [px, e] : expected)
+        brightest = std::max(brightest, e.g);
+    for (const glm::ivec2& px : shaded)
+        darkest = std::max(darkest, rgb(out.at("pt"), px.x, px.y).g);
+    std::printf("%s tracer, sun behind rough glass: %d pixels (%d of the mixture), worst relative error %.5f, "
+                "brightest %.1f; %zu shaded pixels, the brightest %.3g\n",
+                gBackend, checked, rightCount, worst, brightest, shaded.size(), darkest);
+    EXPECT_GE(checked, 300);
+    EXPECT_GE(rightCount, 150);
+    EXPECT_GE(shaded.size(), 100u);
+    EXPECT_GT(brightest, 10.0) << "the lobe must show";
+    EXPECT_LT(darkest, 1e-3 * brightest) << "the wall's shadow";
+}
+
 } // namespace
 } // namespace vitrine::test

@@ -671,14 +671,7 @@ TEST_F(Transparent, LightBehindRoughGlassShinesThroughItsTransmissionLobe) {
         const double f0 = std::pow((ior - 1.0) / (ior + 1.0), 2.0);
         const float alpha = shading::ggxAlpha(shading::roughnessFromShininess(shininess));
         auto lobe = [&](glm::dvec3 v, glm::dvec3 l) {
-            const double NoL = -glm::dot(n, l), NoV = glm::dot(n, v);
-            if (NoL <= 0.0 || NoV <= 0.0) return glm::dvec3(0.0);
-            const glm::dvec3 lm = l - 2.0 * glm::dot(n, l) * n;
-            const glm::dvec3 h = glm::normalize(v + lm);
-            const double F = f0 + (1.0 - f0) * std::pow(1.0 - glm::dot(v, h), 5.0);
-            return glm::dvec3(tint) *
-                   ((1.0 - F) * shading::ggxD(static_cast<float>(glm::dot(n, h)), alpha) *
-                    shading::smithGgxVisibility(static_cast<float>(NoV), static_cast<float>(NoL), alpha) * NoL);
+            return glm::dvec3(tint) * thinTransmissionLobe(n, v, l, f0, alpha);
         };
         int count = 0, shadedCount = 0;
         double worst = 0.0, peak = 0.0, peakShare = 0.0, pointPeak = 0.0;
