@@ -59,19 +59,26 @@ uint64_t fnv1a(const std::string& data, uint64_t hash = 1469598103934665603ull) 
     return hash;
 }
 
-// Resolves #include against the including file's directory, then the shader root. Header
-// names are reported relative to the root so error messages stay short.
+// Where `#include "header"` in the file `includer` (a path relative to root) leads: against the including file's
+// directory, then the shader root; relative to root, or nullopt when neither holds the file. The one rule of both the
+// preprocessor's includer and the source key (shaderSourceKey).
+std::optional<fs::path> resolveInclude(const fs::path& root, const std::string& includer, const std::string& header) {
+    for (const fs::path& candidate : {fs::path(includer).parent_path() / header, fs::path(header)}) {
+        std::error_code ec;
+        if (fs::is_regular_file(root / candidate, ec)) return candidate.lexically_normal();
+    }
+    return std::nullopt;
+}
+
+// Resolves #include with resolveInclude(). Header names are reported relative to the root so error messages stay
+// short.
 class Includer : public glslang::TShader::Includer {
 public:
     explicit Includer(fs::path root) : mRoot(std::move(root)) {}
 
     IncludeResult* includeLocal(const char* header, const char* includer, size_t depth) override {
-        fs::path base = fs::path(includer).parent_path();
-        for (const fs::path& candidate : {mRoot / base / header, mRoot / header}) {
-            std::error_code ec;
-            if (fs::is_regular_file(candidate, ec)) return load(candidate);
-        }
-        return nullptr;
+        std::optional<fs::path> found = resolveInclude(mRoot, includer, header);
+        return found ? load(mRoot / *found) : nullptr;
     }
     IncludeResult* includeSystem(const char* header, const char* includer, size_t depth) override {
         return includeLocal(header, includer, depth);
@@ -154,29 +161,22 @@ std::vector<std::string> includeNames(const std::string& text) {
 bool hashIncludes(const fs::path& root, const std::string& name, const std::string& text, std::set<std::string>& seen,
                   uint64_t& hash) {
     for (const std::string& header : includeNames(text)) {
-        std::optional<std::string> found;
-        const fs::path base = fs::path(name).parent_path();
-        for (const fs::path& candidate : {base / header, fs::path(header)}) {
-            std::error_code ec;
-            if (fs::is_regular_file(root / candidate, ec)) {
-                found = candidate.lexically_normal().generic_string();
-                break;
-            }
-        }
+        const std::optional<fs::path> resolved = resolveInclude(root, name, header);
         // Named but absent: an include the preprocessor skips (`#include <cstdint>` under __cplusplus in the headers
         // shared with C++), or a missing file, which fails preprocessing, so no key ever points to SPIR-V for it.
         // Its line is in the including file's bytes; should a file of that name appear, it is hashed from then on.
-        if (!found) continue;
-        if (!seen.insert(*found).second) continue; // once each (include guards are not read: files may cycle)
+        if (!resolved) continue;
+        const std::string found = resolved->generic_string();
+        if (!seen.insert(found).second) continue; // once each (include guards are not read: files may cycle)
         std::string included;
         try {
-            included = readText(root / *found);
+            included = readText(root / found);
         } catch (const UserError&) {
             return false;
         }
-        hash = fnv1a(*found + '\0' + std::to_string(included.size()) + '\0', hash);
+        hash = fnv1a(found + '\0' + std::to_string(included.size()) + '\0', hash);
         hash = fnv1a(included, hash);
-        if (!hashIncludes(root, *found, included, seen, hash)) return false;
+        if (!hashIncludes(root, found, included, seen, hash)) return false;
     }
     return true;
 }
@@ -239,26 +239,19 @@ CompiledShader ShaderCompiler::compileSource(const std::string& name, const std:
     // shader to find it was most of a warm start's pipeline time (glslang's preprocessor: about 140 of 190 ms for the
     // Museum's compute shaders on lavapipe's 2-core machine), so a first key read from the sources and the files
     // they include (shaderSourceKey) points to it: `src-KEY.ref` holds the expanded text's hash.
-    std::optional<uint64_t> sourceKey;
     fs::path refPath;
-    if (mUseCache) {
-        sourceKey = shaderSourceKey(mRoot, name, source, preamble, static_cast<int>(lang));
-        if (sourceKey) {
-            char key[17];
-            std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(*sourceKey));
-            refPath = mCacheDir / ("src-" + std::string(key) + ".ref");
-            std::error_code ec;
-            if (fs::exists(refPath, ec)) {
-                std::ifstream ref(refPath);
-                std::string hex;
-                ref >> hex;
-                CompiledShader cached;
-                if (hex.size() == 16 && loadCached(mCacheDir, hex, cached)) {
-                    cached.name = name;
-                    ++mHits;
-                    return cached;
-                }
-            }
+    if (const std::optional<uint64_t> sourceKey =
+            mUseCache ? shaderSourceKey(mRoot, name, source, preamble, static_cast<int>(lang)) : std::nullopt) {
+        char key[17];
+        std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(*sourceKey));
+        refPath = mCacheDir / ("src-" + std::string(key) + ".ref");
+        std::string hex;
+        std::ifstream(refPath) >> hex; // empty when there is no ref yet
+        CompiledShader cached;
+        if (hex.size() == 16 && loadCached(mCacheDir, hex, cached)) {
+            cached.name = name;
+            ++mHits;
+            return cached;
         }
     }
 

@@ -673,13 +673,20 @@ struct CpuPathTracer::Impl {
         return r.tfar < 0.0f;
     }
 
+    // pathtrace.comp's dielectricLayers: light t a thin-walled transmissive dielectric lets through, under its sheen
+    // and coat.
+    static vec3 dielectricLayers(const PathSurface& s, vec3 v, vec3 t) {
+        float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
+        if (hasSheen(s.sheen)) t *= sheenScaling(vec3(s.sheen), NoV, s.sheen.a);
+        return clearcoatLayer(t, s.coat.x, glm::dot(s.coatNormal, v), vec3(0.0f));
+    }
+
     // pathtrace.comp's dielectricThrough: what a thin-walled transmissive dielectric lets pass straight on.
     static vec3 dielectricThrough(const PathSurface& s, vec3 v) {
         float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
         vec3 t =
             (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
-        if (hasSheen(s.sheen)) t *= sheenScaling(vec3(s.sheen), NoV, s.sheen.a);
-        return clearcoatLayer(t, s.coat.x, glm::dot(s.coatNormal, v), vec3(0.0f));
+        return dielectricLayers(s, v, t);
     }
 
     // pathtrace.comp's pathPassing: what passes s on a shadow ray (0 for an opaque surface).
@@ -715,10 +722,7 @@ struct CpuPathTracer::Impl {
         if (glm::dot(s.geometricNormal, sunDir) >= 0.0f) return vec3(0.0f);
         vec3 f = thinTransmissionCosine(s.normal, v, sunDir, vec3(s.dielectric), s.dielectric.a, s.roughness);
         if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return vec3(0.0f);
-        float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
-        vec3 t = s.baseColor * s.attenuation * f;
-        if (hasSheen(s.sheen)) t *= sheenScaling(vec3(s.sheen), NoV, s.sheen.a);
-        t = clearcoatLayer(t, s.coat.x, glm::dot(s.coatNormal, v), vec3(0.0f));
+        vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
         return t * sunE *
                shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, rays);
     }

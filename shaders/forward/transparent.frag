@@ -125,7 +125,8 @@ void main() {
     // The sun and the lights behind the surface, through its transmission lobe (the sun's shadow looked up from the
     // far side), tinted as what passes; layered under the sheen and the coat with the rest.
     if (any(greaterThan(tint, vec3(0.0)))) {
-        float behind = u.params.y > 0.5 ? sunVisibility(in_shadow_map, world, -N, vViewDepth) : 1.0;
+        // (no shadow lookup for a sun in front: its lobe is 0 there)
+        float behind = u.params.y > 0.5 && dot(N, l) < 0.0 ? sunVisibility(in_shadow_map, world, -N, vViewDepth) : 1.0;
         vec3 transmitted = thinTransmissionCosine(N, v, l, f0, f90, roughness) * sunE * behind;
         transmitted += shadePunctualTransmitted(world, N, v, f0, f90, roughness);
         lit += tint * transmitted;

@@ -38,14 +38,21 @@ vec3 offsetRay(vec3 p, vec3 ng, vec3 dir) {
     return p + ng * (dot(ng, dir) >= 0.0 ? scale : -scale);
 }
 
+// Light t that a thin-walled transmissive dielectric lets through towards v, under its layers: scaled by the sheen's
+// albedo and seen through the coat, 1 - c Fc(nc.v).
+vec3 dielectricLayers(PathSurface s, vec3 v, vec3 t) {
+    float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
+    if (hasSheen(s.sheen)) t *= sheenScaling(s.sheen.rgb, NoV, s.sheen.a);
+    return clearcoatLayer(t, s.coat.x, dot(s.coatNormal, v), vec3(0.0));
+}
+
 // KHR_materials_transmission's thin-walled dielectric (forward.transparent's `through`): what it does not reflect,
-// 1 - F(n.v), tinted by the base colour and the volume's attenuation, then scaled by the sheen's albedo and seen
-// through the coat, 1 - c Fc(nc.v). Straight on: no refraction offset, no blur by roughness.
+// 1 - F(n.v), tinted by the base colour and the volume's attenuation, under its layers. Straight on: no refraction
+// offset, no blur by roughness.
 vec3 dielectricThrough(PathSurface s, vec3 v) {
     float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
     vec3 t = (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
-    if (hasSheen(s.sheen)) t *= sheenScaling(s.sheen.rgb, NoV, s.sheen.a);
-    return clearcoatLayer(t, s.coat.x, dot(s.coatNormal, v), vec3(0.0));
+    return dielectricLayers(s, v, t);
 }
 
 // What passes surface s seen along -v on a shadow ray: its uncovered share, plus where it is covered the transmissive
@@ -80,10 +87,7 @@ vec3 sunThroughTransmission(PathSurface s, vec3 v, vec3 sunDir, vec3 sunE, bool 
     if (dot(s.geometricNormal, sunDir) >= 0.0) return vec3(0.0);
     vec3 f = thinTransmissionCosine(s.normal, v, sunDir, s.dielectric.rgb, s.dielectric.a, s.roughness);
     if (!any(greaterThan(f, vec3(0.0)))) return vec3(0.0);
-    float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
-    vec3 t = s.baseColor * s.attenuation * f;
-    if (hasSheen(s.sheen)) t *= sheenScaling(s.sheen.rgb, NoV, s.sheen.a);
-    t = clearcoatLayer(t, s.coat.x, dot(s.coatNormal, v), vec3(0.0));
+    vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
     return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough);
 }
 
