@@ -209,8 +209,9 @@ struct Material {
     // KHR_materials_volume: the medium behind a transmissive surface. forward.transparent multiplies the light passing
     // through by Beer's law T = attenuationColor^(d / attenuationDistance), d = |refracted direction × thickness × the
     // node's scale| (thickness × scale for a uniform scale), thickness = thicknessFactor × thicknessTexture.g in the
-    // mesh's own units (the Sample Viewer's approximation; no refraction offset here). thickness 0 (the default) is
-    // thin-walled: nothing is attenuated.
+    // mesh's own units, and reads what lies behind at the exit point (the Sample Viewer's approximation).
+    // render.pathtrace instead refracts at the mesh's real faces and applies Beer's law over the way inside
+    // (shaders/pathtrace/volume.glsl). thickness 0 (the default) is thin-walled: nothing is attenuated.
     float thickness = 0.0f;                                              // ≥ 0
     TextureRef thicknessTexture;                                         // data, green channel
     float attenuationDistance = std::numeric_limits<float>::infinity(); // > 0; +∞: no attenuation

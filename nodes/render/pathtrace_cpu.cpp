@@ -109,6 +109,35 @@ float ggxVndfPdf(float NoV, float NoH, float alpha) {
     return ggxD(NoH, alpha) / (2.0f * (NoV + std::sqrt(a2 + (1.0f - a2) * NoV * NoV)));
 }
 
+// --- volume.glsl ---
+float ggxMaskingRatio(float NoV, float NoL, float alpha) {
+    float a2 = alpha * alpha;
+    float lv = std::sqrt(a2 + (1.0f - a2) * NoV * NoV), ll = std::sqrt(a2 + (1.0f - a2) * NoL * NoL);
+    return NoL * (NoV + lv) / std::max(NoL * lv + NoV * ll, 1e-12f);
+}
+
+bool crossBoundary(vec3 n, vec3 ng, vec3 v, float roughness, vec4 dielectric, float eta, bool fresnel, vec3 u, vec3& l,
+                   vec3& weight, bool& across) {
+    float alpha = ggxAlpha(roughness);
+    glm::mat3 frame = basisAround(n);
+    vec3 h = frame * sampleGgxVndf(glm::transpose(frame) * v, alpha, vec2(u.y, u.z));
+    float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
+    float sin2T = eta * eta * (1.0f - VoH * VoH);
+    across = sin2T < 1.0f;
+    weight = vec3(1.0f);
+    if (across && fresnel) {
+        vec3 F = schlickFresnelF90(vec3(dielectric), dielectric.a, eta < 1.0f ? VoH : std::sqrt(1.0f - sin2T));
+        float p = std::clamp(luminance(F), 1e-3f, 1.0f - 1e-3f);
+        across = u.x >= p;
+        weight = across ? (vec3(1.0f) - F) / (1.0f - p) : F / p;
+    }
+    l = across ? glm::refract(-v, h, eta) : glm::reflect(-v, h);
+    float side = glm::dot(ng, l);
+    if (across ? side >= 0.0f : side <= 0.0f) return false;
+    weight *= ggxMaskingRatio(std::clamp(glm::dot(n, v), 1e-4f, 1.0f), std::abs(glm::dot(n, l)), alpha);
+    return true;
+}
+
 } // namespace cpu_sampling
 
 namespace {
@@ -681,35 +710,46 @@ struct CpuPathTracer::Impl {
         return clearcoatLayer(t, s.coat.x, glm::dot(s.coatNormal, v), vec3(0.0f));
     }
 
-    // pathtrace.comp's dielectricThrough: what a thin-walled transmissive dielectric lets pass straight on.
+    // pathtrace.comp's dielectricThrough: what a transmissive dielectric lets pass (a thin wall straight on, a
+    // volume's boundary refracted).
     static vec3 dielectricThrough(const PathSurface& s, vec3 v) {
         float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
-        vec3 t =
-            (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
+        vec3 t = (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, NoV)) * s.baseColor;
         return dielectricLayers(s, v, t);
     }
 
-    // pathtrace.comp's pathPassing: what passes s on a shadow ray (0 for an opaque surface).
-    static vec3 pathPassing(const PathSurface& s, vec3 v) {
+    // pathtrace.comp's pathPassing: what passes s on a shadow ray (0 for an opaque surface, and for a volume's boundary
+    // unless throughVolumes; from inside a volume, 1 - F(n.v) and Beer's law over `inside`).
+    static vec3 pathPassing(const PathSurface& s, vec3 v, bool throughVolumes, float inside) {
+        if (s.boundary && !throughVolumes) return vec3(0.0f);
+        if (s.inside) {
+            vec3 beer = s.medium.a > 0.0f ? glm::pow(vec3(s.medium), vec3(inside / s.medium.a)) : vec3(1.0f);
+            return (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a,
+                                                   std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f))) *
+                   beer;
+        }
         vec3 through =
             s.transmission > 0.0f ? s.transmission * (1.0f - s.metallic) * dielectricThrough(s, v) : vec3(0.0f);
         return vec3(1.0f - s.coverage) + s.coverage * through;
     }
 
     // pathtrace.comp's shadowTransmittance: 0 behind anything opaque, 1 with nothing in the way; with seeThrough the
-    // product of pathPassing over every surface crossed (at most PATHTRACE_MAX_PASSES).
-    vec3 shadowTransmittance(vec3 o, vec3 d, bool seeThrough, uint64_t& rays) const {
+    // product of pathPassing over every surface crossed (at most PATHTRACE_MAX_PASSES), a volume's boundary stopping
+    // the ray unless throughVolumes (the sun's rays).
+    vec3 shadowTransmittance(vec3 o, vec3 d, bool seeThrough, bool throughVolumes, uint64_t& rays) const {
         if (!seeThrough) return occluded(o, d, rays) ? vec3(0.0f) : vec3(1.0f);
         // First against what no light passes (the GPU tracer walks the surfaces only: one BVH there); then every hit
         // left is one to pass.
         if (rtcOpaque && occludedIn(rtcOpaque, o, d, rays)) return vec3(0.0f);
         vec3 T(1.0f);
-        float tmin = 0.0f;
+        float tmin = 0.0f, entered = 0.0f; // where the ray entered the volume it is in (0: it starts inside one)
         for (uint32_t i = 0; i < PATHTRACE_MAX_PASSES; ++i) {
             Hit hit;
             if (!closest(o, d, tmin, hit, rays)) return T;
-            T *= pathPassing(pathSurface(hit, o, d), -d);
+            const PathSurface s = pathSurface(hit, o, d);
+            T *= pathPassing(s, -d, throughVolumes, hit.t - entered);
             if (std::max(std::max(T.r, T.g), T.b) <= 0.0f) return vec3(0.0f);
+            if (s.boundary && !s.inside) entered = hit.t;
             tmin = std::nextafter(hit.t, kInfinity); // Embree's tnear is inclusive, the GLSL test strict
         }
         return vec3(0.0f);
@@ -719,12 +759,12 @@ struct CpuPathTracer::Impl {
     // v through its transmission lobe (core/shading thinTransmissionCosine), tinted, shadowed from the far side.
     vec3 sunThroughTransmission(const PathSurface& s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough,
                                 uint64_t& rays) const {
-        if (glm::dot(s.geometricNormal, sunDir) >= 0.0f) return vec3(0.0f);
+        if (s.boundary || glm::dot(s.geometricNormal, sunDir) >= 0.0f) return vec3(0.0f);
         vec3 f = thinTransmissionCosine(s.normal, v, sunDir, vec3(s.dielectric), s.dielectric.a, s.roughness);
         if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return vec3(0.0f);
-        vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
+        vec3 t = dielectricLayers(s, v, s.baseColor * f);
         return t * sunE *
-               shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, rays);
+               shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true, rays);
     }
 
     // pathtrace.comp's drawTransmission: one component of KHR_materials_transmission's mixture; true when the path
@@ -746,10 +786,14 @@ struct CpuPathTracer::Impl {
         return false;
     }
 
-    // pathCulled: the back of a single-sided material's triangle, which the rasteriser culls.
+    // surface.glsl's materialBoundsVolume.
+    static bool boundsVolume(const GpuMaterial& m) { return m.optics.x > 0.0f && m.optics.w > 0.0f; }
+
+    // pathCulled: the back of a single-sided material's triangle, which the rasteriser culls (never a volume's).
     bool culled(const Hit& hit, vec3 direction) const {
         const TriangleRef& ref = refs[hit.triangle];
-        if (materials.materials[ref.material].info.w != 0u) return false;
+        const GpuMaterial& m = materials.materials[ref.material];
+        if (m.info.w != 0u || boundsVolume(m)) return false;
         const vec3* p = &worldPositions[3 * static_cast<size_t>(hit.triangle)];
         return glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), direction) > 0.0f;
     }
@@ -849,22 +893,18 @@ struct CpuPathTracer::Impl {
         s.roughness = roughnessFromShininess(std::clamp(l.shininess, 0.0f, 1.0f));
         s.cavity = std::clamp(l.cavity, 0.0f, 1.0f);
         s.dielectric = dielectricSpecular(0.04f, materials.materialSpecular(m, uv0, uv1));
-        // surface.glsl's PATHTRACE_SEE_THROUGH_SURFACE part: coverage, transmission and the volume's attenuation.
+        // surface.glsl's PATHTRACE_SEE_THROUGH_SURFACE part: coverage, transmission and the volume's boundary.
         s.coverage = m.info.z == 1u   ? (l.albedo.a < m.emissive.a ? 0.0f : 1.0f)
                      : m.info.z == 2u ? std::clamp(l.albedo.a, 0.0f, 1.0f)
                                       : 1.0f;
         s.transmission = m.optics.x;
-        if (s.transmission > 0.0f) {
+        s.boundary = boundsVolume(m);
+        s.inside = s.boundary && backFace;
+        const float r = std::sqrt(std::clamp(m.optics.y, 0.0f, 0.98f)); // surface.glsl iorFromF0
+        s.ior = (1.0f + r) / (1.0f - r);
+        s.medium = m.volume;
+        if (s.transmission > 0.0f)
             s.dielectric = dielectricSpecular(m.optics.y, materials.materialSpecular(m, uv0, uv1));
-            const float thickness = materials.materialThickness(m, uv0, uv1);
-            if (thickness > 0.0f && m.volume.a > 0.0f) {
-                const vec3 modelScale(glm::length(w[0]), glm::length(w[1]), glm::length(w[2]));
-                const float r = std::sqrt(m.optics.y);
-                const vec3 refracted = glm::normalize(glm::refract(direction, N, (1.0f - r) / (1.0f + r)));
-                s.attenuation =
-                    glm::pow(vec3(m.volume), vec3(glm::length(refracted * thickness * modelScale) / m.volume.a));
-            }
-        }
         s.emissive = vec3(m.emissive);
         if (m.emissiveRef.info.x >= 0) s.emissive *= vec3(materials.sampleRef(m.emissiveRef, uv0, uv1));
         if (m.optics.z > 0.5f) {
@@ -880,9 +920,11 @@ struct CpuPathTracer::Impl {
     struct PathState {
         vec3 origin{0.0f}, dir{0.0f};
         vec3 radiance{0.0f}, throughput{1.0f};
-        float brdfPdfPrev = 0.0f;
+        float brdfPdfPrev = 0.0f; // 0: a camera ray, or after a volume's boundary (what is found counts in full)
         uint32_t rng = 0, bounce = 0;
-        uint32_t passes = 0; // surfaces passed through (seeThrough; not bounces)
+        uint32_t passes = 0;   // surfaces passed through (seeThrough; not bounces)
+        bool inVolume = false; // inside a volume of this attenuationColor and attenuationDistance (0: none)
+        vec4 medium{0.0f};
         bool ended = false;  // passed through more than PATHTRACE_MAX_PASSES
         Hit hit{};
     };
@@ -904,7 +946,32 @@ struct CpuPathTracer::Impl {
     // s reflects (p.radiance has its emission) or the path ends (p.passes over the limit).
     bool passSurface(PathState& p, PathSurface& s, const CpuTraceSettings& st, const PathLights& lights,
                      uint64_t& rays) const {
+        // Beer's law over the way inside a volume.
+        if (p.inVolume && p.medium.a > 0.0f) p.throughput *= glm::pow(vec3(p.medium), vec3(s.t / p.medium.a));
+        if (st.seeThrough && s.inside) { // a volume's boundary from inside: out through it, or back in by Fresnel
+            if (++p.passes > PATHTRACE_MAX_PASSES) {
+                p.ended = true;
+                return false;
+            }
+            vec3 l, w;
+            bool across;
+            float a = rngNext(p.rng);
+            vec2 bc = rngNext2(p.rng);
+            if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric, s.ior, true, vec3(a, bc),
+                               l, w, across)) {
+                p.ended = true;
+                return false;
+            }
+            p.throughput *= w;
+            p.inVolume = !across;
+            p.medium = s.medium;
+            p.brdfPdfPrev = 0.0f;
+            p.origin = offsetRay(s.position, s.geometricNormal, l);
+            p.dir = l;
+            return true;
+        }
         bool pass = st.seeThrough && s.coverage < 1.0f && rngNext(p.rng) >= s.coverage;
+        bool refracts = false; // passes into a volume
         if (!pass) {
             p.radiance += p.throughput * s.emissive * st.emissiveScale;
             if (st.seeThrough && s.transmission > 0.0f) {
@@ -913,6 +980,7 @@ struct CpuPathTracer::Impl {
                     p.radiance += p.throughput * (s.transmission * (1.0f - s.metallic)) *
                                   sunThroughTransmission(s, -p.dir, lights.sunDir, lights.sunE, st.seeThrough, rays);
                 pass = drawTransmission(s, -p.dir, p.throughput, p.rng);
+                refracts = pass && s.boundary;
             }
         }
         if (!pass) return false;
@@ -920,13 +988,31 @@ struct CpuPathTracer::Impl {
             p.ended = true;
             return false;
         }
+        if (refracts) { // into the volume, through one of the boundary's microfacets
+            vec3 l, w;
+            bool across;
+            float a = rngNext(p.rng);
+            vec2 bc = rngNext2(p.rng);
+            if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric, 1.0f / s.ior, false,
+                               vec3(a, bc), l, w, across)) {
+                p.ended = true;
+                return false;
+            }
+            p.throughput *= w;
+            p.inVolume = true;
+            p.medium = s.medium;
+            p.brdfPdfPrev = 0.0f;
+            p.dir = l;
+        }
         p.origin = offsetRay(s.position, s.geometricNormal, p.dir);
         return true;
     }
 
-    // The path left the scene: the sky it sees, MIS-weighted against the sky's own sampling after a bounce.
+    // The path left the scene: the sky it sees, MIS-weighted against the sky's own sampling after a bounce (nothing
+    // from inside an absorbing volume: an open mesh).
     static void addMiss(PathState& p, const Env& env, const PathLights& lights) {
-        float w = p.bounce == 0u || !lights.envSampling ? 1.0f : powerHeuristic(p.brdfPdfPrev, env.pdf(p.dir));
+        if (p.inVolume && p.medium.a > 0.0f) return;
+        float w = p.brdfPdfPrev <= 0.0f || !lights.envSampling ? 1.0f : powerHeuristic(p.brdfPdfPrev, env.pdf(p.dir));
         p.radiance += p.throughput * env.radiance(p.dir) * w;
     }
 
@@ -950,9 +1036,9 @@ struct CpuPathTracer::Impl {
             vec3 f = brdfCosineSheen(n, s.coatNormal, v, lights.sunDir, s.baseColor, s.metallic, roughness,
                                      s.dielectric, coat, s.sheen);
             if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
-                p.radiance +=
-                    weight * f * lights.sunE *
-                    shadowTransmittance(offsetRay(s.position, ng, lights.sunDir), lights.sunDir, st.seeThrough, rays);
+                p.radiance += weight * f * lights.sunE *
+                              shadowTransmittance(offsetRay(s.position, ng, lights.sunDir), lights.sunDir,
+                                                  st.seeThrough, true, rays);
         }
         if (lights.envSampling) {
             float a = rngNext(p.rng);
@@ -964,7 +1050,7 @@ struct CpuPathTracer::Impl {
                                          s.coat, s.sheen);
                 if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
                     p.radiance += weight * f * env.radiance(l) *
-                                  shadowTransmittance(offsetRay(s.position, ng, l), l, st.seeThrough, rays) *
+                                  shadowTransmittance(offsetRay(s.position, ng, l), l, st.seeThrough, false, rays) *
                                   powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
         }

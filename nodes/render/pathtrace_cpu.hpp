@@ -77,10 +77,13 @@ struct CpuSurface {
     // KHR_materials_sheen: colour (rgb) and perceptual roughness (a); 0 without it.
     glm::vec4 sheen{0.0f};
     // What lets light pass (read only with CpuTraceSettings::seeThrough): 0 where an alpha mask cuts the surface away,
-    // a blended surface's alpha, else 1; KHR_materials_transmission's factor; KHR_materials_volume's Beer attenuation
-    // over the refracted path through the thickness (1 without).
+    // a blended surface's alpha, else 1; KHR_materials_transmission's factor.
     float coverage = 1.0f, transmission = 0.0f;
-    glm::vec3 attenuation{1.0f};
+    // KHR_materials_volume's boundary (shaders/pathtrace/volume.glsl): transmission and a thicknessFactor > 0; seen
+    // from inside (its back face); KHR_materials_ior; the volume's attenuationColor and attenuationDistance (0: none).
+    bool boundary = false, inside = false;
+    float ior = 1.5f;
+    glm::vec4 medium{1.0f, 1.0f, 1.0f, 0.0f};
 };
 
 class CpuPathTracer;

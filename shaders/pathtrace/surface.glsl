@@ -36,7 +36,12 @@ struct PathSurface {
     // What lets light pass (render.pathtrace's `transparent`: render/pathtrace.comp; the bake does not see through):
     float coverage;     // 0 where an alpha mask cuts the surface away, a blended surface's alpha, else 1
     float transmission; // KHR_materials_transmission's factor (0: opaque)
-    vec3 attenuation;   // KHR_materials_volume: Beer's law over the refracted path through the thickness; 1 without
+    // KHR_materials_volume's boundary (pathtrace/volume.glsl): a transmissive material with a thicknessFactor > 0.
+    // The path refracts there and pays Beer's law for its way inside (render/pathtrace.comp).
+    bool boundary;
+    bool inside; // the boundary seen from inside its volume (its back face)
+    float ior;   // KHR_materials_ior of a transmissive surface
+    vec4 medium; // the volume's attenuationColor (rgb) and attenuationDistance (a; 0: no attenuation)
 #endif
 };
 
@@ -53,11 +58,21 @@ vec2 vertexVec2(uint v, uint offset) {
     return vec2(sceneVertices[b], sceneVertices[b + 1u]);
 }
 
+// The IOR of a dielectric whose F0 is f0 = ((ior - 1) / (ior + 1))^2 (GpuMaterial optics.y).
+float iorFromF0(float f0) {
+    float r = sqrt(clamp(f0, 0.0, 0.98));
+    return (1.0 + r) / (1.0 - r);
+}
+
+// Whether a material bounds a volume (pathtrace/volume.glsl): transmission and a thicknessFactor > 0.
+bool materialBoundsVolume(GpuMaterial m) { return m.optics.x > 0.0 && m.optics.w > 0.0; }
+
 // Whether the rasteriser would cull what the ray hit: the back of a triangle whose material is single sided
 // (gbuffer.layered culls those; the BVH reports both sides). The front is counter-clockwise in world space.
 bool pathCulled(BvhHit hit, vec3 direction) {
     GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
-    if (materials[ref.material].info.w != 0u) return false;
+    // A volume's back faces are where paths leave it: never culled.
+    if (materials[ref.material].info.w != 0u || materialBoundsVolume(materials[ref.material])) return false;
     GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];
     uint base = prim.firstIndex + 3u * ref.triangle;
     mat3 world = mat3(instances[hit.instance].world);
@@ -148,21 +163,15 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.dielectric = dielectricSpecular(0.04, materialSpecular(m, uv0, uv1, lod0));
 #ifdef PATHTRACE_SEE_THROUGH_SURFACE
     // As forward.transparent draws them: a mask's cut-off and a blend's alpha (the layers' alpha, not the vertex
-    // colour's), and for transmission the dielectric's F0 from KHR_materials_ior and the volume's Beer attenuation
-    // attenuationColor^(d / attenuationDistance) over d = |refracted direction x thickness x the instance's scale|.
+    // colour's), and for transmission the dielectric's F0 from KHR_materials_ior; KHR_materials_volume's boundary and
+    // the medium behind it.
     s.coverage = m.info.z == 1u ? (l.albedo.a < m.emissive.a ? 0.0 : 1.0) : m.info.z == 2u ? clamp(l.albedo.a, 0.0, 1.0) : 1.0;
     s.transmission = m.optics.x;
-    s.attenuation = vec3(1.0);
-    if (s.transmission > 0.0) {
-        s.dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, uv0, uv1, lod0));
-        float thickness = materialThickness(m, uv0, uv1, lod0);
-        if (thickness > 0.0 && m.volume.a > 0.0) {
-            vec3 modelScale = vec3(length(world[0]), length(world[1]), length(world[2]));
-            float r = sqrt(m.optics.y); // 1/ior = (1 - sqrt(F0)) / (1 + sqrt(F0))
-            vec3 refracted = normalize(refract(direction, N, (1.0 - r) / (1.0 + r)));
-            s.attenuation = pow(m.volume.rgb, vec3(length(refracted * thickness * modelScale) / m.volume.a));
-        }
-    }
+    s.boundary = materialBoundsVolume(m);
+    s.inside = s.boundary && backFace;
+    s.ior = iorFromF0(m.optics.y);
+    s.medium = m.volume;
+    if (s.transmission > 0.0) s.dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, uv0, uv1, lod0));
 #endif
     s.emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) s.emissive *= sampleRef(m.emissiveRef, uv0, uv1, lod0).rgb;

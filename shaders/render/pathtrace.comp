@@ -7,16 +7,19 @@
 // sky.env_cdf and combined with BRDF sampling by the power heuristic), emissive surfaces hit by BRDF
 // sampling. Russian roulette after the third surface; at most `max_bounces` surfaces reflect light.
 // With `transparent` (PATHTRACE_SEE_THROUGH) the BVH also holds forward.transparent's surfaces and light passes them
-// as it passes there: alpha coverage, and KHR_materials_transmission as thin-walled glass (straight on, tinted by the
-// base colour and KHR_materials_volume's attenuation), for paths and shadow rays alike.
+// as it passes there: alpha coverage and KHR_materials_transmission's thin-walled glass (straight on, tinted by the
+// base colour), for paths and shadow rays alike. KHR_materials_volume's glass (a thicknessFactor > 0) is a closed
+// volume that paths refract into and out of, paying Beer's law on the way through (pathtrace/volume.glsl). The sky's
+// shadow rays stop at it (paths find that light); the sun's pass it straight on (shadowTransmittance).
 #define VITRINE_BVH_SET 1
 #define VITRINE_SCENE_SET 2
 #define VITRINE_GEOMETRY_SET 3
 #define VITRINE_SCENE_TEXEL_POOL // one buffer for all textures: no walk over the sampler array per sample
 #include "render/pathtrace.h"
-#define PATHTRACE_SEE_THROUGH_SURFACE // PathSurface's coverage, transmission and attenuation
+#define PATHTRACE_SEE_THROUGH_SURFACE // PathSurface's coverage, transmission and volume boundary
 #include "pathtrace/sampling.glsl"
 #include "pathtrace/surface.glsl"
+#include "pathtrace/volume.glsl"
 #include "common/thin_transmission.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -46,54 +49,66 @@ vec3 dielectricLayers(PathSurface s, vec3 v, vec3 t) {
     return clearcoatLayer(t, s.coat.x, dot(s.coatNormal, v), vec3(0.0));
 }
 
-// KHR_materials_transmission's thin-walled dielectric (forward.transparent's `through`): what it does not reflect,
-// 1 - F(n.v), tinted by the base colour and the volume's attenuation, under its layers. Straight on: no refraction
-// offset, no blur by roughness.
+// KHR_materials_transmission's dielectric (forward.transparent's `through`): what it does not reflect, 1 - F(n.v),
+// tinted by the base colour, under its layers. A thin wall lets it pass straight on; a volume's boundary refracts it.
 vec3 dielectricThrough(PathSurface s, vec3 v) {
     float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
-    vec3 t = (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
+    vec3 t = (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, NoV)) * s.baseColor;
     return dielectricLayers(s, v, t);
 }
 
 // What passes surface s seen along -v on a shadow ray: its uncovered share, plus where it is covered the transmissive
-// dielectric's share (1 - metallic) transmission of dielectricThrough. 0 for an opaque surface.
-vec3 pathPassing(PathSurface s, vec3 v) {
+// dielectric's share (1 - metallic) transmission of dielectricThrough. Nothing more for an opaque surface, nor for a
+// volume's boundary unless throughVolumes: see shadowTransmittance. From inside a volume, the way out of it:
+// 1 - F(n.v) and Beer's law over the `inside` metres the ray crossed in it.
+vec3 pathPassing(PathSurface s, vec3 v, bool throughVolumes, float inside) {
+    if (s.boundary && !throughVolumes) return vec3(0.0);
+    if (s.inside) {
+        vec3 beer = s.medium.a > 0.0 ? pow(s.medium.rgb, vec3(inside / s.medium.a)) : vec3(1.0);
+        return (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, clamp(dot(s.normal, v), 0.0, 1.0))) * beer;
+    }
     vec3 through = s.transmission > 0.0 ? s.transmission * (1.0 - s.metallic) * dielectricThrough(s, v) : vec3(0.0);
     return vec3(1.0 - s.coverage) + s.coverage * through;
 }
 
 // The light a shadow ray from origin along dir brings through what lies in its way: 0 behind anything opaque (either
 // side, as shadow.directional draws both); with seeThrough the product of pathPassing over every surface it crosses.
-vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough) {
+// A volume's boundary stops the ray unless throughVolumes. The sun's rays pass volumes straight on: the sun through
+// glass is a caustic, which neither a path (the sun is a delta light) nor next-event estimation can find, so its
+// light is spread flat over the shadow with the transmittance of the straight chord, instead of being lost. The sky's
+// rays stop there: paths refracted through the volume find that light.
+vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough, bool throughVolumes) {
     if (!seeThrough) return bvhTraceAny(origin, dir, 0.0, kInfinity) ? vec3(0.0) : vec3(1.0);
     vec3 T = vec3(1.0);
-    float tmin = 0.0;
+    float tmin = 0.0, entered = 0.0; // where the ray entered the volume it is in (0: it starts inside one)
     for (uint i = 0u; i < PATHTRACE_MAX_PASSES; ++i) {
         BvhHit hit;
         if (!bvhTraceClosest(origin, dir, tmin, kInfinity, hit)) return T;
-        T *= pathPassing(pathSurface(hit, origin, dir), -dir);
+        PathSurface s = pathSurface(hit, origin, dir);
+        T *= pathPassing(s, -dir, throughVolumes, hit.t - entered);
         if (max(max(T.r, T.g), T.b) <= 0.0) return vec3(0.0);
+        if (s.boundary && !s.inside) entered = hit.t;
         tmin = hit.t;
     }
     return vec3(0.0);
 }
 
 // The sun behind a thin-walled transmissive dielectric, scattered towards v by its rough surface
-// (common/thin_transmission.glsl, as forward.transparent draws it), tinted by the base colour and the volume's
-// attenuation under the sheen's scaling and the coat, and shadowed from the far side. The path itself passes such a
-// surface straight on, so it never meets the sun (a delta light) through it: this is the only way that light
-// arrives. 0 with the sun on v's side.
+// (common/thin_transmission.glsl, as forward.transparent draws it), tinted by the base colour under the sheen's
+// scaling and the coat, and shadowed from the far side. The path itself passes such a surface straight on, so it
+// never meets the sun (a delta light) through it: this is the only way that light arrives. 0 with the sun on v's
+// side, and for a volume's boundary (the sun reaches what lies behind a volume through shadowTransmittance).
 vec3 sunThroughTransmission(PathSurface s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough) {
-    if (dot(s.geometricNormal, sunDir) >= 0.0) return vec3(0.0);
+    if (s.boundary || dot(s.geometricNormal, sunDir) >= 0.0) return vec3(0.0);
     vec3 f = thinTransmissionCosine(s.normal, v, sunDir, s.dielectric.rgb, s.dielectric.a, s.roughness);
     if (!any(greaterThan(f, vec3(0.0)))) return vec3(0.0);
-    vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
-    return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough);
+    vec3 t = dielectricLayers(s, v, s.baseColor * f);
+    return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true);
 }
 
 // KHR_materials_transmission as the glTF spec mixes it, one component drawn per surface: the metal (probability
 // metallic), the opaque dielectric ((1 - metallic)(1 - transmission)) and the transmissive one ((1 - metallic)
-// transmission), whose reflection is its specular alone and which lets dielectricThrough pass straight on. Each is
+// transmission), whose reflection is its specular alone and which lets dielectricThrough pass. Each is
 // drawn with its own probability and weighted 1, so the estimate is the mixture's. Inside the transmissive one,
 // passing is chosen in proportion to what passes against what is reflected (clamped to [0.05, 0.95]) and weighted by
 // its inverse. True when the path passes (throughput scaled); else s is the drawn component's reflecting surface.
@@ -123,19 +138,46 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     bool seeThrough = (push.counts.w & PATHTRACE_SEE_THROUGH) != 0u;
 
     vec3 radiance = vec3(0.0), throughput = vec3(1.0);
-    float brdfPdfPrev = 0.0; // density of the last BRDF-sampled direction (0: a camera ray)
+    // Density of the last BRDF-sampled direction; 0 for a camera ray and after a volume's boundary, where the sky's
+    // own sampling cannot reach (shadow rays stop there), so what the path finds counts in full.
+    float brdfPdfPrev = 0.0;
     uint maxBounces = push.counts.y;
     uint passes = 0u; // surfaces passed through (not bounces)
+    bool inVolume = false;  // the path is inside a volume (pathtrace/volume.glsl) ...
+    vec4 medium = vec4(0.0); // ... of this attenuationColor (rgb) and attenuationDistance (a; 0: no attenuation)
     for (uint bounce = 0u;;) {
         BvhHit hit;
-        if (!pathTraceVisible(origin, dir, hit)) {
-            float w = bounce == 0u || !envSampling ? 1.0 : powerHeuristic(brdfPdfPrev, envPdf(in_env_cdf, envSize, dir));
+        bool found = pathTraceVisible(origin, dir, hit);
+        // Beer's law over the way inside a volume. A path that leaves the scene from inside one (an open mesh) keeps
+        // nothing of an absorbing medium.
+        if (inVolume && medium.a > 0.0) {
+            if (!found) break;
+            throughput *= pow(medium.rgb, vec3(hit.t / medium.a));
+        }
+        if (!found) {
+            float w = brdfPdfPrev <= 0.0 || !envSampling ? 1.0 : powerHeuristic(brdfPdfPrev, envPdf(in_env_cdf, envSize, dir));
             radiance += throughput * skyRadiance(dir) * w;
             break;
         }
         PathSurface s = pathSurface(hit, origin, dir);
+        if (seeThrough && s.inside) { // a volume's boundary from inside: out through it, or back in by Fresnel
+            if (++passes > PATHTRACE_MAX_PASSES) break;
+            vec3 l, w;
+            bool across;
+            if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, s.ior, true,
+                               vec3(rngNext(rng), rngNext2(rng)), l, w, across))
+                break;
+            throughput *= w;
+            inVolume = !across;
+            medium = s.medium;
+            brdfPdfPrev = 0.0;
+            origin = offsetRay(s.position, s.geometricNormal, l);
+            dir = l;
+            continue;
+        }
         // Alpha coverage: the uncovered share lets the path on, untouched (an alpha mask's cut-away part always).
         bool pass = seeThrough && s.coverage < 1.0 && rngNext(rng) >= s.coverage;
+        bool refracts = false; // passes into a volume
         if (!pass) {
             // Emitters are not sampled as lights: what BRDF sampling finds counts in full.
             radiance += throughput * s.emissive * push.scales.z;
@@ -146,10 +188,23 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
                     radiance += throughput * (s.transmission * (1.0 - s.metallic)) *
                                 sunThroughTransmission(s, -dir, sunDir, sunE, seeThrough);
                 pass = drawTransmission(s, -dir, throughput, rng);
+                refracts = pass && s.boundary;
             }
         }
-        if (pass) { // straight on from the far side; the direction's density (for MIS at the sky) is unchanged
+        if (pass) {
             if (++passes > PATHTRACE_MAX_PASSES) break;
+            if (refracts) { // into the volume, through one of the boundary's microfacets
+                vec3 l, w;
+                bool across;
+                if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, 1.0 / s.ior, false,
+                                   vec3(rngNext(rng), rngNext2(rng)), l, w, across))
+                    break;
+                throughput *= w;
+                inVolume = true;
+                medium = s.medium;
+                brdfPdfPrev = 0.0;
+                dir = l;
+            } // else straight on from the far side: the direction's density (for MIS at the sky) is unchanged
             origin = offsetRay(s.position, s.geometricNormal, dir);
             continue;
         }
@@ -168,7 +223,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
             vec3 f = brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
             if (any(greaterThan(f, vec3(0.0))))
-                radiance += weight * f * sunE * shadowTransmittance(offsetRay(s.position, ng, sunDir), sunDir, seeThrough);
+                radiance += weight * f * sunE * shadowTransmittance(offsetRay(s.position, ng, sunDir), sunDir, seeThrough, true);
         }
         // Sky: a direction from its luminance table, weighted against BRDF sampling (power heuristic).
         if (envSampling) {
@@ -178,7 +233,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
                 vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
                 if (any(greaterThan(f, vec3(0.0))))
-                    radiance += weight * f * skyRadiance(l) * shadowTransmittance(offsetRay(s.position, ng, l), l, seeThrough) *
+                    radiance += weight * f * skyRadiance(l) * shadowTransmittance(offsetRay(s.position, ng, l), l, seeThrough, false) *
                                 powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
         }
