@@ -1152,18 +1152,13 @@ PATHTRACE_TEST(CoatAndSheenOverGlassLayerWhatPassesToo) {
     EXPECT_LT(errSheen, 0.02);
 }
 
-// A closed box of half extents `half` whose triangles wind counter-clockwise seen from outside (the path tracer's
-// front faces), with outward normals.
+// A closed box of half extents `half` whose triangles all wind counter-clockwise seen from outside (the path tracer's
+// front faces): lighting_scene's boxTris, whose three faces on the negative axes wind inwards, turned.
 std::vector<Tri> closedBox(glm::vec3 half) {
-    std::vector<Tri> tris;
-    for (int axis = 0; axis < 3; ++axis)
-        for (float sign : {-1.0f, 1.0f}) {
-            glm::vec3 n(0.0f), u(0.0f), v(0.0f);
-            n[axis] = sign;
-            u[(axis + 1) % 3] = half[(axis + 1) % 3];
-            v[(axis + 2) % 3] = sign * half[(axis + 2) % 3]; // u x v along n
-            addQuad(tris, n * half[axis], u, v, n);
-        }
+    std::vector<Tri> tris = boxTris(half);
+    for (Tri& t : tris)
+        if (glm::dot(glm::cross(t.b.position - t.a.position, t.c.position - t.a.position), t.a.normal) < 0.0f)
+            std::swap(t.b, t.c);
     return tris;
 }
 
