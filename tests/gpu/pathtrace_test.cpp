@@ -1068,6 +1068,18 @@ double meanRatioError(const Image& traced, const std::vector<std::pair<glm::ivec
     return std::max({std::abs(mean.r - 1.0), std::abs(mean.g - 1.0), std::abs(mean.b - 1.0)});
 }
 
+// What each pixel of a traced SunlitGround of grey 0.5 (roughness 1) shows when the sun reaches it through a
+// transmittance `through`: core/shading's sun radiance (shadeDirectional, intensity E / pi) times it.
+std::vector<std::pair<glm::ivec2, glm::dvec3>> sunOnGreyGround(const SunlitGround& g, glm::dvec3 through) {
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    for (const auto& [px, d] : g.pixels)
+        expected.push_back(
+            {px, glm::dvec3(shading::shadeDirectional(glm::vec3(0, 1, 0), glm::vec3(-d), glm::vec3(g.toSun),
+                                                      glm::vec3(0.5f), 0.0f, 1.0f, glm::vec3(g.sunE / kPi))) *
+                     through});
+    return expected;
+}
+
 // KHR_materials_transmission: smooth (shininess 1) tinted glass panes of base colour c under a uniform sky C. On the
 // left, transmission 1: its specular reflects C F(NoV) (Schlick, F0 0.04 from the IOR 1.5: the uniform sky through a
 // mirror lobe, see the top of the file) and it lets (1 - F(NoV)) c of the sky behind pass, so every pixel is
@@ -1428,13 +1440,7 @@ PATHTRACE_TEST(SunPassesAVolumeStraightOnByFresnelAndBeersLaw) {
     const double F = schlick(0.04, g.toSun.y);
     const glm::dvec3 through =
         (1.0 - F) * (1.0 - F) * glm::pow(glm::dvec3(a), glm::dvec3(thickness / g.toSun.y / distance));
-    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
-    for (const auto& [px, d] : g.pixels)
-        expected.push_back(
-            {px, glm::dvec3(shading::shadeDirectional(glm::vec3(0, 1, 0), glm::vec3(-d), glm::vec3(g.toSun),
-                                                      glm::vec3(0.5f), 0.0f, 1.0f, glm::vec3(g.sunE / kPi))) *
-                     through});
-    const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
+    const auto [checked, worst] = expectPixels(g.out.at("pt"), sunOnGreyGround(g, through), 0.01);
     std::printf("%s tracer, the sun through a volume's roof: %d pixels, worst relative error %.4f\n", gBackend, checked,
                 worst);
     EXPECT_GE(checked, 300);
@@ -1568,17 +1574,33 @@ PATHTRACE_TEST(SunThroughAGlassRoofIsTintedByItsTransmittance) {
         const glm::dvec3 through = transparent ? (1.0 - alpha) + alpha * transmission * (1.0 - metallic) *
                                                                      (1.0 - schlick(0.04, g.toSun.y)) * glm::dvec3(c)
                                                : glm::dvec3(1.0);
-        std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
-        for (const auto& [px, d] : g.pixels)
-            expected.push_back(
-                {px, glm::dvec3(shading::shadeDirectional(glm::vec3(0, 1, 0), glm::vec3(-d), glm::vec3(g.toSun),
-                                                          glm::vec3(0.5f), 0.0f, 1.0f, glm::vec3(g.sunE / kPi))) *
-                         through});
-        const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
+        const auto [checked, worst] = expectPixels(g.out.at("pt"), sunOnGreyGround(g, through), 0.01);
         std::printf("%s tracer, sun through a glass roof (transparent %d): %d pixels, worst relative error %.4f\n",
                     gBackend, transparent ? 1 : 0, checked, worst);
         EXPECT_GE(checked, 300);
     }
+}
+
+// The backlit scenes below: the camera at the origin looking at (0.2, 0.1, -3), the sun behind what it sees (towards
+// (0.15, 0.35, -1)), no sky, one bounce, no antialiasing. Returns the traced image, the direction to the sun and its
+// illuminance times sunScale.
+struct Backlit {
+    std::map<std::string, Image> out;
+    glm::dvec3 toSun, sunE;
+};
+Backlit traceBacklit(SceneBuilder& b, int spp, int W, int H, double sunScale) {
+    b.camera({0.0f, 0.0f, 0.0f}, {0.2f, 0.1f, -3.0f}, 0.8f);
+    b.sun({0.15f, 0.35f, -1.0f});
+    auto glb = b.write();
+    json nodes = baseNodes(glb);
+    nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
+    nodes["pt"] = pathtraceNode(
+        {{"spp", spp}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
+    Backlit r;
+    r.out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
+    r.toSun = glm::normalize(rgb(r.out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
+    r.sunE = rgb(r.out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    return r;
 }
 
 // The sun behind rough thin glass, seen through it: panes of roughness 0.6 (tinted c, IOR 1.5) facing the camera,
@@ -1608,16 +1630,7 @@ PATHTRACE_TEST(SunBehindRoughGlassShinesThroughItsTransmissionLobe) {
     b.node("right", static_cast<int32_t>(b.mesh("right", right, mixed)), glm::vec3(0, 0, -3));
     b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, b.material("wall", glm::vec3(0.5f), 0.0f, 0.0f))),
            glm::vec3(0, 0, -6));
-    b.camera({0.0f, 0.0f, 0.0f}, {0.2f, 0.1f, -3.0f}, 0.8f);
-    b.sun({0.15f, 0.35f, -1.0f});
-    auto glb = b.write();
-    json nodes = baseNodes(glb);
-    nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
-    nodes["pt"] = pathtraceNode(
-        {{"spp", 1}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
-    auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
-    const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const auto [out, toSun, sunE] = traceBacklit(b, 1, W, H, sunScale);
     const float alpha = shading::ggxAlpha(shading::roughnessFromShininess(shininess));
     const glm::dvec3 n(0.0, 0.0, 1.0);
     Pinhole cam(b.s, W, H);
@@ -1669,16 +1682,7 @@ PATHTRACE_TEST(SunBehindARoughVolumeAddsNoThinWalledLobe) {
     const uint32_t glass = volumeGlass(b, "glass", shininess);
     b.node("box", static_cast<int32_t>(b.mesh("box", closedBox(glm::vec3(2.0f, 2.0f, 0.15f)), glass)),
            glm::vec3(0.0f, 0.0f, -3.15f));
-    b.camera({0.0f, 0.0f, 0.0f}, {0.2f, 0.1f, -3.0f}, 0.8f);
-    b.sun({0.15f, 0.35f, -1.0f});
-    auto glb = b.write();
-    json nodes = baseNodes(glb);
-    nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
-    nodes["pt"] = pathtraceNode(
-        {{"spp", 4}, {"max_bounces", 1}, {"sky_scale", 0.0}, {"sun_scale", sunScale}, {"antialias", false}});
-    auto out = runGraph(graph(nodes, {{"pt", "pt.color"}, {"sh", "sky.sh"}}, W, H));
-    const glm::dvec3 toSun = glm::normalize(rgb(out.at("sh"), SKY_TEXEL_SUN_DIRECTION, 0));
-    const glm::dvec3 sunE = rgb(out.at("sh"), SKY_TEXEL_SUN_ILLUMINANCE, 0) * sunScale;
+    const auto [out, toSun, sunE] = traceBacklit(b, 4, W, H, sunScale);
     const float alpha = shading::ggxAlpha(shading::roughnessFromShininess(shininess));
     Pinhole cam(b.s, W, H);
     double lobe = 0.0, brightest = 0.0;
