@@ -1,5 +1,7 @@
 #include "core/accel/scene_bvh.hpp"
 
+#include "core/scene/closed_mesh.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -31,13 +33,24 @@ void gather(const scene::Scene& scene, uint32_t mesh, const glm::mat4& world, bo
 
 } // namespace
 
+std::vector<GpuBvhPrimitive> SceneBvh::primitivesOf(const scene::Scene& scene) {
+    const std::vector<uint8_t> openVolume = scene::openVolumePrimitives(scene);
+    std::vector<GpuBvhPrimitive> out;
+    out.reserve(scene.primitives.size());
+    for (size_t i = 0; i < scene.primitives.size(); ++i) {
+        const scene::Primitive& p = scene.primitives[i];
+        out.push_back(
+            {p.firstIndex, p.indexCount, p.vertexOffset, openVolume[i] ? VITRINE_BVH_PRIMITIVE_OPEN_VOLUME : 0u});
+    }
+    return out;
+}
+
 SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     SceneBvh bvh;
     bvh.mSceneHash = scene.contentHash();
     bvh.mOptions = options;
-    for (const scene::Primitive& p : scene.primitives)
-        bvh.mPrimitives.push_back({p.firstIndex, p.indexCount, p.vertexOffset, p.material});
+    bvh.mPrimitives = primitivesOf(scene);
 
     std::vector<BvhBuildTriangle> triangles;
     for (uint32_t i = 0; i < scene.instances.size(); ++i) {

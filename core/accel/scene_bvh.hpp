@@ -33,7 +33,8 @@ inline glm::vec3 transformPoint(const glm::mat4& m, const glm::vec3& p) {
 class SceneBvh {
 public:
     // Bumped whenever the builder or the byte format changes, so caches of older builds are not used.
-    static constexpr uint32_t kVersion = 3; // 2: transparent primitives left out; 3: unless options.transparent
+    static constexpr uint32_t kVersion = 4; // 2: transparent primitives left out; 3: unless options.transparent;
+                                            // 4: GpuBvhPrimitive::flags
 
     static SceneBvh build(const scene::Scene& scene, const BvhBuildOptions& options = {});
 
@@ -68,6 +69,10 @@ public:
     double buildMs() const { return mBuildMs; } // 0 when loaded
 
 private:
+    // One GpuBvhPrimitive per scene primitive. Its flags come from core/scene/closed_mesh.hpp, whose rules are not part
+    // of the cache key: loadOrBuild() takes them from here, not from the cache.
+    static std::vector<GpuBvhPrimitive> primitivesOf(const scene::Scene& scene);
+
     BvhArrays mArrays;
     std::vector<GpuBvhPrimitive> mPrimitives;
     std::vector<BvhBottomLevel> mLevels;

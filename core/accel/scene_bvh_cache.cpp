@@ -123,6 +123,7 @@ SceneBvh SceneBvh::loadOrBuild(const scene::Scene& scene, const BakeCache& cache
         if (std::optional<SceneBvh> bvh = deserialize(*bytes);
             bvh && bvh->mSceneHash == scene.contentHash() && bvh->mOptions == options) {
             st.fromCache = true;
+            bvh->mPrimitives = primitivesOf(scene);
             return std::move(*bvh);
         }
     }

@@ -1,8 +1,10 @@
 // glTF meshes → the scene's flat vertex/index arrays and primitive ranges.
 
+#include "core/scene/closed_mesh.hpp"
 #include "core/scene/gltf_detail.hpp"
 #include "core/scene/tangents.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -252,6 +254,29 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     scene.primitives.push_back(prim);
 }
 
+// KHR_materials_volume on faces that bound nothing (core/scene/closed_mesh.hpp): one warning per material of the mesh.
+void warnOpenVolumes(LoadContext& ctx, const Mesh& mesh, const std::vector<std::string>& elements) {
+    const Scene& scene = *ctx.scene;
+    std::vector<uint32_t> warned;
+    for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+        const uint32_t material = scene.primitives[mesh.firstPrimitive + k].material;
+        if (!boundsVolume(scene.materials[material]) ||
+            std::find(warned.begin(), warned.end(), material) != warned.end())
+            continue;
+        warned.push_back(material);
+        std::vector<uint32_t> faces;
+        for (uint32_t q = mesh.firstPrimitive; q < mesh.firstPrimitive + mesh.primitiveCount; ++q)
+            if (scene.primitives[q].material == material) faces.push_back(q);
+        if (trianglesClosed(scene, faces)) continue;
+        const std::string& name = scene.materials[material].name;
+        ctx.warn(elements[k], "materials[" + std::to_string(material) + "]" +
+                                  (name.empty() ? "" : " ('" + name + "')") +
+                                  " has KHR_materials_volume (thicknessFactor > 0), which needs a closed mesh, but "
+                                  "this mesh's faces of that material leave edges open; render.pathtrace traces them "
+                                  "as thin-walled glass tinted over the thickness, as the rasteriser draws them");
+    }
+}
+
 } // namespace
 
 void loadMeshes(LoadContext& ctx) {
@@ -284,14 +309,18 @@ void loadMeshes(LoadContext& ctx) {
         mesh.weights.assign(targets, 0.0f);
         for (size_t k = 0; k < w.size(); ++k)
             mesh.weights[k] = static_cast<float>(w[k]);
+        std::vector<std::string> elements; // of the primitives loaded (points and lines are skipped)
         for (size_t j = 0; j < model.meshes[i].primitives.size(); ++j) {
             std::string e = "meshes[" + std::to_string(i) + "].primitives[" + std::to_string(j) + "]";
             int indexAccessor = static_cast<int>(integer(ctx, primsJson[j], "indices", -1, e));
             int material = variantMaterial(ctx, primsJson[j], model.meshes[i].primitives[j].material, e);
+            const size_t before = ctx.scene->primitives.size();
             loadPrimitive(ctx, model.meshes[i].primitives[j], indexAccessor, mesh.weights, material, e);
+            if (ctx.scene->primitives.size() > before) elements.push_back(e);
         }
         mesh.primitiveCount = static_cast<uint32_t>(ctx.scene->primitives.size()) - mesh.firstPrimitive;
         ctx.scene->meshes.push_back(mesh);
+        warnOpenVolumes(ctx, ctx.scene->meshes.back(), elements);
     }
 }
 

@@ -4,6 +4,7 @@
 #include "nodes/render/pathtrace_cpu.hpp"
 
 #include "core/base/error.hpp"
+#include "core/scene/closed_mesh.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "core/shading/brdf.hpp"
 #include "shaders/render/pathtrace.h"
@@ -579,6 +580,7 @@ struct CpuPathTracer::Impl {
     std::vector<glm::mat3> normalMatrix;
     Materials materials;
     std::vector<TriangleRef> refs;
+    std::vector<uint8_t> openVolume;       // per scene primitive: scene::openVolumePrimitives
     std::vector<glm::vec3> worldPositions; // 3 per triangle (the shading's geometric normal uses world positions)
     RTCDevice device = nullptr;
     RTCScene rtc = nullptr;
@@ -588,6 +590,7 @@ struct CpuPathTracer::Impl {
         : scene(s), world(instanceWorld) {
         packMaterials(s, materials.materials, materials.layers);
         materials.pool = packTexelPool(s);
+        openVolume = scene::openVolumePrimitives(s);
         device = rtcNewDevice("threads=1"); // our own threads call into it; its builder uses one
         if (!device) throw InternalError("render.pathtrace: Embree could not create a device");
         for (size_t i = 0; i < s.instances.size(); ++i) {
@@ -714,7 +717,8 @@ struct CpuPathTracer::Impl {
     // volume's boundary refracted).
     static vec3 dielectricThrough(const PathSurface& s, vec3 v) {
         float NoV = std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f);
-        vec3 t = (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, NoV)) * s.baseColor;
+        vec3 t =
+            (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
         return dielectricLayers(s, v, t);
     }
 
@@ -762,7 +766,7 @@ struct CpuPathTracer::Impl {
         if (s.boundary || glm::dot(s.geometricNormal, sunDir) >= 0.0f) return vec3(0.0f);
         vec3 f = thinTransmissionCosine(s.normal, v, sunDir, vec3(s.dielectric), s.dielectric.a, s.roughness);
         if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return vec3(0.0f);
-        vec3 t = dielectricLayers(s, v, s.baseColor * f);
+        vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
         return t * sunE *
                shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true, rays);
     }
@@ -787,13 +791,17 @@ struct CpuPathTracer::Impl {
     }
 
     // surface.glsl's materialBoundsVolume.
-    static bool boundsVolume(const GpuMaterial& m) { return m.optics.x > 0.0f && m.optics.w > 0.0f; }
+    static bool materialBoundsVolume(const GpuMaterial& m) { return m.optics.x > 0.0f && m.optics.w > 0.0f; }
+    // surface.glsl's boundsVolume: the material bounds a volume and the primitive's faces of it are closed.
+    bool boundsVolume(const GpuMaterial& m, uint32_t primitive) const {
+        return materialBoundsVolume(m) && !openVolume[primitive];
+    }
 
     // pathCulled: the back of a single-sided material's triangle, which the rasteriser culls (never a volume's).
     bool culled(const Hit& hit, vec3 direction) const {
         const TriangleRef& ref = refs[hit.triangle];
         const GpuMaterial& m = materials.materials[ref.material];
-        if (m.info.w != 0u || boundsVolume(m)) return false;
+        if (m.info.w != 0u || boundsVolume(m, ref.primitive)) return false;
         const vec3* p = &worldPositions[3 * static_cast<size_t>(hit.triangle)];
         return glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), direction) > 0.0f;
     }
@@ -898,11 +906,17 @@ struct CpuPathTracer::Impl {
                      : m.info.z == 2u ? std::clamp(l.albedo.a, 0.0f, 1.0f)
                                       : 1.0f;
         s.transmission = m.optics.x;
-        s.boundary = boundsVolume(m);
+        s.boundary = boundsVolume(m, ref.primitive);
         s.inside = s.boundary && backFace;
         const float r = std::sqrt(std::clamp(m.optics.y, 0.0f, 0.98f)); // surface.glsl iorFromF0
         s.ior = (1.0f + r) / (1.0f - r);
         s.medium = m.volume;
+        if (materialBoundsVolume(m) && !s.boundary && m.volume.a > 0.0f) { // faces that bound nothing: thin-walled
+            const vec3 modelScale(glm::length(w[0]), glm::length(w[1]), glm::length(w[2]));
+            const vec3 crossing = glm::normalize(glm::refract(direction, N, 1.0f / s.ior)) *
+                                  materials.materialThickness(m, uv0, uv1) * modelScale;
+            s.attenuation = glm::pow(vec3(m.volume), vec3(glm::length(crossing) / m.volume.a));
+        }
         if (s.transmission > 0.0f)
             s.dielectric = dielectricSpecular(m.optics.y, materials.materialSpecular(m, uv0, uv1));
         s.emissive = vec3(m.emissive);

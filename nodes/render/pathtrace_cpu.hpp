@@ -84,6 +84,9 @@ struct CpuSurface {
     bool boundary = false, inside = false;
     float ior = 1.5f;
     glm::vec4 medium{1.0f, 1.0f, 1.0f, 0.0f};
+    // What thin-walled glass lets through is tinted by: 1, but for a KHR_materials_volume on faces that bound nothing
+    // (scene::openVolumePrimitives) Beer's law over the refracted path through its thickness, as forward.transparent.
+    glm::vec3 attenuation{1.0f};
 };
 
 class CpuPathTracer;

@@ -53,8 +53,12 @@ struct GpuBvhPrimitive {
     uint firstIndex;
     uint indexCount;
     uint vertexOffset;
-    uint material;
+    uint flags; // VITRINE_BVH_PRIMITIVE_* bits
 };
+
+// GpuBvhPrimitive::flags: its material bounds a KHR_materials_volume but its mesh's faces of that material are not
+// closed (core/scene/closed_mesh.hpp), so the tracers take it for thin-walled glass, as the rasteriser draws it.
+#define VITRINE_BVH_PRIMITIVE_OPEN_VOLUME 1u
 
 // One entry of the top level, written every frame (GpuBvh::update).
 struct GpuBvhInstance {

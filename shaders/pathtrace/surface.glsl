@@ -42,6 +42,10 @@ struct PathSurface {
     bool inside; // the boundary seen from inside its volume (its back face)
     float ior;   // KHR_materials_ior of a transmissive surface
     vec4 medium; // the volume's attenuationColor (rgb) and attenuationDistance (a; 0: no attenuation)
+    // What thin-walled glass lets through is tinted by: 1, but for a KHR_materials_volume on faces that bound nothing
+    // (VITRINE_BVH_PRIMITIVE_OPEN_VOLUME) Beer's law over the refracted path through its thickness, as
+    // forward.transparent tints it.
+    vec3 attenuation;
 #endif
 };
 
@@ -67,13 +71,19 @@ float iorFromF0(float f0) {
 // Whether a material bounds a volume (pathtrace/volume.glsl): transmission and a thicknessFactor > 0.
 bool materialBoundsVolume(GpuMaterial m) { return m.optics.x > 0.0 && m.optics.w > 0.0; }
 
+// Whether a triangle bounds a volume: its material does and its mesh's faces of that material are closed (a volume
+// material on faces that bound nothing is thin-walled glass: core/scene/closed_mesh.hpp).
+bool boundsVolume(GpuMaterial m, GpuBvhPrimitive prim) {
+    return materialBoundsVolume(m) && (prim.flags & VITRINE_BVH_PRIMITIVE_OPEN_VOLUME) == 0u;
+}
+
 // Whether the rasteriser would cull what the ray hit: the back of a triangle whose material is single sided
 // (gbuffer.layered culls those; the BVH reports both sides). The front is counter-clockwise in world space.
 bool pathCulled(BvhHit hit, vec3 direction) {
     GpuBvhTriangleRef ref = bvhRefs[hit.triangle];
-    // A volume's back faces are where paths leave it: never culled.
-    if (materials[ref.material].info.w != 0u || materialBoundsVolume(materials[ref.material])) return false;
     GpuBvhPrimitive prim = bvhPrimitives[ref.primitive];
+    // A volume's back faces are where paths leave it: never culled.
+    if (materials[ref.material].info.w != 0u || boundsVolume(materials[ref.material], prim)) return false;
     uint base = prim.firstIndex + 3u * ref.triangle;
     mat3 world = mat3(instances[hit.instance].world);
     vec3 p0 = world * vertexVec3(sceneIndices[base] + prim.vertexOffset, 0u);
@@ -167,10 +177,16 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     // the medium behind it.
     s.coverage = m.info.z == 1u ? (l.albedo.a < m.emissive.a ? 0.0 : 1.0) : m.info.z == 2u ? clamp(l.albedo.a, 0.0, 1.0) : 1.0;
     s.transmission = m.optics.x;
-    s.boundary = materialBoundsVolume(m);
+    s.boundary = boundsVolume(m, prim);
     s.inside = s.boundary && backFace;
     s.ior = iorFromF0(m.optics.y);
     s.medium = m.volume;
+    s.attenuation = vec3(1.0);
+    if (materialBoundsVolume(m) && !s.boundary && m.volume.a > 0.0) {
+        vec3 modelScale = vec3(length(world[0]), length(world[1]), length(world[2]));
+        vec3 crossing = normalize(refract(direction, N, 1.0 / s.ior)) * materialThickness(m, uv0, uv1, lod0) * modelScale;
+        s.attenuation = pow(m.volume.rgb, vec3(length(crossing) / m.volume.a));
+    }
     if (s.transmission > 0.0) s.dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, uv0, uv1, lod0));
 #endif
     s.emissive = m.emissive.rgb;

@@ -53,7 +53,7 @@ vec3 dielectricLayers(PathSurface s, vec3 v, vec3 t) {
 // tinted by the base colour, under its layers. A thin wall lets it pass straight on; a volume's boundary refracts it.
 vec3 dielectricThrough(PathSurface s, vec3 v) {
     float NoV = clamp(dot(s.normal, v), 0.0, 1.0);
-    vec3 t = (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, NoV)) * s.baseColor;
+    vec3 t = (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, NoV)) * s.baseColor * s.attenuation;
     return dielectricLayers(s, v, t);
 }
 
@@ -102,7 +102,7 @@ vec3 sunThroughTransmission(PathSurface s, vec3 v, vec3 sunDir, vec3 sunE, bool 
     if (s.boundary || dot(s.geometricNormal, sunDir) >= 0.0) return vec3(0.0);
     vec3 f = thinTransmissionCosine(s.normal, v, sunDir, s.dielectric.rgb, s.dielectric.a, s.roughness);
     if (!any(greaterThan(f, vec3(0.0)))) return vec3(0.0);
-    vec3 t = dielectricLayers(s, v, s.baseColor * f);
+    vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
     return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true);
 }
 

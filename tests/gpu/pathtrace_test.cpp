@@ -1703,5 +1703,76 @@ PATHTRACE_TEST(SunBehindARoughVolumeAddsNoThinWalledLobe) {
     EXPECT_LT(brightest, 1e-6 * lobe);
 }
 
+// KHR_materials_volume on faces that bound nothing (core/scene/closed_mesh.hpp): traceSunlitGround's ground under a
+// roof that is a single quad of smooth glass of base colour c = (1, 0.8, 0.6), thicknessFactor 0.2 drawn at scale 2,
+// attenuationColor a = (0.25, 0.5, 1), attenuationDistance 0.5, the sun 60° up, no sky. A quad refracted into as a
+// volume is never left; the tracers take it for thin-walled glass tinted as forward.transparent tints it (the Sample
+// Viewer's approximation): the ground's sun radiance (shadeDirectional) times (1 - F) c a^(0.2 x 2 / 0.5) per channel,
+// F = Schlick(0.04, sin 60°) once, Beer's law over the thickness times the node's scale (the Sample Viewer's
+// transmission ray is the unit refracted direction times both, so not the slant). Deterministic: 1 % per pixel.
+PATHTRACE_TEST(SunThroughAnOpenVolumeRoofIsThinGlassTintedOverItsThickness) {
+    const glm::vec3 c(1.0f, 0.8f, 0.6f), a(0.25f, 0.5f, 1.0f);
+    const double thickness = 0.2, scale = 2.0, distance = 0.5;
+    const SunlitGround g = traceSunlitGround(
+        "pt_open_volume_roof", 48, 48,
+        [&](SceneBuilder& b) {
+            const uint32_t glass = b.material("glass", c, 0.0f, 1.0f);
+            b.s.materials[glass].transmission = 1.0f;
+            b.s.materials[glass].thickness = static_cast<float>(thickness);
+            b.s.materials[glass].attenuationColor = a;
+            b.s.materials[glass].attenuationDistance = static_cast<float>(distance);
+            std::vector<Tri> roof;
+            addQuad(roof, glm::vec3(0.0f), glm::vec3(60, 0, 0), glm::vec3(0, 0, 60), glm::vec3(0, 1, 0));
+            b.node("roof", static_cast<int32_t>(b.mesh("roof", roof, glass)), glm::vec3(0.0f, 3.0f, 0.0f));
+            b.s.nodes.back().local.scale = glm::vec3(static_cast<float>(scale));
+            return b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f);
+        },
+        json::object(), 60.0);
+    const glm::dvec3 through = (1.0 - schlick(0.04, g.toSun.y)) * glm::dvec3(c) *
+                               glm::pow(glm::dvec3(a), glm::dvec3(thickness * scale / distance));
+    const auto [checked, worst] = expectPixels(g.out.at("pt"), sunOnGreyGround(g, through), 0.01);
+    std::printf("%s tracer, the sun through an open volume's roof: %d pixels, worst relative error %.4f\n", gBackend,
+                checked, worst);
+    EXPECT_GE(checked, 300);
+}
+
+// The sun behind rough glass whose volume is not closed: traceBacklit's scene with one pane, a single quad 4 m wide
+// 3 m in front of the camera, of roughness 0.6, base colour c, thicknessFactor 0.3, attenuationColor a and
+// attenuationDistance 0.5. As thin-walled glass it shows the sun scattered through its transmission lobe, as the
+// thin pane of SunBehindRoughGlassShinesThroughItsTransmissionLobe, tinted by a^(0.3 / 0.5) as well (a closed volume
+// of the same glass shows nothing there: SunBehindARoughVolumeAddsNoThinWalledLobe). Deterministic: 0.1 % per pixel.
+PATHTRACE_TEST(SunBehindAnOpenVolumePaneShinesThroughItsTintedLobe) {
+    const int W = 40, H = 30;
+    const glm::vec3 c(1.0f, 0.5f, 0.25f), a(0.25f, 0.5f, 1.0f);
+    const float shininess = 0.4f;
+    const double sunScale = 0.1, thickness = 0.3, distance = 0.5;
+    SceneBuilder b("pt_open_volume_backlit");
+    std::vector<Tri> pane;
+    addQuad(pane, glm::vec3(0.0f), glm::vec3(2, 0, 0), glm::vec3(0, 2, 0), glm::vec3(0, 0, 1));
+    const uint32_t glass = b.material("glass", c, 0.0f, shininess);
+    b.s.materials[glass].transmission = 1.0f;
+    b.s.materials[glass].thickness = static_cast<float>(thickness);
+    b.s.materials[glass].attenuationColor = a;
+    b.s.materials[glass].attenuationDistance = static_cast<float>(distance);
+    b.node("pane", static_cast<int32_t>(b.mesh("pane", pane, glass)), glm::vec3(0, 0, -3));
+    const auto [out, toSun, sunE] = traceBacklit(b, 1, W, H, sunScale);
+    const float alpha = shading::ggxAlpha(shading::roughnessFromShininess(shininess));
+    const glm::dvec3 tint = glm::dvec3(c) * glm::pow(glm::dvec3(a), glm::dvec3(thickness / distance));
+    Pinhole cam(b.s, W, H);
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const glm::dvec3 d = cam.ray(x, y);
+            const glm::dvec3 p = d * (-3.0 / d.z);
+            if (d.z >= 0.0 || std::abs(p.x) > 1.9 || std::abs(p.y) > 1.9) continue;
+            expected.push_back(
+                {{x, y}, tint * thinTransmissionLobe(glm::dvec3(0, 0, 1), -d, toSun, 0.04, alpha) * sunE});
+        }
+    const auto [checked, worst] = expectPixels(out.at("pt"), expected, 0.001);
+    std::printf("%s tracer, sun behind an open volume's rough pane: %d pixels, worst relative error %.5f\n", gBackend,
+                checked, worst);
+    EXPECT_GE(checked, 300);
+}
+
 } // namespace
 } // namespace vitrine::test
