@@ -955,6 +955,23 @@ struct CpuPathTracer::Impl {
         return l;
     }
 
+    // pathtrace.comp's throughBoundary: the path through a volume's boundary s (out of it, or back in by Fresnel, from
+    // inside; else into it); false where the microfacet drawn sends it nowhere.
+    static bool throughBoundary(PathState& p, const PathSurface& s) {
+        vec3 l, w;
+        bool across;
+        const float a = rngNext(p.rng);
+        const vec2 bc = rngNext2(p.rng);
+        if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric,
+                           s.inside ? s.ior : 1.0f / s.ior, s.inside, vec3(a, bc), l, w, across))
+            return false;
+        p.throughput *= w;
+        p.inVolume = across != s.inside;
+        p.medium = s.medium;
+        p.dir = l;
+        return true;
+    }
+
     // pathtrace.comp's tracePath at a surface found along p.dir: alpha coverage, then (where covered) the emission and
     // the transmission's component. True when the path passes through it (p moved past it, not a bounce); false when
     // s reflects (p.radiance has its emission) or the path ends (p.passes over the limit).
@@ -963,25 +980,12 @@ struct CpuPathTracer::Impl {
         // Beer's law over the way inside a volume.
         if (p.inVolume && p.medium.a > 0.0f) p.throughput *= glm::pow(vec3(p.medium), vec3(s.t / p.medium.a));
         if (st.seeThrough && s.inside) { // a volume's boundary from inside: out through it, or back in by Fresnel
-            if (++p.passes > PATHTRACE_MAX_PASSES) {
+            if (++p.passes > PATHTRACE_MAX_PASSES || !throughBoundary(p, s)) {
                 p.ended = true;
                 return false;
             }
-            vec3 l, w;
-            bool across;
-            float a = rngNext(p.rng);
-            vec2 bc = rngNext2(p.rng);
-            if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric, s.ior, true, vec3(a, bc),
-                               l, w, across)) {
-                p.ended = true;
-                return false;
-            }
-            p.throughput *= w;
-            p.inVolume = !across;
-            p.medium = s.medium;
             p.brdfPdfPrev = 0.0f;
-            p.origin = offsetRay(s.position, s.geometricNormal, l);
-            p.dir = l;
+            p.origin = offsetRay(s.position, s.geometricNormal, p.dir);
             return true;
         }
         bool pass = st.seeThrough && s.coverage < 1.0f && rngNext(p.rng) >= s.coverage;
@@ -1003,20 +1007,11 @@ struct CpuPathTracer::Impl {
             return false;
         }
         if (refracts) { // into the volume, through one of the boundary's microfacets
-            vec3 l, w;
-            bool across;
-            float a = rngNext(p.rng);
-            vec2 bc = rngNext2(p.rng);
-            if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric, 1.0f / s.ior, false,
-                               vec3(a, bc), l, w, across)) {
+            if (!throughBoundary(p, s)) {
                 p.ended = true;
                 return false;
             }
-            p.throughput *= w;
-            p.inVolume = true;
-            p.medium = s.medium;
             p.brdfPdfPrev = 0.0f;
-            p.dir = l;
         }
         p.origin = offsetRay(s.position, s.geometricNormal, p.dir);
         return true;

@@ -128,6 +128,23 @@ bool drawTransmission(inout PathSurface s, vec3 v, inout vec3 throughput, inout 
     return false;
 }
 
+// A path along dir through a volume's boundary s: out of the volume (or back into it by Fresnel) from inside, else into
+// it, the Fresnel choice made by drawTransmission. dir, throughput and the volume the path is in (s's medium) follow
+// the microfacet crossBoundary draws; false where that sends the path nowhere (it ends).
+bool throughBoundary(PathSurface s, inout vec3 dir, inout vec3 throughput, inout bool inVolume, inout vec4 medium,
+                     inout uint rng) {
+    vec3 l, w;
+    bool across;
+    if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, s.inside ? s.ior : 1.0 / s.ior,
+                       s.inside, vec3(rngNext(rng), rngNext2(rng)), l, w, across))
+        return false;
+    throughput *= w;
+    inVolume = across != s.inside;
+    medium = s.medium;
+    dir = l;
+    return true;
+}
+
 vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     bool envSampling = (push.counts.w & PATHTRACE_ENV_CDF) != 0u && push.scales.y > 0.0;
     int envSize = textureSize(in_sky, 0).x;
@@ -161,18 +178,9 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         }
         PathSurface s = pathSurface(hit, origin, dir);
         if (seeThrough && s.inside) { // a volume's boundary from inside: out through it, or back in by Fresnel
-            if (++passes > PATHTRACE_MAX_PASSES) break;
-            vec3 l, w;
-            bool across;
-            if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, s.ior, true,
-                               vec3(rngNext(rng), rngNext2(rng)), l, w, across))
-                break;
-            throughput *= w;
-            inVolume = !across;
-            medium = s.medium;
+            if (++passes > PATHTRACE_MAX_PASSES || !throughBoundary(s, dir, throughput, inVolume, medium, rng)) break;
             brdfPdfPrev = 0.0;
-            origin = offsetRay(s.position, s.geometricNormal, l);
-            dir = l;
+            origin = offsetRay(s.position, s.geometricNormal, dir);
             continue;
         }
         // Alpha coverage: the uncovered share lets the path on, untouched (an alpha mask's cut-away part always).
@@ -194,16 +202,8 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         if (pass) {
             if (++passes > PATHTRACE_MAX_PASSES) break;
             if (refracts) { // into the volume, through one of the boundary's microfacets
-                vec3 l, w;
-                bool across;
-                if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, 1.0 / s.ior, false,
-                                   vec3(rngNext(rng), rngNext2(rng)), l, w, across))
-                    break;
-                throughput *= w;
-                inVolume = true;
-                medium = s.medium;
+                if (!throughBoundary(s, dir, throughput, inVolume, medium, rng)) break;
                 brdfPdfPrev = 0.0;
-                dir = l;
             } // else straight on from the far side: the direction's density (for MIS at the sky) is unchanged
             origin = offsetRay(s.position, s.geometricNormal, dir);
             continue;
