@@ -15,10 +15,11 @@ namespace {
 
 // Gives the corners of a set of triangles ids, one per position: corners closer than `tolerance` on every axis share
 // one. Exporters split a mesh's vertices at UV seams and hard edges into copies at the same place, and generated
-// meshes close their seams up to rounding (the sine of 2 pi is not 0).
+// meshes close their seams up to rounding (the sine of 2 pi is not 0). Cells are counted from `origin`, the corners'
+// lowest point, so their indices stay within the extent over the tolerance however far the mesh is from 0.
 class Welder {
 public:
-    explicit Welder(float tolerance) : mTolerance(tolerance) {}
+    Welder(glm::vec3 origin, float tolerance) : mOrigin(origin), mTolerance(tolerance) {}
 
     uint32_t id(glm::vec3 p) {
         const glm::ivec3 cell = cellOf(p);
@@ -40,12 +41,13 @@ public:
     }
 
 private:
-    glm::ivec3 cellOf(glm::vec3 p) const { return glm::ivec3(glm::floor(p / mTolerance)); }
+    glm::ivec3 cellOf(glm::vec3 p) const { return glm::ivec3(glm::floor((p - mOrigin) / mTolerance)); }
     static uint64_t key(glm::ivec3 c) {
         auto u = [](int v) { return static_cast<uint64_t>(static_cast<uint32_t>(v) & 0x1fffffu); };
         return u(c.x) | u(c.y) << 21 | u(c.z) << 42;
     }
 
+    glm::vec3 mOrigin;
     float mTolerance;
     std::vector<glm::vec3> mPositions;
     std::unordered_map<uint64_t, std::vector<uint32_t>> mCells;
@@ -65,7 +67,7 @@ bool trianglesClosed(const Scene& scene, const std::vector<uint32_t>& primitives
             hi = glm::max(hi, position(scene.primitives[p], i));
         }
     const glm::vec3 extent = hi - lo;
-    Welder welder(std::max(1e-6f * std::max({extent.x, extent.y, extent.z}), 1e-30f));
+    Welder welder(lo, std::max(1e-6f * std::max({extent.x, extent.y, extent.z}), 1e-30f));
     // +1 for each crossing from the lower id to the higher, -1 for each the other way; closed when all sum to 0.
     std::unordered_map<uint64_t, int32_t> balance;
     for (uint32_t p : primitives) {
@@ -86,20 +88,27 @@ bool trianglesClosed(const Scene& scene, const std::vector<uint32_t>& primitives
     return true;
 }
 
+std::vector<uint8_t> openVolumePrimitives(const Scene& scene, const Mesh& mesh) {
+    std::vector<uint8_t> open(mesh.primitiveCount, 0);
+    std::map<uint32_t, std::vector<uint32_t>> byMaterial;
+    for (uint32_t p = mesh.firstPrimitive; p < mesh.firstPrimitive + mesh.primitiveCount; ++p) {
+        const uint32_t material = scene.primitives[p].material;
+        if (material < scene.materials.size() && boundsVolume(scene.materials[material]))
+            byMaterial[material].push_back(p);
+    }
+    for (const auto& [material, primitives] : byMaterial) {
+        if (trianglesClosed(scene, primitives)) continue;
+        for (uint32_t p : primitives)
+            open[p - mesh.firstPrimitive] = 1;
+    }
+    return open;
+}
+
 std::vector<uint8_t> openVolumePrimitives(const Scene& scene) {
     std::vector<uint8_t> open(scene.primitives.size(), 0);
     for (const Mesh& mesh : scene.meshes) {
-        std::map<uint32_t, std::vector<uint32_t>> byMaterial;
-        for (uint32_t p = mesh.firstPrimitive; p < mesh.firstPrimitive + mesh.primitiveCount; ++p) {
-            const uint32_t material = scene.primitives[p].material;
-            if (material < scene.materials.size() && boundsVolume(scene.materials[material]))
-                byMaterial[material].push_back(p);
-        }
-        for (const auto& [material, primitives] : byMaterial) {
-            if (trianglesClosed(scene, primitives)) continue;
-            for (uint32_t p : primitives)
-                open[p] = 1;
-        }
+        const std::vector<uint8_t> flags = openVolumePrimitives(scene, mesh);
+        std::copy(flags.begin(), flags.end(), open.begin() + mesh.firstPrimitive);
     }
     return open;
 }

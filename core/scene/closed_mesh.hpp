@@ -22,8 +22,10 @@ bool boundsVolume(const Material& m);
 // cross each edge once each way. Degenerate triangles (two corners welded into one) are ignored.
 bool trianglesClosed(const Scene& scene, const std::vector<uint32_t>& primitives);
 
-// One entry per Scene::primitives: 1 where the primitive's material bounds a volume but the faces of that material
-// in its mesh (its primitives sharing the material, taken together) are not closed; 0 elsewhere.
+// One entry per primitive of the mesh: 1 where the primitive's material bounds a volume but the faces of that material
+// in the mesh (its primitives sharing the material, taken together) are not closed; 0 elsewhere.
+std::vector<uint8_t> openVolumePrimitives(const Scene& scene, const Mesh& mesh);
+// The same for every mesh, one entry per Scene::primitives.
 std::vector<uint8_t> openVolumePrimitives(const Scene& scene);
 
 } // namespace vitrine::scene

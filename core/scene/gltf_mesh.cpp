@@ -257,17 +257,12 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
 // KHR_materials_volume on faces that bound nothing (core/scene/closed_mesh.hpp): one warning per material of the mesh.
 void warnOpenVolumes(LoadContext& ctx, const Mesh& mesh, const std::vector<std::string>& elements) {
     const Scene& scene = *ctx.scene;
+    const std::vector<uint8_t> open = openVolumePrimitives(scene, mesh);
     std::vector<uint32_t> warned;
     for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
         const uint32_t material = scene.primitives[mesh.firstPrimitive + k].material;
-        if (!boundsVolume(scene.materials[material]) ||
-            std::find(warned.begin(), warned.end(), material) != warned.end())
-            continue;
+        if (!open[k] || std::find(warned.begin(), warned.end(), material) != warned.end()) continue;
         warned.push_back(material);
-        std::vector<uint32_t> faces;
-        for (uint32_t q = mesh.firstPrimitive; q < mesh.firstPrimitive + mesh.primitiveCount; ++q)
-            if (scene.primitives[q].material == material) faces.push_back(q);
-        if (trianglesClosed(scene, faces)) continue;
         const std::string& name = scene.materials[material].name;
         ctx.warn(elements[k], "materials[" + std::to_string(material) + "]" +
                                   (name.empty() ? "" : " ('" + name + "')") +
