@@ -140,10 +140,11 @@ NodeSchema schema() {
          "Trace what forward.transparent draws: alpha-blended surfaces by their coverage, alpha masks cut away, and "
          "KHR_materials_transmission as thin-walled glass (straight on, tinted by the base colour) for paths and "
          "shadow rays alike, and KHR_materials_volume's glass (thicknessFactor > 0) as a closed volume that paths "
-         "refract into and out of, rough by GGX microfacets, absorbing by Beer's law on the way inside; shadow "
-         "rays stop at it (faces of such glass that close nothing, e.g. a single quad, are thin-walled glass tinted "
-         "over the thickness, as forward.transparent draws them) (off: those surfaces are left out of the scene, as "
-         "for the bake and the twins, and masks are opaque)"},
+         "refract into and out of, rough by GGX microfacets, absorbing by Beer's law on the way inside, volumes "
+         "nesting (a liquid in a glass, a bubble in a block: each boundary bends by the IORs on its two sides); "
+         "shadow rays stop at it (faces of such glass that close nothing, e.g. a single quad, are thin-walled glass "
+         "tinted over the thickness, as forward.transparent draws them) (off: those surfaces are left out of the "
+         "scene, as for the bake and the twins, and masks are opaque)"},
         {"backend",
          ParamType::Enum,
          "auto",

@@ -563,6 +563,67 @@ struct TriangleRef {
 
 using PathSurface = CpuSurface;
 
+// surface.glsl iorFromF0: the IOR of a dielectric whose F0 is ((ior - 1) / (ior + 1))^2 (GpuMaterial optics.y).
+float iorFromF0(float f0) {
+    const float r = std::sqrt(std::clamp(f0, 0.0f, 0.98f));
+    return (1.0f + r) / (1.0f - r);
+}
+
+// shaders/pathtrace/media.glsl PathMedia: the KHR_materials_volume media a path is in, innermost (the last entered)
+// last, at most kMaxMedia (PATHTRACE_MAX_MEDIA).
+struct PathMedia {
+    static constexpr uint32_t kMaxMedia = 4;
+    uint32_t count = 0;
+    std::array<uint32_t, kMaxMedia> material{};
+
+    // media.glsl findMedium: where the media hold `m`, innermost first; -1 where the path is not in it.
+    int find(uint32_t m) const {
+        for (int i = static_cast<int>(count) - 1; i >= 0; --i)
+            if (material[static_cast<size_t>(i)] == m) return i;
+        return -1;
+    }
+    // media.glsl currentMedium: the innermost volume's attenuationColor and attenuationDistance (0: none, as air).
+    vec4 current(std::span<const GpuMaterial> materials) const {
+        return count > 0 ? materials[material[count - 1]].volume : vec4(1.0f, 1.0f, 1.0f, 0.0f);
+    }
+    // media.glsl meetBoundary: s.eta and s.dielectric from the IORs on s's two sides.
+    void meet(PathSurface& s, std::span<const GpuMaterial> materials) const {
+        const auto ior = [&](uint32_t i) { return iorFromF0(materials[material[i]].optics.y); };
+        const float outer = count > 0 ? ior(count - 1) : 1.0f;
+        float here = outer, there = s.ior;
+        bool air = count == 0; // what lies beyond s's volume is no volume
+        if (s.inside) {
+            const int at = find(s.material);
+            if (at < 0) { // the path started inside this volume
+                here = s.ior;
+                there = outer;
+            } else if (at == static_cast<int>(count) - 1) { // out of the innermost volume into the one around it
+                there = at > 0 ? ior(static_cast<uint32_t>(at - 1)) : 1.0f;
+                air = at == 0;
+            } else { // out of a volume overlapped by one entered later: the path stays in that one
+                there = outer;
+            }
+        }
+        s.eta = here / there;
+        if (!air) { // F0 of the two media (against air, the material's own)
+            const float r = (here - there) / (here + there);
+            s.dielectric = dielectricSpecular(r * r, s.specular);
+        }
+    }
+    // media.glsl crossMedia: the path met boundary s and crossed it (into its volume or out of it) or was reflected.
+    void cross(const PathSurface& s, bool across) {
+        const int at = find(s.material);
+        if (across == s.inside) { // out of the volume, or reflected outside it
+            if (!across || at < 0) return;
+            for (uint32_t i = static_cast<uint32_t>(at); i + 1 < count; ++i)
+                material[i] = material[i + 1];
+            --count;
+        } else if ((across || at < 0) && count < kMaxMedia) {
+            material[count++] = s.material;
+        }
+    }
+};
+
 // Paths traced in lock step by CpuPathTracer::Impl::tracePaths: enough for their texture fetches' cache misses to
 // overlap, few enough that a batch's state stays in the L1 cache.
 constexpr size_t kPathBatch = 16;
@@ -723,15 +784,12 @@ struct CpuPathTracer::Impl {
     }
 
     // pathtrace.comp's pathPassing: what passes s on a shadow ray (0 for an opaque surface, and for a volume's boundary
-    // unless throughVolumes; from inside a volume, 1 - F(n.v) and Beer's law over `inside`).
-    static vec3 pathPassing(const PathSurface& s, vec3 v, bool throughVolumes, float inside) {
+    // unless throughVolumes; from inside a volume, 1 - F(n.v)).
+    static vec3 pathPassing(const PathSurface& s, vec3 v, bool throughVolumes) {
         if (s.boundary && !throughVolumes) return vec3(0.0f);
-        if (s.inside) {
-            vec3 beer = s.medium.a > 0.0f ? glm::pow(vec3(s.medium), vec3(inside / s.medium.a)) : vec3(1.0f);
-            return (vec3(1.0f) - schlickFresnelF90(vec3(s.dielectric), s.dielectric.a,
-                                                   std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f))) *
-                   beer;
-        }
+        if (s.inside)
+            return vec3(1.0f) -
+                   schlickFresnelF90(vec3(s.dielectric), s.dielectric.a, std::clamp(glm::dot(s.normal, v), 0.0f, 1.0f));
         vec3 through =
             s.transmission > 0.0f ? s.transmission * (1.0f - s.metallic) * dielectricThrough(s, v) : vec3(0.0f);
         return vec3(1.0f - s.coverage) + s.coverage * through;
@@ -739,21 +797,29 @@ struct CpuPathTracer::Impl {
 
     // pathtrace.comp's shadowTransmittance: 0 behind anything opaque, 1 with nothing in the way; with seeThrough the
     // product of pathPassing over every surface crossed (at most PATHTRACE_MAX_PASSES), a volume's boundary stopping
-    // the ray unless throughVolumes (the sun's rays).
-    vec3 shadowTransmittance(vec3 o, vec3 d, bool seeThrough, bool throughVolumes, uint64_t& rays) const {
+    // the ray unless throughVolumes (the sun's rays); Beer's law over each segment in the media it is in (from the
+    // path's `media`).
+    vec3 shadowTransmittance(vec3 o, vec3 d, bool seeThrough, bool throughVolumes, PathMedia media,
+                             uint64_t& rays) const {
         if (!seeThrough) return occluded(o, d, rays) ? vec3(0.0f) : vec3(1.0f);
         // First against what no light passes (the GPU tracer walks the surfaces only: one BVH there); then every hit
         // left is one to pass.
         if (rtcOpaque && occludedIn(rtcOpaque, o, d, rays)) return vec3(0.0f);
         vec3 T(1.0f);
-        float tmin = 0.0f, entered = 0.0f; // where the ray entered the volume it is in (0: it starts inside one)
+        float tmin = 0.0f, last = 0.0f; // last: where the ray met the last surface
         for (uint32_t i = 0; i < PATHTRACE_MAX_PASSES; ++i) {
             Hit hit;
             if (!closest(o, d, tmin, hit, rays)) return T;
-            const PathSurface s = pathSurface(hit, o, d);
-            T *= pathPassing(s, -d, throughVolumes, hit.t - entered);
+            const vec4 medium = media.current(materials.materials);
+            if (medium.a > 0.0f) T *= glm::pow(vec3(medium), vec3((hit.t - last) / medium.a));
+            PathSurface s = pathSurface(hit, o, d);
+            if (s.boundary && throughVolumes) {
+                media.meet(s, materials.materials);
+                media.cross(s, true);
+            }
+            T *= pathPassing(s, -d, throughVolumes);
             if (std::max(std::max(T.r, T.g), T.b) <= 0.0f) return vec3(0.0f);
-            if (s.boundary && !s.inside) entered = hit.t;
+            last = hit.t;
             tmin = std::nextafter(hit.t, kInfinity); // Embree's tnear is inclusive, the GLSL test strict
         }
         return vec3(0.0f);
@@ -762,13 +828,14 @@ struct CpuPathTracer::Impl {
     // pathtrace.comp's sunThroughTransmission: the sun behind a thin-walled transmissive dielectric, scattered towards
     // v through its transmission lobe (core/shading thinTransmissionCosine), tinted, shadowed from the far side.
     vec3 sunThroughTransmission(const PathSurface& s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough,
-                                uint64_t& rays) const {
+                                const PathMedia& media, uint64_t& rays) const {
         if (s.boundary || glm::dot(s.geometricNormal, sunDir) >= 0.0f) return vec3(0.0f);
         vec3 f = thinTransmissionCosine(s.normal, v, sunDir, vec3(s.dielectric), s.dielectric.a, s.roughness);
         if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return vec3(0.0f);
         vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
         return t * sunE *
-               shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true, rays);
+               shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true, media,
+                                   rays);
     }
 
     // pathtrace.comp's drawTransmission: one component of KHR_materials_transmission's mixture; true when the path
@@ -908,17 +975,18 @@ struct CpuPathTracer::Impl {
         s.transmission = m.optics.x;
         s.boundary = boundsVolume(m, ref.primitive);
         s.inside = s.boundary && backFace;
-        const float r = std::sqrt(std::clamp(m.optics.y, 0.0f, 0.98f)); // surface.glsl iorFromF0
-        s.ior = (1.0f + r) / (1.0f - r);
+        s.ior = iorFromF0(m.optics.y);
         s.medium = m.volume;
+        s.material = ref.material;
+        s.eta = s.inside ? s.ior : 1.0f / s.ior;
+        s.specular = materials.materialSpecular(m, uv0, uv1);
         if (materialBoundsVolume(m) && !s.boundary && m.volume.a > 0.0f) { // faces that bound nothing: thin-walled
             const vec3 modelScale(glm::length(w[0]), glm::length(w[1]), glm::length(w[2]));
             const vec3 crossing = glm::normalize(glm::refract(direction, N, 1.0f / s.ior)) *
                                   materials.materialThickness(m, uv0, uv1) * modelScale;
             s.attenuation = glm::pow(vec3(m.volume), vec3(glm::length(crossing) / m.volume.a));
         }
-        if (s.transmission > 0.0f)
-            s.dielectric = dielectricSpecular(m.optics.y, materials.materialSpecular(m, uv0, uv1));
+        if (s.transmission > 0.0f) s.dielectric = dielectricSpecular(m.optics.y, s.specular);
         s.emissive = vec3(m.emissive);
         if (m.emissiveRef.info.x >= 0) s.emissive *= vec3(materials.sampleRef(m.emissiveRef, uv0, uv1));
         if (m.optics.z > 0.5f) {
@@ -937,8 +1005,7 @@ struct CpuPathTracer::Impl {
         float brdfPdfPrev = 0.0f; // 0: a camera ray, or after a volume's boundary (what is found counts in full)
         uint32_t rng = 0, bounce = 0;
         uint32_t passes = 0;   // surfaces passed through (seeThrough; not bounces)
-        bool inVolume = false; // inside a volume of this attenuationColor and attenuationDistance (0: none)
-        vec4 medium{0.0f};
+        PathMedia media;       // the volumes the path is in
         bool ended = false;  // passed through more than PATHTRACE_MAX_PASSES
         Hit hit{};
     };
@@ -955,19 +1022,22 @@ struct CpuPathTracer::Impl {
         return l;
     }
 
-    // pathtrace.comp's throughBoundary: the path through a volume's boundary s (out of it, or back in by Fresnel, from
-    // inside; else into it); false where the microfacet drawn sends it nowhere.
+    // pathtrace.comp's fromDenserSide: a path meets boundary s from inside its volume, or enters it from a denser
+    // medium; the crossing's Fresnel is drawn at the microfacet there.
+    static bool fromDenserSide(const PathSurface& s) { return s.inside || s.eta > 1.0f; }
+
+    // pathtrace.comp's throughBoundary: the path through a volume's boundary s (met by PathMedia::meet; across it or
+    // back by Fresnel from its denser side, else into it); false where the microfacet drawn sends it nowhere.
     static bool throughBoundary(PathState& p, const PathSurface& s) {
         vec3 l, w;
         bool across;
         const float a = rngNext(p.rng);
         const vec2 bc = rngNext2(p.rng);
-        if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric,
-                           s.inside ? s.ior : 1.0f / s.ior, s.inside, vec3(a, bc), l, w, across))
+        if (!crossBoundary(s.normal, s.geometricNormal, -p.dir, s.roughness, s.dielectric, s.eta, fromDenserSide(s),
+                           vec3(a, bc), l, w, across))
             return false;
         p.throughput *= w;
-        p.inVolume = across != s.inside;
-        p.medium = s.medium;
+        p.media.cross(s, across);
         p.dir = l;
         return true;
     }
@@ -978,8 +1048,11 @@ struct CpuPathTracer::Impl {
     bool passSurface(PathState& p, PathSurface& s, const CpuTraceSettings& st, const PathLights& lights,
                      uint64_t& rays) const {
         // Beer's law over the way inside a volume.
-        if (p.inVolume && p.medium.a > 0.0f) p.throughput *= glm::pow(vec3(p.medium), vec3(s.t / p.medium.a));
-        if (st.seeThrough && s.inside) { // a volume's boundary from inside: out through it, or back in by Fresnel
+        const vec4 medium = p.media.current(materials.materials);
+        if (medium.a > 0.0f) p.throughput *= glm::pow(vec3(medium), vec3(s.t / medium.a));
+        if (st.seeThrough && s.boundary) p.media.meet(s, materials.materials); // the IORs on its two sides
+        // A boundary from its denser side: across it by Fresnel, or back.
+        if (st.seeThrough && s.boundary && fromDenserSide(s)) {
             if (++p.passes > PATHTRACE_MAX_PASSES || !throughBoundary(p, s)) {
                 p.ended = true;
                 return false;
@@ -995,8 +1068,9 @@ struct CpuPathTracer::Impl {
             if (st.seeThrough && s.transmission > 0.0f) {
                 // The transmissive component's share, whichever component drawTransmission then draws.
                 if (lights.sun)
-                    p.radiance += p.throughput * (s.transmission * (1.0f - s.metallic)) *
-                                  sunThroughTransmission(s, -p.dir, lights.sunDir, lights.sunE, st.seeThrough, rays);
+                    p.radiance +=
+                        p.throughput * (s.transmission * (1.0f - s.metallic)) *
+                        sunThroughTransmission(s, -p.dir, lights.sunDir, lights.sunE, st.seeThrough, p.media, rays);
                 pass = drawTransmission(s, -p.dir, p.throughput, p.rng);
                 refracts = pass && s.boundary;
             }
@@ -1019,8 +1093,8 @@ struct CpuPathTracer::Impl {
 
     // The path left the scene: the sky it sees, MIS-weighted against the sky's own sampling after a bounce (nothing
     // from inside an absorbing volume: an open mesh).
-    static void addMiss(PathState& p, const Env& env, const PathLights& lights) {
-        if (p.inVolume && p.medium.a > 0.0f) return;
+    void addMiss(PathState& p, const Env& env, const PathLights& lights) const {
+        if (p.media.current(materials.materials).a > 0.0f) return;
         float w = p.brdfPdfPrev <= 0.0f || !lights.envSampling ? 1.0f : powerHeuristic(p.brdfPdfPrev, env.pdf(p.dir));
         p.radiance += p.throughput * env.radiance(p.dir) * w;
     }
@@ -1047,7 +1121,7 @@ struct CpuPathTracer::Impl {
             if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
                 p.radiance += weight * f * lights.sunE *
                               shadowTransmittance(offsetRay(s.position, ng, lights.sunDir), lights.sunDir,
-                                                  st.seeThrough, true, rays);
+                                                  st.seeThrough, true, p.media, rays);
         }
         if (lights.envSampling) {
             float a = rngNext(p.rng);
@@ -1058,9 +1132,10 @@ struct CpuPathTracer::Impl {
                 vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
                 if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
-                    p.radiance += weight * f * env.radiance(l) *
-                                  shadowTransmittance(offsetRay(s.position, ng, l), l, st.seeThrough, false, rays) *
-                                  powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
+                    p.radiance +=
+                        weight * f * env.radiance(l) *
+                        shadowTransmittance(offsetRay(s.position, ng, l), l, st.seeThrough, false, p.media, rays) *
+                        powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
         }
 

@@ -84,6 +84,12 @@ struct CpuSurface {
     bool boundary = false, inside = false;
     float ior = 1.5f;
     glm::vec4 medium{1.0f, 1.0f, 1.0f, 0.0f};
+    // The volume's material (which of the media a path is in it bounds: shaders/pathtrace/media.glsl); the IOR on the
+    // ray's side over the IOR across (against air; PathMedia::meet's in a medium); KHR_materials_specular's colour
+    // (rgb) and strength (a), for an interface's Fresnel.
+    uint32_t material = 0;
+    float eta = 1.0f / 1.5f;
+    glm::vec4 specular{1.0f};
     // What thin-walled glass lets through is tinted by: 1, but for a KHR_materials_volume on faces that bound nothing
     // (scene::openVolumePrimitives) Beer's law over the refracted path through its thickness, as forward.transparent.
     glm::vec3 attenuation{1.0f};

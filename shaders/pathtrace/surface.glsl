@@ -42,6 +42,9 @@ struct PathSurface {
     bool inside; // the boundary seen from inside its volume (its back face)
     float ior;   // KHR_materials_ior of a transmissive surface
     vec4 medium; // the volume's attenuationColor (rgb) and attenuationDistance (a; 0: no attenuation)
+    uint material; // the volume's material: which of the media a path is in it bounds (pathtrace/media.glsl)
+    float eta;     // the IOR on the ray's side over the IOR across: against air here, meetBoundary's in a medium
+    vec4 specular; // KHR_materials_specular's colour (rgb) and strength (a), for an interface's Fresnel
     // What thin-walled glass lets through is tinted by: 1, but for a KHR_materials_volume on faces that bound nothing
     // (VITRINE_BVH_PRIMITIVE_OPEN_VOLUME) Beer's law over the refracted path through its thickness, as
     // forward.transparent tints it.
@@ -181,13 +184,16 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.inside = s.boundary && backFace;
     s.ior = iorFromF0(m.optics.y);
     s.medium = m.volume;
+    s.material = ref.material;
+    s.eta = s.inside ? s.ior : 1.0 / s.ior;
+    s.specular = materialSpecular(m, uv0, uv1, lod0);
     s.attenuation = vec3(1.0);
     if (materialBoundsVolume(m) && !s.boundary && m.volume.a > 0.0) {
         vec3 modelScale = vec3(length(world[0]), length(world[1]), length(world[2]));
         vec3 crossing = normalize(refract(direction, N, 1.0 / s.ior)) * materialThickness(m, uv0, uv1, lod0) * modelScale;
         s.attenuation = pow(m.volume.rgb, vec3(length(crossing) / m.volume.a));
     }
-    if (s.transmission > 0.0) s.dielectric = dielectricSpecular(m.optics.y, materialSpecular(m, uv0, uv1, lod0));
+    if (s.transmission > 0.0) s.dielectric = dielectricSpecular(m.optics.y, s.specular);
 #endif
     s.emissive = m.emissive.rgb;
     if (m.emissiveRef.info.x >= 0) s.emissive *= sampleRef(m.emissiveRef, uv0, uv1, lod0).rgb;

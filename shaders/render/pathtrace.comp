@@ -10,7 +10,8 @@
 // as it passes there: alpha coverage and KHR_materials_transmission's thin-walled glass (straight on, tinted by the
 // base colour), for paths and shadow rays alike. KHR_materials_volume's glass (a thicknessFactor > 0) is a closed
 // volume that paths refract into and out of, paying Beer's law on the way through (pathtrace/volume.glsl). The sky's
-// shadow rays stop at it (paths find that light); the sun's pass it straight on (shadowTransmittance).
+// shadow rays stop at it (paths find that light); the sun's pass it straight on (shadowTransmittance). Volumes nest:
+// paths and shadow rays keep the media they are in (pathtrace/media.glsl).
 #define VITRINE_BVH_SET 1
 #define VITRINE_SCENE_SET 2
 #define VITRINE_GEOMETRY_SET 3
@@ -20,6 +21,7 @@
 #include "pathtrace/sampling.glsl"
 #include "pathtrace/surface.glsl"
 #include "pathtrace/volume.glsl"
+#include "pathtrace/media.glsl"
 #include "common/thin_transmission.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -59,14 +61,12 @@ vec3 dielectricThrough(PathSurface s, vec3 v) {
 
 // What passes surface s seen along -v on a shadow ray: its uncovered share, plus where it is covered the transmissive
 // dielectric's share (1 - metallic) transmission of dielectricThrough. Nothing more for an opaque surface, nor for a
-// volume's boundary unless throughVolumes: see shadowTransmittance. From inside a volume, the way out of it:
-// 1 - F(n.v) and Beer's law over the `inside` metres the ray crossed in it.
-vec3 pathPassing(PathSurface s, vec3 v, bool throughVolumes, float inside) {
+// volume's boundary unless throughVolumes: see shadowTransmittance. From inside a volume, the way out of it: 1 - F(n.v)
+// (Beer's law inside is the ray's, over each segment).
+vec3 pathPassing(PathSurface s, vec3 v, bool throughVolumes) {
     if (s.boundary && !throughVolumes) return vec3(0.0);
-    if (s.inside) {
-        vec3 beer = s.medium.a > 0.0 ? pow(s.medium.rgb, vec3(inside / s.medium.a)) : vec3(1.0);
-        return (vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, clamp(dot(s.normal, v), 0.0, 1.0))) * beer;
-    }
+    if (s.inside)
+        return vec3(1.0) - schlickFresnelF90(s.dielectric.rgb, s.dielectric.a, clamp(dot(s.normal, v), 0.0, 1.0));
     vec3 through = s.transmission > 0.0 ? s.transmission * (1.0 - s.metallic) * dielectricThrough(s, v) : vec3(0.0);
     return vec3(1.0 - s.coverage) + s.coverage * through;
 }
@@ -76,18 +76,24 @@ vec3 pathPassing(PathSurface s, vec3 v, bool throughVolumes, float inside) {
 // A volume's boundary stops the ray unless throughVolumes. The sun's rays pass volumes straight on: the sun through
 // glass is a caustic, which neither a path (the sun is a delta light) nor next-event estimation can find, so its
 // light is spread flat over the shadow with the transmittance of the straight chord, instead of being lost. The sky's
-// rays stop there: paths refracted through the volume find that light.
-vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough, bool throughVolumes) {
+// rays stop there: paths refracted through the volume find that light. `media`: the volumes the ray starts in (the
+// path's), whose boundaries it crosses as a path would and whose medium attenuates each segment by Beer's law.
+vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough, bool throughVolumes, PathMedia media) {
     if (!seeThrough) return bvhTraceAny(origin, dir, 0.0, kInfinity) ? vec3(0.0) : vec3(1.0);
     vec3 T = vec3(1.0);
-    float tmin = 0.0, entered = 0.0; // where the ray entered the volume it is in (0: it starts inside one)
+    float tmin = 0.0;
     for (uint i = 0u; i < PATHTRACE_MAX_PASSES; ++i) {
         BvhHit hit;
         if (!bvhTraceClosest(origin, dir, tmin, kInfinity, hit)) return T;
+        vec4 medium = currentMedium(media);
+        if (medium.a > 0.0) T *= pow(medium.rgb, vec3((hit.t - tmin) / medium.a));
         PathSurface s = pathSurface(hit, origin, dir);
-        T *= pathPassing(s, -dir, throughVolumes, hit.t - entered);
+        if (s.boundary && throughVolumes) {
+            meetBoundary(s, media);
+            crossMedia(media, s, true);
+        }
+        T *= pathPassing(s, -dir, throughVolumes);
         if (max(max(T.r, T.g), T.b) <= 0.0) return vec3(0.0);
-        if (s.boundary && !s.inside) entered = hit.t;
         tmin = hit.t;
     }
     return vec3(0.0);
@@ -98,12 +104,12 @@ vec3 shadowTransmittance(vec3 origin, vec3 dir, bool seeThrough, bool throughVol
 // scaling and the coat, and shadowed from the far side. The path itself passes such a surface straight on, so it
 // never meets the sun (a delta light) through it: this is the only way that light arrives. 0 with the sun on v's
 // side, and for a volume's boundary (the sun reaches what lies behind a volume through shadowTransmittance).
-vec3 sunThroughTransmission(PathSurface s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough) {
+vec3 sunThroughTransmission(PathSurface s, vec3 v, vec3 sunDir, vec3 sunE, bool seeThrough, PathMedia media) {
     if (s.boundary || dot(s.geometricNormal, sunDir) >= 0.0) return vec3(0.0);
     vec3 f = thinTransmissionCosine(s.normal, v, sunDir, s.dielectric.rgb, s.dielectric.a, s.roughness);
     if (!any(greaterThan(f, vec3(0.0)))) return vec3(0.0);
     vec3 t = dielectricLayers(s, v, s.baseColor * s.attenuation * f);
-    return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true);
+    return t * sunE * shadowTransmittance(offsetRay(s.position, s.geometricNormal, sunDir), sunDir, seeThrough, true, media);
 }
 
 // KHR_materials_transmission as the glTF spec mixes it, one component drawn per surface: the metal (probability
@@ -128,19 +134,22 @@ bool drawTransmission(inout PathSurface s, vec3 v, inout vec3 throughput, inout 
     return false;
 }
 
-// A path along dir through a volume's boundary s: out of the volume (or back into it by Fresnel) from inside, else into
-// it, the Fresnel choice made by drawTransmission. dir, throughput and the volume the path is in (s's medium) follow
-// the microfacet crossBoundary draws; false where that sends the path nowhere (it ends).
-bool throughBoundary(PathSurface s, inout vec3 dir, inout vec3 throughput, inout bool inVolume, inout vec4 medium,
-                     inout uint rng) {
+// Whether a path meets boundary s (met by meetBoundary) from its denser side: from inside its volume (towards air, or a
+// rarer medium around it), or entering it from a denser medium (water from glass). There the crossing's Fresnel is
+// drawn at the microfacet, total internal reflection included (throughBoundary); elsewhere drawTransmission draws it.
+bool fromDenserSide(PathSurface s) { return s.inside || s.eta > 1.0; }
+
+// A path along dir through a volume's boundary s (met by meetBoundary): across it or reflected back by Fresnel from
+// its denser side (fromDenserSide), else into the volume, the Fresnel choice made by drawTransmission. dir, throughput
+// and the media the path is in follow the microfacet crossBoundary draws; false where that sends the path nowhere.
+bool throughBoundary(PathSurface s, inout vec3 dir, inout vec3 throughput, inout PathMedia media, inout uint rng) {
     vec3 l, w;
     bool across;
-    if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, s.inside ? s.ior : 1.0 / s.ior,
-                       s.inside, vec3(rngNext(rng), rngNext2(rng)), l, w, across))
+    if (!crossBoundary(s.normal, s.geometricNormal, -dir, s.roughness, s.dielectric, s.eta, fromDenserSide(s),
+                       vec3(rngNext(rng), rngNext2(rng)), l, w, across))
         return false;
     throughput *= w;
-    inVolume = across != s.inside;
-    medium = s.medium;
+    crossMedia(media, s, across);
     dir = l;
     return true;
 }
@@ -160,14 +169,14 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
     float brdfPdfPrev = 0.0;
     uint maxBounces = push.counts.y;
     uint passes = 0u; // surfaces passed through (not bounces)
-    bool inVolume = false;  // the path is inside a volume (pathtrace/volume.glsl) ...
-    vec4 medium = vec4(0.0); // ... of this attenuationColor (rgb) and attenuationDistance (a; 0: no attenuation)
+    PathMedia media = noMedia(); // the volumes the path is in (pathtrace/media.glsl)
     for (uint bounce = 0u;;) {
         BvhHit hit;
         bool found = pathTraceVisible(origin, dir, hit);
         // Beer's law over the way inside a volume. A path that leaves the scene from inside one (an open mesh) keeps
         // nothing of an absorbing medium.
-        if (inVolume && medium.a > 0.0) {
+        vec4 medium = currentMedium(media);
+        if (medium.a > 0.0) {
             if (!found) break;
             throughput *= pow(medium.rgb, vec3(hit.t / medium.a));
         }
@@ -177,8 +186,9 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
             break;
         }
         PathSurface s = pathSurface(hit, origin, dir);
-        if (seeThrough && s.inside) { // a volume's boundary from inside: out through it, or back in by Fresnel
-            if (++passes > PATHTRACE_MAX_PASSES || !throughBoundary(s, dir, throughput, inVolume, medium, rng)) break;
+        if (seeThrough && s.boundary) meetBoundary(s, media); // the IORs on its two sides
+        if (seeThrough && s.boundary && fromDenserSide(s)) { // across by Fresnel, or back
+            if (++passes > PATHTRACE_MAX_PASSES || !throughBoundary(s, dir, throughput, media, rng)) break;
             brdfPdfPrev = 0.0;
             origin = offsetRay(s.position, s.geometricNormal, dir);
             continue;
@@ -194,7 +204,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
                 // component drawTransmission then draws.
                 if (sun)
                     radiance += throughput * (s.transmission * (1.0 - s.metallic)) *
-                                sunThroughTransmission(s, -dir, sunDir, sunE, seeThrough);
+                                sunThroughTransmission(s, -dir, sunDir, sunE, seeThrough, media);
                 pass = drawTransmission(s, -dir, throughput, rng);
                 refracts = pass && s.boundary;
             }
@@ -202,7 +212,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
         if (pass) {
             if (++passes > PATHTRACE_MAX_PASSES) break;
             if (refracts) { // into the volume, through one of the boundary's microfacets
-                if (!throughBoundary(s, dir, throughput, inVolume, medium, rng)) break;
+                if (!throughBoundary(s, dir, throughput, media, rng)) break;
                 brdfPdfPrev = 0.0;
             } // else straight on from the far side: the direction's density (for MIS at the sky) is unchanged
             origin = offsetRay(s.position, s.geometricNormal, dir);
@@ -223,7 +233,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
             vec3 f = brdfCosineSheen(n, s.coatNormal, v, sunDir, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
             if (any(greaterThan(f, vec3(0.0))))
-                radiance += weight * f * sunE * shadowTransmittance(offsetRay(s.position, ng, sunDir), sunDir, seeThrough, true);
+                radiance += weight * f * sunE * shadowTransmittance(offsetRay(s.position, ng, sunDir), sunDir, seeThrough, true, media);
         }
         // Sky: a direction from its luminance table, weighted against BRDF sampling (power heuristic).
         if (envSampling) {
@@ -233,7 +243,7 @@ vec3 tracePath(vec3 origin, vec3 dir, inout uint rng) {
                 vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
                                          s.coat, s.sheen);
                 if (any(greaterThan(f, vec3(0.0))))
-                    radiance += weight * f * skyRadiance(l) * shadowTransmittance(offsetRay(s.position, ng, l), l, seeThrough, false) *
+                    radiance += weight * f * skyRadiance(l) * shadowTransmittance(offsetRay(s.position, ng, l), l, seeThrough, false, media) *
                                 powerHeuristic(pdf, brdfPdf(lobes, n, v, l)) / pdf;
             }
         }
