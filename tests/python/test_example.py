@@ -1,5 +1,6 @@
-"""ctest python.example: examples/fxaa_subpix_sweep.py runs at a tiny size and writes its plot; it never replaces an
-existing file without --force. Environment as tests/python/test_vitrine.py."""
+"""ctest python.example: examples/fxaa_subpix_sweep.py runs at a tiny size and writes its plot;
+examples/nested_volumes_scene.py writes a scene that `vitrine run --strict` path-traces (every volume closed, so no
+warning). Neither replaces an existing file without --force. Environment as tests/python/test_vitrine.py."""
 
 import os
 import subprocess
@@ -34,3 +35,24 @@ def test_sweep_example_writes_png(tmp_path):
     proc = run("--size", "32x18", "--steps", "2", "--out", out)
     assert proc.returncode != 0 and "--force" in proc.stderr
     assert out.read_bytes() == before
+
+
+def test_nested_volumes_scene_traces_without_warnings(tmp_path):
+    script = SRC / "examples" / "nested_volumes_scene.py"
+    scene = tmp_path / "nested.gltf"
+    proc = subprocess.run([sys.executable, str(script), str(scene)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    vitrine = os.environ.get("VITRINE_BIN", str(SRC / "build" / "vitrine"))
+    out = tmp_path / "out"
+    proc = subprocess.run([vitrine, "run", str(SRC / "graphs" / "variants" / "gltf_reference.json"), "--scene",
+                           str(scene), "--strict", "--set", "frame.width=16", "--set", "frame.height=16", "--set",
+                           "pathtrace.params.target_noise=0", "--set", "pathtrace.params.spp=2", "--out", str(out)],
+                          capture_output=True, text=True, cwd=SRC)
+    assert proc.returncode == 0, proc.stderr
+    assert "warning" not in proc.stderr, proc.stderr
+    assert (out / "final.png").stat().st_size > 0
+
+    before = scene.read_bytes()
+    proc = subprocess.run([sys.executable, str(script), str(scene)], capture_output=True, text=True)
+    assert proc.returncode != 0 and "--force" in proc.stderr
+    assert scene.read_bytes() == before
