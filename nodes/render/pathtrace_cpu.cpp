@@ -976,7 +976,6 @@ struct CpuPathTracer::Impl {
         s.boundary = boundsVolume(m, ref.primitive);
         s.inside = s.boundary && backFace;
         s.ior = iorFromF0(m.optics.y);
-        s.medium = m.volume;
         s.material = ref.material;
         s.eta = s.inside ? s.ior : 1.0f / s.ior;
         s.specular = materials.materialSpecular(m, uv0, uv1);

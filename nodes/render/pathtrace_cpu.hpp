@@ -80,11 +80,11 @@ struct CpuSurface {
     // a blended surface's alpha, else 1; KHR_materials_transmission's factor.
     float coverage = 1.0f, transmission = 0.0f;
     // KHR_materials_volume's boundary (shaders/pathtrace/volume.glsl): transmission and a thicknessFactor > 0; seen
-    // from inside (its back face); KHR_materials_ior; the volume's attenuationColor and attenuationDistance (0: none).
+    // from inside (its back face); KHR_materials_ior.
     bool boundary = false, inside = false;
     float ior = 1.5f;
-    glm::vec4 medium{1.0f, 1.0f, 1.0f, 0.0f};
-    // The volume's material (which of the media a path is in it bounds: shaders/pathtrace/media.glsl); the IOR on the
+    // The volume's material (which of the media a path is in it bounds, and their attenuation:
+    // shaders/pathtrace/media.glsl); the IOR on the
     // ray's side over the IOR across (against air; PathMedia::meet's in a medium); KHR_materials_specular's colour
     // (rgb) and strength (a), for an interface's Fresnel.
     uint32_t material = 0;

@@ -20,8 +20,8 @@
 #define PATHTRACE_MAX_MEDIA 4
 
 struct PathMedia {
-    uint count;                             // volumes the path is in
-    uint material[PATHTRACE_MAX_MEDIA];     // their materials, innermost (the last entered) last
+    uint count;                         // volumes the path is in
+    uint material[PATHTRACE_MAX_MEDIA]; // their materials, innermost (the last entered) last
 };
 
 PathMedia noMedia() {

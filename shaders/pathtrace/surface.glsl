@@ -41,8 +41,7 @@ struct PathSurface {
     bool boundary;
     bool inside; // the boundary seen from inside its volume (its back face)
     float ior;   // KHR_materials_ior of a transmissive surface
-    vec4 medium; // the volume's attenuationColor (rgb) and attenuationDistance (a; 0: no attenuation)
-    uint material; // the volume's material: which of the media a path is in it bounds (pathtrace/media.glsl)
+    uint material; // the volume's material: which media a path is in, and their attenuation (pathtrace/media.glsl)
     float eta;     // the IOR on the ray's side over the IOR across: against air here, meetBoundary's in a medium
     vec4 specular; // KHR_materials_specular's colour (rgb) and strength (a), for an interface's Fresnel
     // What thin-walled glass lets through is tinted by: 1, but for a KHR_materials_volume on faces that bound nothing
@@ -176,14 +175,12 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.dielectric = dielectricSpecular(0.04, materialSpecular(m, uv0, uv1, lod0));
 #ifdef PATHTRACE_SEE_THROUGH_SURFACE
     // As forward.transparent draws them: a mask's cut-off and a blend's alpha (the layers' alpha, not the vertex
-    // colour's), and for transmission the dielectric's F0 from KHR_materials_ior; KHR_materials_volume's boundary and
-    // the medium behind it.
+    // colour's), and for transmission the dielectric's F0 from KHR_materials_ior; KHR_materials_volume's boundary.
     s.coverage = m.info.z == 1u ? (l.albedo.a < m.emissive.a ? 0.0 : 1.0) : m.info.z == 2u ? clamp(l.albedo.a, 0.0, 1.0) : 1.0;
     s.transmission = m.optics.x;
     s.boundary = boundsVolume(m, prim);
     s.inside = s.boundary && backFace;
     s.ior = iorFromF0(m.optics.y);
-    s.medium = m.volume;
     s.material = ref.material;
     s.eta = s.inside ? s.ior : 1.0 / s.ior;
     s.specular = materialSpecular(m, uv0, uv1, lod0);
