@@ -967,7 +967,8 @@ struct CpuPathTracer::Impl {
         s.metallic = std::clamp(l.metallic, 0.0f, 1.0f);
         s.roughness = roughnessFromShininess(std::clamp(l.shininess, 0.0f, 1.0f));
         s.cavity = std::clamp(l.cavity, 0.0f, 1.0f);
-        s.dielectric = dielectricSpecular(0.04f, materials.materialSpecular(m, uv0, uv1));
+        s.specular = materials.materialSpecular(m, uv0, uv1);
+        s.dielectric = dielectricSpecular(0.04f, s.specular);
         // surface.glsl's PATHTRACE_SEE_THROUGH_SURFACE part: coverage, transmission and the volume's boundary.
         s.coverage = m.info.z == 1u   ? (l.albedo.a < m.emissive.a ? 0.0f : 1.0f)
                      : m.info.z == 2u ? std::clamp(l.albedo.a, 0.0f, 1.0f)
@@ -978,7 +979,6 @@ struct CpuPathTracer::Impl {
         s.ior = iorFromF0(m.optics.y);
         s.material = ref.material;
         s.eta = s.inside ? s.ior : 1.0f / s.ior;
-        s.specular = materials.materialSpecular(m, uv0, uv1);
         if (materialBoundsVolume(m) && !s.boundary && m.volume.a > 0.0f) { // faces that bound nothing: thin-walled
             const vec3 modelScale(glm::length(w[0]), glm::length(w[1]), glm::length(w[2]));
             const vec3 crossing = glm::normalize(glm::refract(direction, N, 1.0f / s.ior)) *

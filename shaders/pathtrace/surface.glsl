@@ -172,7 +172,8 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.cavity = clamp(l.cavity, 0.0, 1.0);
     // KHR_materials_specular over the fixed dielectric F0 of specularF0 (the tracer, like the G-buffer path, does
     // not read KHR_materials_ior).
-    s.dielectric = dielectricSpecular(0.04, materialSpecular(m, uv0, uv1, lod0));
+    vec4 specular = materialSpecular(m, uv0, uv1, lod0);
+    s.dielectric = dielectricSpecular(0.04, specular);
 #ifdef PATHTRACE_SEE_THROUGH_SURFACE
     // As forward.transparent draws them: a mask's cut-off and a blend's alpha (the layers' alpha, not the vertex
     // colour's), and for transmission the dielectric's F0 from KHR_materials_ior; KHR_materials_volume's boundary.
@@ -183,7 +184,7 @@ PathSurface pathSurface(BvhHit hit, vec3 origin, vec3 direction) {
     s.ior = iorFromF0(m.optics.y);
     s.material = ref.material;
     s.eta = s.inside ? s.ior : 1.0 / s.ior;
-    s.specular = materialSpecular(m, uv0, uv1, lod0);
+    s.specular = specular;
     s.attenuation = vec3(1.0);
     if (materialBoundsVolume(m) && !s.boundary && m.volume.a > 0.0) {
         vec3 modelScale = vec3(length(world[0]), length(world[1]), length(world[2]));

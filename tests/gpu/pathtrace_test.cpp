@@ -1192,6 +1192,12 @@ uint32_t absorbingVolume(SceneBuilder& b, const std::string& name, glm::vec3 col
     return m;
 }
 
+// A closed box of half extents `half` about `at` (a node named and meshed `name`): what the volume tests fill with a
+// volume material.
+void volumeBox(SceneBuilder& b, const std::string& name, glm::dvec3 half, uint32_t material, glm::dvec3 at) {
+    b.node(name, static_cast<int32_t>(b.mesh(name, closedBox(glm::vec3(half)), material)), glm::vec3(at));
+}
+
 // An unlit white wall facing +z at z, 2 half wide: what the volume tests see through their glass, with no sky.
 void unlitWhiteWall(SceneBuilder& b, float z, float half) {
     const uint32_t white = b.material("wall", glm::vec3(1.0f), 0.0f, 0.0f);
@@ -1457,11 +1463,8 @@ PATHTRACE_TEST(SunPassesAVolumeStraightOnByFresnelAndBeersLaw) {
     const SunlitGround g = traceSunlitGround(
         "pt_volume_roof", 48, 48,
         [&](SceneBuilder& b) {
-            const uint32_t glass = absorbingVolume(b, "glass", a, distance);
-            b.node("roof",
-                   static_cast<int32_t>(b.mesh(
-                       "roof", closedBox(glm::vec3(120.0f, static_cast<float>(thickness / 2.0), 120.0f)), glass)),
-                   glm::vec3(0.0f, 3.0f, 0.0f));
+            volumeBox(b, "roof", {120.0, thickness / 2.0, 120.0}, absorbingVolume(b, "glass", a, distance),
+                      {0.0, 3.0, 0.0});
             return b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f);
         },
         {{"spp", 4}}, 60.0);
@@ -1530,11 +1533,9 @@ PATHTRACE_TEST(NestedVolumesBendReflectAndAbsorbByTheMediaOnBothSides) {
     const int W = 40, H = 30;
     SceneBuilder b("pt_nested_volumes");
     const uint32_t glass = absorbingVolume(b, "glass", ag, 1.0), water = absorbingVolume(b, "water", aw, 1.0, nWater);
-    const glm::vec3 centre(0.0f, 0.0f, static_cast<float>(-depth - thickness / 2.0));
-    b.node("glass", static_cast<int32_t>(b.mesh("glass", closedBox(glm::vec3(10.0f, 10.0f, thickness / 2.0)), glass)),
-           centre);
-    b.node("water", static_cast<int32_t>(b.mesh("water", closedBox(glm::vec3(9.5f, 9.5f, inner / 2.0)), water)),
-           centre);
+    const glm::dvec3 centre(0.0, 0.0, -depth - thickness / 2.0);
+    volumeBox(b, "glass", {10.0, 10.0, thickness / 2.0}, glass, centre);
+    volumeBox(b, "water", {9.5, 9.5, inner / 2.0}, water, centre);
     unlitWhiteWall(b, -6.0f, 30.0f);
     b.camera({0.0f, 0.0f, 0.0f}, {0.4f, 0.3f, static_cast<float>(-depth)}, 1.2f);
     const double f0Water = interfaceF0(nGlass, nWater);
@@ -1567,10 +1568,8 @@ PATHTRACE_TEST(OverlappingVolumesTakeTheMediumEnteredLast) {
     const int W = 40, H = 30;
     SceneBuilder b("pt_overlapping_volumes");
     const uint32_t glass = absorbingVolume(b, "a", aA, 1.0), hollow = absorbingVolume(b, "b", aB, 1.0, 1.0);
-    b.node("a", static_cast<int32_t>(b.mesh("a", closedBox(glm::vec3(10.0f, 10.0f, 0.5f)), glass)),
-           glm::vec3(0.0f, 0.0f, -3.5f));
-    b.node("b", static_cast<int32_t>(b.mesh("b", closedBox(glm::vec3(9.0f, 9.0f, 0.5f)), hollow)),
-           glm::vec3(0.0f, 0.0f, -4.0f));
+    volumeBox(b, "a", {10.0, 10.0, 0.5}, glass, {0.0, 0.0, -3.5});
+    volumeBox(b, "b", {9.0, 9.0, 0.5}, hollow, {0.0, 0.0, -4.0});
     unlitWhiteWall(b, -6.0f, 30.0f);
     b.camera({0.0f, 0.0f, 0.0f}, {0.4f, 0.3f, -3.0f}, 1.2f);
     const double err = traceLayersAgainstWall(
@@ -1599,16 +1598,10 @@ PATHTRACE_TEST(SunPassesNestedVolumesAttenuatedByEachMedium) {
     const SunlitGround g = traceSunlitGround(
         "pt_nested_roof", 48, 48,
         [&](SceneBuilder& b) {
-            const uint32_t glass = absorbingVolume(b, "glass", ag, distance);
-            const uint32_t water = absorbingVolume(b, "water", aw, distance, 1.33);
-            b.node("roof",
-                   static_cast<int32_t>(b.mesh(
-                       "roof", closedBox(glm::vec3(120.0f, static_cast<float>(glassThickness / 2.0), 120.0f)), glass)),
-                   glm::vec3(0.0f, 3.0f, 0.0f));
-            b.node("water",
-                   static_cast<int32_t>(b.mesh(
-                       "water", closedBox(glm::vec3(110.0f, static_cast<float>(waterThickness / 2.0), 110.0f)), water)),
-                   glm::vec3(0.0f, 3.1f, 0.0f));
+            volumeBox(b, "roof", {120.0, glassThickness / 2.0, 120.0}, absorbingVolume(b, "glass", ag, distance),
+                      {0.0, 3.0, 0.0});
+            volumeBox(b, "water", {110.0, waterThickness / 2.0, 110.0}, absorbingVolume(b, "water", aw, distance, 1.33),
+                      {0.0, 3.1, 0.0});
             return b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f);
         },
         {{"spp", 4}}, 60.0);
@@ -1638,9 +1631,8 @@ PATHTRACE_TEST(SunLightsWhatLiesInsideAVolumeThroughItsMedium) {
     const SunlitGround g = traceSunlitGround(
         "pt_under_water", 48, 48,
         [&](SceneBuilder& b) {
-            const uint32_t water = absorbingVolume(b, "water", aw, distance, nWater);
-            b.node("water", static_cast<int32_t>(b.mesh("water", closedBox(glm::vec3(60.0f, 1.25f, 60.0f)), water)),
-                   glm::vec3(0.0f, static_cast<float>(depth - 1.25), 0.0f));
+            volumeBox(b, "water", {60.0, 1.25, 60.0}, absorbingVolume(b, "water", aw, distance, nWater),
+                      {0.0, depth - 1.25, 0.0});
             return b.material("ground", glm::vec3(0.5f), 0.0f, 0.0f);
         },
         {{"spp", 64}}, 60.0);
@@ -1684,16 +1676,9 @@ PATHTRACE_TEST(AirBubbleInGlassReflectsWholePastTheCriticalAngle) {
     const uint32_t glass = volumeGlass(b, "glass");
     const uint32_t air = volumeGlass(b, "bubble");
     b.s.materials[air].ior = 1.0f;
-    b.node("block", static_cast<int32_t>(b.mesh("block", closedBox(glm::vec3(10.0f, 10.0f, 1.0f)), glass)),
-           glm::vec3(centre));
+    volumeBox(b, "block", {10.0, 10.0, 1.0}, glass, centre);
     const glm::dquat turn = glm::angleAxis(angle, glm::dvec3(0, 1, 0));
-    b.node("bubble",
-           static_cast<int32_t>(
-               b.mesh("bubble",
-                      closedBox(glm::vec3(static_cast<float>(bubbleWidth), static_cast<float>(bubbleHeight),
-                                          static_cast<float>(bubbleHalf))),
-                      air)),
-           glm::vec3(centre));
+    volumeBox(b, "bubble", {bubbleWidth, bubbleHeight, bubbleHalf}, air, centre);
     b.s.nodes.back().local.rotation = glm::quat(turn);
     unlitWhiteWall(b, -6.0f, 4.0f);
     b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
