@@ -522,12 +522,20 @@ TEST_F(LightingTerms, SkyFallbackBlursTowardsItsShWithRoughness) {
 // --- The irradiance volume's lookup (issue 26) ------------------------------------------------------------------
 
 // test.linear_volume: what bake.lightmap hands lighting.deferred (its `volume` texture and `layout` grid), made up: a
-// 5^3 grid of probes 1 m apart around the origin whose SH9 holds only band 0, linear in the probe's position
-// (red along x, green along y, blue along z). Trilinear interpolation of a linear function is exact, so the SH a
-// point reads is that same function at the point it looks up.
+// 5^3 grid of probes 1 m apart around the origin whose SH9 coefficients are each linear in the probe's position:
+// band 0 red along x, green along y, blue along z; the eight higher coefficients small, each its own colour and
+// sign, so that a coefficient read from the wrong texel changes the light. Trilinear interpolation of a linear
+// function is exact, so the SH a point reads is that same function at the point it looks up.
 constexpr double kVolumeSpacing = 1.0;
 const glm::dvec3 kVolumeOrigin(-2.0), kVolumeSlope(0.5, 0.4, -0.45);
-glm::dvec3 linearVolumeBand0(glm::dvec3 p) { return glm::dvec3(1.0) + kVolumeSlope * p; }
+shading::Sh9 linearVolumeSh(glm::dvec3 p) {
+    shading::Sh9 sh{};
+    sh.c[0] = glm::dvec3(1.0) + kVolumeSlope * p;
+    const double scale = 1.0 + 0.1 * (p.x + p.y - p.z);
+    for (int k = 1; k < 9; ++k)
+        sh.c[k] = scale * 0.012 * glm::dvec3(k % 3 == 0 ? k : -k, k % 2 == 0 ? 0.5 * k : 4.0, 9 - k);
+    return sh;
+}
 
 class LinearVolume final : public Node {
 public:
@@ -546,12 +554,12 @@ public:
         for (int z = 0; z < kCount; ++z)
             for (int y = 0; y < kCount; ++y)
                 for (int x = 0; x < kCount; ++x) {
-                    const glm::dvec3 c = linearVolumeBand0(kVolumeOrigin + kVolumeSpacing * glm::dvec3(x, y, z));
+                    const shading::Sh9 sh = linearVolumeSh(kVolumeOrigin + kVolumeSpacing * glm::dvec3(x, y, z));
                     for (int k = 0; k < 9; ++k) {
                         float* px = volume.at(9 * x + k, y + kCount * z);
-                        px[0] = k == 0 ? float(c.r) : 0.0f;
-                        px[1] = k == 0 ? float(c.g) : 0.0f;
-                        px[2] = k == 0 ? float(c.b) : 0.0f;
+                        px[0] = float(sh.c[k].r);
+                        px[1] = float(sh.c[k].g);
+                        px[2] = float(sh.c[k].b);
                         px[3] = 1.0f;
                     }
                 }
@@ -582,8 +590,8 @@ const NodeRegistration kLinearVolume(linearVolumeSchema(), [] { return std::make
 
 // A matte sphere (radius 0.8 at the origin) lit by test.linear_volume alone: each pixel's diffuse_indirect is the
 // diffuse albedo x the SH irradiance of the volume read a quarter of a cell along the normal in front of the surface
-// point (bake/irradiance_volume.glsl), i.e. of band 0 = linearVolumeBand0(p + 0.25 s n), evaluated here with
-// core/shading's SH. Read at p itself the sphere's rim is off by up to 0.25 x slope / band 0 (~10 %), read behind it
+// point (bake/irradiance_volume.glsl), i.e. of linearVolumeSh(p + 0.25 s n), evaluated here with core/shading's
+// SH. Read at p itself the sphere's rim is off by up to 0.25 x slope / band 0 (~10 %), read behind it
 // twice that; the bound is 1 %.
 TEST_F(LightingTerms, IrradianceVolumeIsReadInFrontOfTheSurface) {
     const int W = 96, H = 96;
@@ -614,8 +622,7 @@ TEST_F(LightingTerms, IrradianceVolumeIsReadInFrontOfTheSurface) {
             glm::dvec3 p = cam.position + t * d, n = glm::normalize(p);
             if (glm::dot(n, -d) < 0.2) continue; // away from the silhouette
             auto expectedAt = [&](glm::dvec3 q) {
-                shading::Sh9 sh{};
-                sh.c[0] = linearVolumeBand0(q);
+                const shading::Sh9 sh = linearVolumeSh(q);
                 return albedo * glm::max(shading::shIrradiance(sh, n), 0.0) / kPi;
             };
             const glm::dvec3 expected = expectedAt(p + n * (0.25 * kVolumeSpacing));

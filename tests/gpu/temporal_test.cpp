@@ -22,11 +22,12 @@ using nlohmann::json;
 using namespace lighting;
 
 // test.frames: a uniform RGBA32F image of `a` on frame 0 and `b` afterwards (with `alternate`: a on even frames, b on
-// odd ones), or with `noise` a per-pixel, per-frame PCG hash in [0, 1) in every channel (noiseValue below).
+// odd ones), plus `odd_columns` in the odd columns, or with `noise` a per-pixel, per-frame PCG hash in [0, 1) in every
+// channel (noiseValue below).
 const char* kFramesSource = R"(#version 460
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) writeonly uniform image2D out_color;
-layout(push_constant) uniform Push { vec4 value; uint frame; uint noise; uint pad0; uint pad1; } pc;
+layout(push_constant) uniform Push { vec4 value; vec4 oddColumns; uint frame; uint noise; uint pad0; uint pad1; } pc;
 uint pcg(uint v) {
     uint state = v * 747796405u + 2891336453u;
     uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
@@ -35,7 +36,7 @@ uint pcg(uint v) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(out_color)))) return;
-    vec4 c = pc.value;
+    vec4 c = pc.value + ((p.x & 1) != 0 ? pc.oddColumns : vec4(0.0));
     if (pc.noise != 0u)
         for (int i = 0; i < 4; ++i)
             c[i] = float(pcg(uint(p.x) * 7919u + uint(p.y) * 104729u + pc.frame * 1299709u + uint(i) * 15485863u) >> 8u) / 16777216.0;
@@ -67,11 +68,12 @@ public:
         const Params& p = ctx.params();
         const uint32_t f = ctx.frameIndex();
         struct {
-            glm::vec4 value;
+            glm::vec4 value, oddColumns;
             uint32_t frame, noise, pad0, pad1;
         } push{};
         const bool second = p.getBool("alternate") ? f % 2 == 1 : f > 0;
         push.value = second ? p.getVec4("b") : p.getVec4("a");
+        push.oddColumns = p.getVec4("odd_columns");
         push.frame = f;
         push.noise = p.getBool("noise") ? 1u : 0u;
         const ImageDesc& out = ctx.output("color").desc();
@@ -94,6 +96,7 @@ NodeSchema framesSchema() {
     s.params = {{"a", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "frame 0"},
                 {"b", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "later frames"},
                 {"alternate", ParamType::Bool, false, {}, {}, {}, "a on even frames, b on odd ones"},
+                {"odd_columns", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "added in odd columns"},
                 {"noise", ParamType::Bool, false, {}, {}, {}, "per-pixel per-frame hash instead"},
                 {"half", ParamType::Bool, false, {}, {}, {}, "half the frame's size (rounded up)"}};
     return s;
@@ -433,21 +436,26 @@ TEST_F(Temporal, MovingObjectLeavesNoGhostAndDisocclusionRestartsTheCount) {
     EXPECT_EQ(full, background);
 }
 
-// gbuffer.temporal_filter on a uniform G-buffer normal target alternating between two normals (static, no velocity):
-// the history is the running blend avg_k = mix(n_k, avg_k-1, feedback), the output's normal is avg / |avg| and its
-// shininess 1 - toksvigRoughness(1 - s, |avg|) of core/shading (the G-buffer's own Toksvig formula). A depth change
-// beyond the tolerance restarts the blend (the raw normal and shininess come back).
+// gbuffer.temporal_filter on a G-buffer normal target alternating between two normals (static, no velocity; the depth
+// alternates by column): the history is the running blend avg_k = mix(n_k, avg_k-1, feedback), the output's normal is
+// avg / |avg| and its shininess 1 - toksvigRoughness(1 - s, |avg|) of core/shading (the G-buffer's own Toksvig
+// formula). A depth change beyond the tolerance restarts the blend (the raw normal and shininess come back).
 TEST_F(Temporal, GbufferFilterBlendsNormalsAndReducesShininessLikeToksvig) {
     const glm::vec3 na = glm::normalize(glm::vec3(0.3f, 1.0f, 0.1f)), nb = glm::normalize(glm::vec3(-0.4f, 1.0f, 0.5f));
     const glm::vec2 ea = shading::octEncode(na), eb = shading::octEncode(nb);
-    const float shininess = 0.85f, depth = 6.0f;
+    // The depth alternates by column (6 m, 9 m: beyond the tolerance), so a history tap one texel off is another
+    // surface's and left out.
+    const float shininess = 0.85f, depth = 6.0f, oddDepth = 3.0f;
     const double feedback = 0.6;
     const int w = 24, h = 16;
     for (int frames : {1, 2, 5}) {
         json nodes = {{"src",
                        {{"type", "test.frames"},
                         {"params",
-                         {{"a", {ea.x, ea.y, depth, shininess}}, {"b", {eb.x, eb.y, depth, shininess}}, {"alternate", true}}}}},
+                         {{"a", {ea.x, ea.y, depth, shininess}},
+                          {"b", {eb.x, eb.y, depth, shininess}},
+                          {"odd_columns", {0.0, 0.0, oddDepth, 0.0}},
+                          {"alternate", true}}}}},
                       {"filter",
                        {{"type", "gbuffer.temporal_filter"},
                         {"params", {{"feedback", feedback}}},
@@ -466,7 +474,7 @@ TEST_F(Temporal, GbufferFilterBlendsNormalsAndReducesShininessLikeToksvig) {
                 const float* o = out.at("out").at(x, y);
                 worstN = std::max(worstN, glm::length(glm::dvec3(shading::octDecode({o[0], o[1]})) - expectedNormal));
                 worstS = std::max(worstS, std::fabs(o[3] - expectedShininess));
-                EXPECT_EQ(o[2], depth);
+                EXPECT_EQ(o[2], depth + (x % 2 ? oddDepth : 0.0f));
                 const float* hh = out.at("history").at(x, y);
                 worstH = std::max(worstH, glm::length(glm::dvec3(hh[0], hh[1], hh[2]) - avg));
             }
