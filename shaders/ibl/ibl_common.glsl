@@ -5,8 +5,8 @@
 
 // Mip m of a prefiltered cube with `mipCount` levels is the radiance convolved with the GGX lobe of perceptual
 // roughness m / (mipCount - 1) (the G-buffer's roughness = 1 - shininess, see common/brdf.glsl): mip 0 is the
-// mirror, the last mip roughness 1.
-float iblRoughnessForMip(float mip, float mipCount) { return mipCount > 1.0 ? mip / (mipCount - 1.0) : 0.0; }
+// mirror, the last mip roughness 1 (ibl.capture gives each mip that roughness, nodes/ibl/capture.cpp). The mip a
+// roughness reads:
 float iblMipForRoughness(float roughness, float mipCount) { return clamp(roughness, 0.0, 1.0) * max(mipCount - 1.0, 0.0); }
 
 // The BRDF LUT: texel (u, v) = (NoV, perceptual roughness) holds (A, B) in .rg so that the directional albedo of

@@ -723,6 +723,35 @@ TEST_F(Gbuffer, BackFacesOfDoubleSidedMaterialsFaceTheViewer) {
     EXPECT_EQ(oneSidedPixels, 0);
 }
 
+// alphaMode MASK: three quads side by side, the base colour's alpha 0.45 and 0.55 with the cut-off at 0.5 (the left
+// one cut away, the middle one drawn), and 0.3 with the cut-off at 0.25 (drawn: the material's own cut-off decides).
+TEST_F(Gbuffer, AlphaMaskDrawsWhatReachesItsCutoff) {
+    SceneBuilder b;
+    const float alphas[3] = {0.45f, 0.55f, 0.3f}, cutoffs[3] = {0.5f, 0.5f, 0.25f};
+    for (int i = 0; i < 3; ++i) {
+        sc::Material m = singleLayer(0.5f);
+        m.layers[0].albedo.factor.a = alphas[i];
+        m.alphaMode = sc::AlphaMode::Mask;
+        m.alphaCutoff = cutoffs[i];
+        b.s.materials.push_back(m);
+        const std::string name = "mask" + std::to_string(i);
+        b.node(name, b.mesh(name, quadVertices(1.5f, {0, 0}, {1, 1}), kQuadIndices, static_cast<uint32_t>(i)),
+               at({-5.0f + 5.0f * static_cast<float>(i), 0, -4}, glm::quat(1, 0, 0, 0)));
+    }
+    b.cameraPath("look", 1.2f, {{0.0f, glm::vec3(0.0f), glm::quat(1, 0, 0, 0), 1.2f}});
+    const int w = 96, h = 32;
+    auto out = runGraph(gbufferGraph(b.write("alpha_mask"), w, h, json::object(), json::object()));
+    int drawn[3] = {0, 0, 0};
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (out["depth"].at(x, y)[0] > 0.0f) ++drawn[std::min(3 * x / w, 2)];
+    std::printf("alpha mask: %d pixels drawn of the quad below its cut-off, %d and %d of those above it\n", drawn[0],
+                drawn[1], drawn[2]);
+    EXPECT_EQ(drawn[0], 0);
+    EXPECT_GT(drawn[1], 100);
+    EXPECT_GT(drawn[2], 100);
+}
+
 // ---------------------------------------------------------------------------------------------
 // 4. Toksvig through the G-buffer
 
