@@ -126,8 +126,12 @@ double rmse(const Image& a, const Image& b) {
 double maxAbsDiff(const Image& a, const Image& b) {
     if (!comparable(a, b)) return std::numeric_limits<double>::infinity();
     double m = 0.0;
-    for (size_t i = 0; i < a.pixels.size(); ++i)
-        m = std::max(m, static_cast<double>(std::fabs(a.pixels[i] - b.pixels[i])));
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        const double d = std::fabs(static_cast<double>(a.pixels[i]) - static_cast<double>(b.pixels[i]));
+        // A NaN on either side is as far as can be (std::max would skip it: a NaN output must not pass).
+        if (std::isnan(d)) return std::numeric_limits<double>::infinity();
+        m = std::max(m, d);
+    }
     return m;
 }
 

@@ -45,6 +45,6 @@ std::filesystem::path writeSceneGlb(scene::Scene& s, const std::string& name);
 glm::quat lookRotation(glm::vec3 eye, glm::vec3 target);
 
 double rmse(const Image& a, const Image& b); // over RGB
-double maxAbsDiff(const Image& a, const Image& b);
+double maxAbsDiff(const Image& a, const Image& b); // over RGBA; infinity where either has a NaN, or the sizes differ
 
 } // namespace vitrine::test

@@ -381,6 +381,10 @@ TEST_F(IblCapture, DeterministicAndCachedByScenePlacementAndSun) {
     ASSERT_EQ(files().size(), 1u);
     const fs::path file = files()[0];
     const auto stamp = fs::last_write_time(file);
+    // Another capture in between (not cached), so that memory the next run is given holds other texels than the
+    // cached ones: a load that leaves texels unwritten must not pass on what the last capture left there.
+    registerScene("other_box", redBox({-0.4f, 0.8f, 0.6f}, {0.3f, 1.0f, 0.2f}));
+    ASSERT_NE(runCapture(captureGraph("other_box", proceduralSky(), uncached)).mips[0][1].pixels, a.mips[0][1].pixels);
     const Capture second = runCapture(captureGraph("cached_box", proceduralSky(), params));
     expectSame(second, a);
     EXPECT_EQ(fs::last_write_time(file), stamp) << "the second run captured again";

@@ -351,6 +351,60 @@ int countSpikes(const Image& s, double x, double y, double r) {
     return runs;
 }
 
+// post.flare and post.streaks composite: out = in + their layer (at 1 / downsample of the frame) read bilinearly at
+// each pixel's centre, zero outside, per channel. A coloured background and a coloured dot, so that a channel read
+// wrong or a layer shifted by a fraction of its pixel shows; the bound is RGBA16F's rounding.
+TEST_F(Lens, FlareAndStreaksAddTheirUpsampledLayerToTheImage) {
+    Image img(kFW, kFH);
+    for (int y = 0; y < kFH; ++y)
+        for (int x = 0; x < kFW; ++x) {
+            float* p = img.at(x, y);
+            p[0] = 0.1f + 0.3f * static_cast<float>(x) / kFW;
+            p[1] = 0.45f;
+            p[2] = 0.8f - 0.3f * static_cast<float>(y) / kFH;
+            p[3] = 1.0f;
+        }
+    addDot(img, 0.37 * kFW, 0.41 * kFH, 4.0, glm::vec3(300.0f, 120.0f, 40.0f));
+    const json flare = {{"downsample", kFactor}, {"ghost_intensity", 0.05}, {"halo_intensity", 0.02}};
+    const json streaks = {
+        {"downsample", kFactor}, {"length", 0.3}, {"strength", 0.2}, {"blades", 6}, {"f_number", 8.0}};
+    for (const auto& [type, params] : {std::pair<std::string, json>{"post.flare", flare}, {"post.streaks", streaks}}) {
+        SCOPED_TRACE(type);
+        const std::string layer = type == "post.flare" ? "flare" : "streaks";
+        json nodes = {{"in", loadNode(writeInput(img, "composite_dot"))},
+                      {"lens", {{"type", type}, {"params", params}, {"in", {{"color", "in.color"}}}}}};
+        auto out = runGraph(graph(nodes, {{"out", "lens.color"}, {"layer", "lens." + layer}}, kFW, kFH));
+        const Image& low = out.at("layer");
+        ASSERT_EQ(low.width, kFW / kFactor);
+        auto layerAt = [&](double px, double py, int c) { // bilinear, zero outside, at low-resolution position (px, py)
+            const double qx = px - 0.5, qy = py - 0.5;
+            const int ix = static_cast<int>(std::floor(qx)), iy = static_cast<int>(std::floor(qy));
+            const double fx = qx - ix, fy = qy - iy;
+            double sum = 0.0;
+            for (int k = 0; k < 4; ++k) {
+                const int tx = ix + (k & 1), ty = iy + (k >> 1);
+                if (tx < 0 || ty < 0 || tx >= low.width || ty >= low.height) continue;
+                sum += ((k & 1) ? fx : 1.0 - fx) * ((k >> 1) ? fy : 1.0 - fy) * low.at(tx, ty)[c];
+            }
+            return sum;
+        };
+        double worst = 0.0, added = 0.0;
+        for (int y = 0; y < kFH; ++y)
+            for (int x = 0; x < kFW; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const double l = layerAt((x + 0.5) / kFactor, (y + 0.5) / kFactor, c);
+                    const double expected = img.at(x, y)[c] + l;
+                    const double err = std::fabs(out.at("out").at(x, y)[c] - expected) / (1.0 + expected);
+                    worst = std::isnan(err) ? 1e30 : std::max(worst, err);
+                    added += l;
+                }
+        std::printf("%s composite: layer energy %.1f, worst relative error of in + layer %.2e\n", type.c_str(), added,
+                    worst);
+        EXPECT_GT(added, 100.0); // the layer is there
+        EXPECT_LT(worst, 2e-3);
+    }
+}
+
 TEST_F(Lens, StreakCountFollowsTheBladesAndLengthTheFNumber) {
     const glm::dvec2 cLow(kFW / 2.0 / kFactor, kFH / 2.0 / kFactor);
     Image img = blank(kFW, kFH);

@@ -716,13 +716,15 @@ TEST_F(Transparent, LightBehindRoughGlassShinesThroughItsTransmissionLobe) {
 }
 
 // A BLEND quad of alpha 1 is lit as lighting.deferred lights the same quad opaque: sun with shadows (half the quad
-// under an occluder), sky ambient diffuse and reflection, a point and a spot light, vertex AO, cavity, emission.
+// under an occluder), sky ambient diffuse and reflection, a point and a spot light, vertex AO, cavity, emission
+// (scaled by emissive_scale).
 // Base colour, AO and cavity are multiples of 1/255 so the G-buffer's UNORM8 stores them exactly; 1 % per channel
-// (octahedral RGBA16F normal, R11G11B10 emission, RGBA16F outputs). Coated: the same quad under a KHR_materials_clearcoat
-// of strength 1 and roughness 16/31 (values the G-buffer's 5-bit packing keeps exactly; the coat has no normal map, so
-// the deferred path's base normal is the coat's): the forward pass's coat, lit by the sun, the lights and the sky,
-// matches the deferred one within the same 1 %. Sheen: the same quad under a KHR_materials_sheen of colour
-// (1, 16/31, 10/15) and roughness 8/15 (kept exactly by the G-buffer's 5-5-4 + 4-bit packing), same bound.
+// (octahedral RGBA16F normal, R11G11B10 emission, RGBA16F outputs). Coated: the same quad under a
+// KHR_materials_clearcoat of strength 1 and roughness 16/31 (values the G-buffer's 5-bit packing keeps exactly; the
+// coat has no normal map, so the deferred path's base normal is the coat's): the forward pass's coat, lit by the sun,
+// the lights and the sky, matches the deferred one within the same 1 %. Sheen: the same quad under a
+// KHR_materials_sheen of colour (1, 16/31, 10/15) and roughness 8/15 (kept exactly by the G-buffer's 5-5-4 + 4-bit
+// packing), same bound.
 TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
     const int W = 64, H = 64;
     const glm::vec3 base(153.0f / 255.0f, 102.0f / 255.0f, 51.0f / 255.0f);
@@ -776,7 +778,8 @@ TEST_F(Transparent, OpaqueBlendQuadIsLitAsTheDeferredPath) {
     // gi: bake.lightmap's irradiance volume feeds both passes' ambient terms instead of the sky stand-in. Both
     // graphs bake the BLEND file (transparent primitives are not in the BVH), so both read the same volume.
     auto render = [&](bool transparent, bool gi) {
-        json params = {{"sky_ambient", 0.003}, {"sun_scale", 0.0005}};
+        // emissive_scale 3 on both passes: the emission is scaled alike.
+        json params = {{"sky_ambient", 0.003}, {"sun_scale", 0.0005}, {"emissive_scale", 3.0}};
         json nodes = pipeline(transparent ? blendGlb : opaqueGlb, params, params);
         if (gi) {
             nodes["bake_scene"] = {{"type", "scene.gltf"}, {"params", {{"path", blendGlb.string()}}}};
