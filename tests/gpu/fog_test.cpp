@@ -452,5 +452,69 @@ TEST_F(Fog, UpsampleDoesNotBleedAcrossDepthEdge) {
     EXPECT_GE(checked, W * H * 3 / 4);
 }
 
+// A pole narrower than a low-resolution texel, 2 m away in front of the far wall, placed between the centres of the
+// low-resolution texels: none of the 2x2 taps around its pixels sees it, every bilateral weight is nil, and the
+// composite takes the tap nearest in distance alone (fog/composite.comp), the far wall's fog. The pole's pixels are
+// fogged as the tap nearest in distance says, within 1 % of the fog (taking none would leave them unfogged).
+TEST_F(Fog, ThinFeatureTakesTheTapNearestInDistance) {
+    const int W = 64, H = 36;
+    const double sigma = 0.1, ambientScale = 4e-4, nearZ = 2.0, farZ = 20.0;
+    const double pixelX = 2.0 * nearZ * std::tan(0.45) * (double(W) / H) / W; // a pixel's width at the pole
+    std::vector<Tri> pole, farWall;
+    // Full-resolution columns 27.25 .. 28.75 (the low-resolution texels' centres are at columns 26 and 30).
+    addQuad(pole, {static_cast<float>(-4.0 * pixelX), 0.0f, static_cast<float>(-nearZ)},
+            {static_cast<float>(0.75 * pixelX), 0, 0}, {0, 5, 0}, {0, 0, 1}); // centre, half extents
+    addQuad(farWall, {0, 0, static_cast<float>(-farZ)}, {40, 0, 0}, {0, 40, 0}, {0, 0, 1});
+    FogWalls w = fogWalls("fog_pole", {pole, farWall});
+    auto out = runGraph(graph(fogNodes(w.glb, sigma, 0.25, ambientScale),
+                              {{"fogged", "composite.color"},
+                               {"color", "checker.color"},
+                               {"sh", "sky.sh"},
+                               {"distance", "fog.distance"},
+                               {"scatter", "fog.scatter"}},
+                              W, H));
+    const Image& lowDistance = out.at("distance");
+    const Image& scatter = out.at("scatter");
+    ASSERT_EQ(lowDistance.width, W / 4);
+    Pinhole cam(w.s, W, H);
+    int checked = 0;
+    double worst = 0.0, fogAmount = 0.0;
+    for (int y = 4; y < H - 4; ++y)
+        for (int x = 27; x <= 28; ++x) {
+            const glm::dvec3 d = cam.ray(x, y);
+            const double distance = (nearZ / -d.z) * glm::length(d);
+            // The 2x2 taps: every one the far wall's; the one nearest in distance is taken.
+            const double lx = (x + 0.5) / 4.0 - 0.5, ly = (y + 0.5) / 4.0 - 0.5;
+            double nearest = 1e30;
+            glm::dvec4 fog(0.0);
+            for (int j = 0; j < 2; ++j)
+                for (int i = 0; i < 2; ++i) {
+                    const int tx = std::clamp(int(std::floor(lx)) + i, 0, W / 4 - 1);
+                    const int ty = std::clamp(int(std::floor(ly)) + j, 0, H / 4 - 1);
+                    const double tapDistance = lowDistance.at(tx, ty)[0];
+                    ASSERT_GT(tapDistance, 0.5 * farZ) << "a tap sees the pole at " << x << "," << y;
+                    const double rel = std::abs(tapDistance - distance) / distance;
+                    if (rel < nearest) {
+                        nearest = rel;
+                        const float* s = scatter.at(tx, ty);
+                        fog = {s[0], s[1], s[2], s[3]};
+                    }
+                }
+            const glm::dvec3 colour = rgb(out.at("color"), x, y);
+            const glm::dvec3 expected = colour * fog.a + glm::dvec3(fog);
+            const double range = glm::length(glm::dvec3(fog)) + glm::length(colour) * (1.0 - fog.a);
+            const double e = glm::length(rgb(out.at("fogged"), x, y) - expected) / range;
+            worst = std::max(worst, std::isnan(e) ? 1e30 : e);
+            fogAmount += 1.0 - fog.a;
+            ++checked;
+        }
+    std::printf("thin pole: %d pixels fogged by the tap nearest in distance (mean transmittance %.3f), max error %.3g "
+                "of the fog\n",
+                checked, 1.0 - fogAmount / checked, worst);
+    EXPECT_GE(checked, 50);
+    EXPECT_GT(fogAmount / checked, 0.5); // the far wall's fog is thick: taking no tap would show
+    EXPECT_LT(worst, 0.01);
+}
+
 } // namespace
 } // namespace vitrine::test

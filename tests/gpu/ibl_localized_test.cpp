@@ -359,8 +359,13 @@ struct OverlapScene {
     glm::vec3 base{0.9f, 0.5f, 0.2f};
     float metallic = 0.4f, shininess = 0.6f;
 
-    OverlapScene() {
-        room.build(b, b.material("m", base, metallic, shininess));
+    // vertexAo, cavity: the room's vertex AO (vertex colour alpha) and its material's cavity (1: neither darkens).
+    explicit OverlapScene(float vertexAo = 1.0f, float cavity = 1.0f) {
+        const uint32_t m = b.material("m", base, metallic, shininess);
+        b.s.materials[m].layers[0].cavity = {cavity, 0.0f};
+        room.build(b, m);
+        for (scene::Vertex& v : b.s.vertices)
+            v.color.a = vertexAo;
         b.camera({0.0f, 4.0f, 9.0f}, {0.0f, 0.5f, -2.0f}, 0.9f);
         b.sun({0.3f, 1.0f, 0.2f});
         Probe a;
@@ -536,12 +541,14 @@ TEST_F(IblLocalized, SpecularReadsThePrefilteredMipOfItsRoughness) {
     EXPECT_GT(checked[1], W * H / 10);
 }
 
-// lighting.deferred with ibl_specular: its specular_indirect is the IBL input (vertex AO and cavity are 1 here)
+// lighting.deferred with ibl_specular: its specular_indirect is the IBL input times the vertex AO and the cavity
 // and its colour changes by exactly the swap; with ibl_diffuse too (sky_ambient 0: no other indirect diffuse) the
-// colour gains ibl.diffuse.
+// colour gains ibl.diffuse times the same two.
 TEST_F(IblLocalized, LightingTakesItsIndirectTermsFromTheProbes) {
     const int W = 96, H = 64;
-    OverlapScene sc;
+    // Vertex AO and cavity (multiples of 1/255: the G-buffer's UNORM8 keeps them) darken both probe terms.
+    const double vertexAo = 153.0 / 255.0, cavity = 204.0 / 255.0;
+    OverlapScene sc(static_cast<float>(vertexAo), static_cast<float>(cavity));
     json nodes = iblNodes(sc.glb, sc.probes, {{"ibl", {{"blend", "b"}}}});
     json params = {{"sky_ambient", 0.0}, {"sun_scale", 0.0}};
     nodes["plain"] = lightingNode(params, false);
@@ -565,13 +572,14 @@ TEST_F(IblLocalized, LightingTakesItsIndirectTermsFromTheProbes) {
         for (int x = 0; x < W; ++x) {
             if (!sc.room.hit(cam.position, cam.ray(x, y))) continue;
             ++checked;
-            glm::dvec3 ibl = rgb(out.at("ibl_spec"), x, y);
-            EXPECT_EQ(rgb(out.at("spec_spec"), x, y), ibl) << x << "," << y;
+            glm::dvec3 ibl = rgb(out.at("ibl_spec"), x, y) * (vertexAo * cavity);
+            EXPECT_LT(glm::length(rgb(out.at("spec_spec"), x, y) - ibl), 2e-3 * (1e-3 + glm::length(ibl)))
+                << x << "," << y;
             glm::dvec3 rest = rgb(out.at("spec"), x, y) - ibl;
             glm::dvec3 plainRest = rgb(out.at("plain"), x, y) - rgb(out.at("plain_spec"), x, y);
             EXPECT_LT(glm::length(rest - plainRest), 2e-3 * (1.0 + glm::length(ibl))) << x << "," << y;
             glm::dvec3 gained = rgb(out.at("both"), x, y) - rgb(out.at("spec"), x, y);
-            glm::dvec3 diffuse = rgb(out.at("ibl_diffuse"), x, y);
+            glm::dvec3 diffuse = rgb(out.at("ibl_diffuse"), x, y) * (vertexAo * cavity);
             EXPECT_LT(glm::length(gained - diffuse), 2e-3 * (1.0 + glm::length(rgb(out.at("both"), x, y))))
                 << x << "," << y;
             changed = std::max(changed, glm::length(rgb(out.at("spec"), x, y) - rgb(out.at("plain"), x, y)));
