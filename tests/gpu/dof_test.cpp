@@ -19,6 +19,7 @@
 #include "core/scene/aperture.hpp"
 #include "core/shader/compiler.hpp"
 #include "tests/gpu/cli.hpp"
+#include "tests/gpu/post_test_util.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -270,6 +271,106 @@ TEST_F(Dof, PointLightBokehHasTheApertureShapeAndThinLensDiameter) {
         if (k.fNumber > 1.4) EXPECT_GT(match, turnedMatch + 0.05);
         else EXPECT_NEAR(match, turnedMatch, 0.02); // round: turning changes nothing
     }
+}
+
+// post.dof's classification (dof_classify.comp) against the rule written out here, on a colour image of its own
+// (image.load) over a wall far out of focus: a pixel scatters a sprite when its CoC is at least scatter_min_coc and
+// its luminance exceeds scatter_ratio times that of its 8 neighbours' mean (clamped at the frame's edge); the sprite
+// takes c - min(c, mean) per channel and the rest is left to gather. The background is coloured and varies per pixel
+// (a neighbourhood one row off or read with swapped channels gives other sprites); bright pixels of several colours,
+// some beside each other, stand out of it.
+TEST_F(Dof, SpritesTakeWhatStandsAboveTheNeighbourhoodMean) {
+    const int size = 64;
+    const double yfov = 0.3, z = 6.0, zf = 1.0; // a CoC of about 11 px
+    SceneBuilder b("dof_classify");
+    std::vector<Tri> wall;
+    addQuad(wall, {0.0f, 0.0f, static_cast<float>(-z)}, {20.0f, 0.0f, 0.0f}, {0.0f, 20.0f, 0.0f}, {0, 0, 1});
+    // A card in focus over the left of the frame: its pixels' CoC is below scatter_min_coc, so none scatters.
+    std::vector<Tri> card;
+    addQuad(card, {-0.1f, 0.0f, static_cast<float>(-zf)}, {0.05f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}, {0, 0, 1});
+    const uint32_t grey = emissive(b, "grey", glm::vec3(0.1f));
+    b.node("wall", static_cast<int32_t>(b.mesh("wall", wall, grey)));
+    b.node("card", static_cast<int32_t>(b.mesh("card", card, grey)));
+    b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, static_cast<float>(yfov));
+    Image colour(size, size);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            float* p = colour.at(x, y);
+            p[0] = 0.2f + 0.15f * std::sin(0.7f * static_cast<float>(x) + 0.3f * static_cast<float>(y));
+            p[1] = 0.5f + 0.2f * std::cos(0.45f * static_cast<float>(y));
+            p[2] = 0.9f + 0.3f * std::sin(0.21f * static_cast<float>(x * y));
+            p[3] = 1.0f;
+        }
+    const glm::vec3 bright[4] = {{40.0f, 8.0f, 2.0f}, {3.0f, 30.0f, 6.0f}, {1.0f, 4.0f, 60.0f}, {20.0f, 20.0f, 20.0f}};
+    for (int i = 0; i < 12; ++i) {
+        const int x = 5 + (i * 17) % 54, y = 6 + (i * 23) % 52;
+        for (int k = 0; k < 3; ++k)
+            colour.at(x, y)[k] = bright[i % 4][k];
+        if (i % 3 == 0) // a neighbour almost as bright: the mean is high there, the sprite smaller
+            for (int k = 0; k < 3; ++k)
+                colour.at(x + 1, y)[k] = 0.6f * bright[(i + 1) % 4][k];
+    }
+    const double ratio = 2.0, minCoc = 3.0;
+    json params = {{"f_number", 1.4},
+                   {"focus_distance", zf},
+                   {"max_coc", 24.0},
+                   {"scatter_ratio", ratio},
+                   {"scatter_min_coc", minCoc}};
+    json nodes = {{"scene", sceneNode(b.write())},
+                  {"gbuffer", gbufferNode()},
+                  {"in", post::loadNode(post::writeInput(colour, "dof_classify"))},
+                  {"dof", dofNode(params, "in.color")}};
+    auto out = runGraph(makeGraph(
+        nodes, {{"in", "in.color"}, {"coc", "dof.coc"}, {"sprites", "dof.sprites"}, {"count", "dof.sprite_count"}},
+        size, size));
+    const Image& in = out.at("in");
+    const Image& coc = out.at("coc");
+    auto luminance = [](glm::dvec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; };
+    auto at = [&](int x, int y) {
+        const float* p = in.at(std::clamp(x, 0, size - 1), std::clamp(y, 0, size - 1));
+        return glm::max(glm::dvec3(p[0], p[1], p[2]), glm::dvec3(0.0));
+    };
+    std::map<std::pair<int, int>, glm::dvec3> expected; // pixel -> the sprite's colour
+    int sharpBright = 0;                                // bright pixels on the card, which must not scatter
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            if (std::abs(coc.at(x, y)[0]) < minCoc) {
+                sharpBright += luminance(at(x, y)) > 1.0 ? 1 : 0;
+                continue;
+            }
+            glm::dvec3 mean(0.0);
+            for (int j = -1; j <= 1; ++j)
+                for (int i = -1; i <= 1; ++i)
+                    if (i != 0 || j != 0) mean += at(x + i, y + j) / 8.0;
+            const glm::dvec3 c = at(x, y);
+            if (luminance(c) > 0.0 && luminance(c) > ratio * luminance(mean)) expected[{x, y}] = c - glm::min(c, mean);
+        }
+    const int count = static_cast<int>(out.at("count").at(0, 0)[0]);
+    const Image& sprites = out.at("sprites");
+    int matched = 0;
+    double worst = 0.0;
+    for (int i = 0; i < std::min(count, sprites.width / 2); ++i) {
+        const float* pos = sprites.at(2 * i, 0);
+        const float* value = sprites.at(2 * i + 1, 0);
+        const auto it = expected.find({static_cast<int>(pos[0]), static_cast<int>(pos[1])});
+        if (it == expected.end()) {
+            ADD_FAILURE() << "a sprite at " << pos[0] << "," << pos[1] << " that the rule does not make";
+            continue;
+        }
+        ++matched;
+        for (int k = 0; k < 3; ++k) {
+            const double e = std::fabs(value[k] - it->second[k]) / (1e-3 + it->second[k]);
+            worst = std::isnan(e) ? 1e30 : std::max(worst, e);
+        }
+    }
+    std::printf("dof classification: %d sprites (the rule: %zu; %d bright pixels in focus left out), worst relative "
+                "error of their colour %.2e\n",
+                count, expected.size(), sharpBright, worst);
+    EXPECT_GE(sharpBright, 2);
+    EXPECT_EQ(count, static_cast<int>(expected.size()));
+    EXPECT_EQ(matched, count);
+    EXPECT_GE(count, 8);
+    EXPECT_LT(worst, 1e-4);
 }
 
 // With camera_state connected, post.dof and post.airy read the f-number (and the aperture's roundness and area at
