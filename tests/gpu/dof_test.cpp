@@ -835,6 +835,73 @@ TEST_F(Dof, ResolvedCocHasNoGhostOnDisocclusion) {
     EXPECT_GT(changed, 200);
     EXPECT_LT(worst, 1e-4 * maxCoc);
 }
+// The CoC history's reprojection: a plane close to the camera, tilted both ways (so the CoC changes along x and y),
+// still, with a velocity input of (0.3, 0.6) px a frame from test.frames. Frame 1's CoC is then, written out here
+// from the resolve's description, mix(c, clamp(h, lo, hi), coc_feedback): c this frame's thin-lens CoC (frame 0's
+// output, the same still scene), lo / hi its 3x3 range (taps past the frame read its edge), h the bilinear blend of
+// frame 0's CoC at p + 0.5 - v (taps clamped to the frame; no history where that point lies outside it, the first
+// row here). Bound 1e-4 of max_coc (float32); the history must move the CoC by 20x that somewhere.
+TEST_F(Dof, ResolvedCocReprojectsItsHistoryBilinearly) {
+    const int W = 48, H = 32;
+    const double yfov = 0.3, fNumber = 1.4, zf = 2.0, maxCoc = 24.0, feedback = 0.9;
+    const glm::vec2 v(0.3f, 0.6f);
+    SceneBuilder b("dof_reproject");
+    std::vector<Tri> tris;
+    addQuad(tris, {0.0f, 0.0f, -0.35f}, {0.4f, 0.0f, 0.3f}, {0.0f, 0.3f, 0.3f},
+            glm::normalize(glm::vec3(-0.75f, -1.0f, 1.0f)));
+    b.node("plane", static_cast<int32_t>(b.mesh("plane", tris, emissive(b, "grey", glm::vec3(0.5f)))));
+    b.camera({0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, static_cast<float>(yfov));
+    auto glb = b.write();
+    json dof =
+        dofNode({{"f_number", fNumber}, {"focus_distance", zf}, {"max_coc", maxCoc}, {"coc_feedback", feedback}});
+    dof["in"]["coc_history"] = "dof.coc@prev";
+    dof["in"]["velocity"] = "motion.color";
+    json nodes = {
+        {"scene", sceneNode(glb)},
+        {"gbuffer", gbufferNode()},
+        {"motion", {{"type", "test.frames"}, {"params", {{"a", {v.x, v.y, 0.0, 0.0}}, {"b", {v.x, v.y, 0.0, 0.0}}}}}},
+        {"dof", dof}};
+    auto frames = runEveryFrame(makeGraph(nodes, {{"coc", "dof.coc"}, {"depth", "gbuffer.depth"}}, W, H, 2));
+    const Image &raw = frames[0].at("coc"), &resolved = frames[1].at("coc"), &depth = frames[0].at("depth");
+    auto c = [&](int x, int y) { return double(raw.at(std::clamp(x, 0, W - 1), std::clamp(y, 0, H - 1))[0]); };
+    double worst = 0.0, moved = 0.0, worstRaw = 0.0;
+    int outside = 0, inRange = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const double d = depth.at(x, y)[0];
+            ASSERT_GT(d, 0.0) << "the plane covers pixel " << x << "," << y;
+            worstRaw = std::max(worstRaw, std::abs(c(x, y) - std::clamp(thinLensCoc(kZNear / d, zf, yfov, fNumber, H),
+                                                                        -maxCoc, maxCoc)));
+            double lo = c(x, y), hi = c(x, y);
+            for (int i = 0; i < 9; ++i) {
+                lo = std::min(lo, c(x + i % 3 - 1, y + i / 3 - 1));
+                hi = std::max(hi, c(x + i % 3 - 1, y + i / 3 - 1));
+            }
+            const glm::dvec2 prev = glm::dvec2(x, y) + 0.5 - glm::dvec2(v);
+            double expected = c(x, y);
+            if (prev.x >= 0.0 && prev.y >= 0.0 && prev.x <= W && prev.y <= H) {
+                const glm::dvec2 s = prev - 0.5, bl = glm::floor(s), f = s - bl;
+                const int bx = int(bl.x), by = int(bl.y);
+                const double h = glm::mix(glm::mix(c(bx, by), c(bx + 1, by), f.x),
+                                          glm::mix(c(bx, by + 1), c(bx + 1, by + 1), f.x), f.y);
+                inRange += h > lo && h < hi;
+                expected = glm::mix(c(x, y), std::clamp(h, lo, hi), feedback);
+            } else {
+                ++outside;
+            }
+            moved = std::max(moved, std::abs(expected - c(x, y)));
+            worst = std::max(worst, std::abs(resolved.at(x, y)[0] - expected));
+        }
+    std::printf("CoC reprojection: frame 0 within %.2e px of the thin lens; history moves the CoC by up to %.3f px "
+                "(%d pixels inside their range, %d from outside the frame); worst |GPU - resolve| %.2e px\n",
+                worstRaw, moved, inRange, outside, worst);
+    EXPECT_LT(worstRaw, 1e-4 * maxCoc);
+    EXPECT_LT(worst, 1e-4 * maxCoc);
+    EXPECT_GT(moved, 0.05);
+    EXPECT_GT(inRange, W * H / 2);
+    EXPECT_EQ(outside, W);
+}
+
 // ---------------------------------------------------------------------------------------------
 // 4. TAA jitter + DOF on a moving shot
 

@@ -470,6 +470,63 @@ PATHTRACE_TEST(ClearcoatDirectSunMatchesItsClosedForm) {
     EXPECT_GT(coatMatters, 2.0);
 }
 
+// clearcoatNormalTexture in the tracers: the coated ground above with a coat normal map of one texel, the unit
+// tangent-space normal about (0.30, -0.15, 0.94) stored as UNORM8 and scaled by 0.8 (the coat's tangent-space normal
+// is (2 t - 1) with its xy scaled, as a layer's normal map), while the base keeps the vertex normal. The ground's
+// tangent frame is that of lighting_scene's vertex(): t = +z, b = n x t = +x. The closed form is brdfCosineClearcoat
+// with the coat normal decoded here from the stored bytes; the tilt moves the coat's highlight (checked: the untilted
+// coat differs by more than 2x somewhere), so a wrong decode, a dropped scale or swapped channels all show. Bound
+// 1 % per channel where the expected value is above 1 % of the brightest.
+PATHTRACE_TEST(ClearcoatNormalMapTiltsOnlyTheCoat) {
+    const float shininess = 0.55f, c = 0.8f, coatRoughness = 0.2f, scale = 0.8f;
+    const glm::vec3 base(0.05f);
+    const uint8_t texel[4] = {166, 108, 248, 255}; // (0.30, -0.15, 0.94) x 0.5 + 0.5, rounded
+    const SunlitGround g = traceSunlitGround("pt_clearcoat_normal", 64, 64, [&](SceneBuilder& b) {
+        scene::TextureImage img;
+        img.name = "coat_normal";
+        img.width = img.height = 2;
+        img.pixels.resize(2 * 2 * 4);
+        for (size_t i = 0; i < img.pixels.size(); ++i)
+            img.pixels[i] = texel[i % 4];
+        b.s.images.push_back(std::move(img));
+        scene::Texture t;
+        t.name = "coat_normal";
+        t.image = static_cast<uint32_t>(b.s.images.size() - 1);
+        t.usage = scene::TextureUsage::Normal;
+        b.s.textures.push_back(t);
+        uint32_t m = b.material("coated", base, 0.0f, shininess);
+        b.s.materials[m].clearcoat = c;
+        b.s.materials[m].clearcoatRoughness = coatRoughness;
+        b.s.materials[m].clearcoatNormal.scale = scale;
+        b.s.materials[m].clearcoatNormal.texture.texture = static_cast<int32_t>(b.s.textures.size() - 1);
+        return m;
+    });
+    const glm::vec3 n(0, 1, 0), t(0, 0, 1), bt(1, 0, 0);
+    glm::vec3 cts = glm::vec3(texel[0], texel[1], texel[2]) / 255.0f * 2.0f - 1.0f;
+    cts = glm::normalize(glm::vec3(cts.x * scale, cts.y * scale, cts.z));
+    const glm::vec3 nc = glm::normalize(t * cts.x + bt * cts.y + n * cts.z);
+    const float roughness = shading::roughnessFromShininess(shininess);
+    const glm::vec4 plain = shading::dielectricSpecular(0.04f, glm::vec4(1.0f));
+    std::vector<std::pair<glm::ivec2, glm::dvec3>> expected;
+    double tiltMatters = 0.0;
+    for (const auto& [px, d] : g.pixels) {
+        glm::vec3 v(-d), lf(g.toSun);
+        const glm::vec2 coat(c, coatRoughness);
+        glm::dvec3 e =
+            glm::dvec3(shading::brdfCosineClearcoat(n, nc, v, lf, base, 0.0f, roughness, plain, coat)) * g.sunE;
+        glm::dvec3 flat =
+            glm::dvec3(shading::brdfCosineClearcoat(n, n, v, lf, base, 0.0f, roughness, plain, coat)) * g.sunE;
+        tiltMatters = std::max(tiltMatters, std::max(e.r / std::max(flat.r, 1e-9), flat.r / std::max(e.r, 1e-9)));
+        expected.push_back({px, e});
+    }
+    const auto [checked, worst] = expectPixels(g.out.at("pt"), expected, 0.01);
+    std::printf("%s tracer, clear coat with its own normal map: %d pixels, worst relative error %.4f, tilted / flat "
+                "coat up to %.1fx apart\n",
+                gBackend, checked, worst, tiltMatters);
+    EXPECT_GE(checked, 300);
+    EXPECT_GT(tiltMatters, 2.0);
+}
+
 // Energy of the coat's lobe in the tracers' sampling: a white rough dielectric sphere (shininess 0.35) under a full
 // coat of roughness 0.4, alone under a uniform sky C (the furnace above). Its radiance is C times the coated BRDF's
 // directional albedo at NoV, integrated here on a fine grid from core/shading brdfCosineClearcoat; a coat lobe sampled

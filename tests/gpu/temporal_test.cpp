@@ -22,12 +22,12 @@ using nlohmann::json;
 using namespace lighting;
 
 // test.frames: a uniform RGBA32F image of `a` on frame 0 and `b` afterwards (with `alternate`: a on even frames, b on
-// odd ones), plus `odd_columns` in the odd columns, or with `noise` a per-pixel, per-frame PCG hash in [0, 1) in every
-// channel (noiseValue below).
+// odd ones), plus `odd_columns` in the odd columns and `odd_rows` in the odd rows, or with `noise` a per-pixel,
+// per-frame PCG hash in [0, 1) in every channel (noiseValue below).
 const char* kFramesSource = R"(#version 460
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) writeonly uniform image2D out_color;
-layout(push_constant) uniform Push { vec4 value; vec4 oddColumns; uint frame; uint noise; uint pad0; uint pad1; } pc;
+layout(push_constant) uniform Push { vec4 value; vec4 oddColumns; vec4 oddRows; uint frame; uint noise; uint pad0; uint pad1; } pc;
 uint pcg(uint v) {
     uint state = v * 747796405u + 2891336453u;
     uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
@@ -36,7 +36,7 @@ uint pcg(uint v) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(p, imageSize(out_color)))) return;
-    vec4 c = pc.value + ((p.x & 1) != 0 ? pc.oddColumns : vec4(0.0));
+    vec4 c = pc.value + ((p.x & 1) != 0 ? pc.oddColumns : vec4(0.0)) + ((p.y & 1) != 0 ? pc.oddRows : vec4(0.0));
     if (pc.noise != 0u)
         for (int i = 0; i < 4; ++i)
             c[i] = float(pcg(uint(p.x) * 7919u + uint(p.y) * 104729u + pc.frame * 1299709u + uint(i) * 15485863u) >> 8u) / 16777216.0;
@@ -68,12 +68,13 @@ public:
         const Params& p = ctx.params();
         const uint32_t f = ctx.frameIndex();
         struct {
-            glm::vec4 value, oddColumns;
+            glm::vec4 value, oddColumns, oddRows;
             uint32_t frame, noise, pad0, pad1;
         } push{};
         const bool second = p.getBool("alternate") ? f % 2 == 1 : f > 0;
         push.value = second ? p.getVec4("b") : p.getVec4("a");
         push.oddColumns = p.getVec4("odd_columns");
+        push.oddRows = p.getVec4("odd_rows");
         push.frame = f;
         push.noise = p.getBool("noise") ? 1u : 0u;
         const ImageDesc& out = ctx.output("color").desc();
@@ -97,6 +98,7 @@ NodeSchema framesSchema() {
                 {"b", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "later frames"},
                 {"alternate", ParamType::Bool, false, {}, {}, {}, "a on even frames, b on odd ones"},
                 {"odd_columns", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "added in odd columns"},
+                {"odd_rows", ParamType::Vec4, json::array({0.0, 0.0, 0.0, 0.0}), {}, {}, {}, "added in odd rows"},
                 {"noise", ParamType::Bool, false, {}, {}, {}, "per-pixel per-frame hash instead"},
                 {"half", ParamType::Bool, false, {}, {}, {}, "half the frame's size (rounded up)"}};
     return s;
@@ -250,15 +252,17 @@ TEST_F(Temporal, OneStepWeightsMatchTheirFormulas) {
 }
 
 // A partial disocclusion inside the history's bilinear footprint: per-pixel noise as colour and as view depth (both
-// frames differ everywhere), a uniform velocity of (0.5, 0.25) px so that every pixel's history is a 2x2 bilinear
-// fetch with weights (0.5 x 0.25 .. 0.5 x 0.75), and a depth tolerance of 30 % that rejects some of the four taps at
+// frames differ everywhere), a uniform velocity of (0.6, -0.25) px so that every pixel's history is a 2x2 bilinear
+// fetch with weights (0.4 x 0.25 .. 0.6 x 0.75), and a depth tolerance of 30 % that rejects some of the four taps at
 // most pixels. The history is then the mean of the accepted taps' last outputs with their bilinear weights, divided
 // by the sum of those weights (renormalised), recomputed here from the same hash; the output is its running blend
-// with this frame, n = 1: mix(current, history, 1/2); all four taps rejected: current alone.
+// with this frame, n = 1: mix(current, history, 1/2); all four taps rejected: current alone. The whole frame is
+// checked: the first column's points came from outside it (no history), the last row's taps below the frame read
+// its edge.
 TEST_F(Temporal, PartlyRejectedBilinearHistoryIsRenormalised) {
     const int w = 32, h = 24;
     const double tolerance = 0.3;
-    const glm::vec2 velocity(0.5f, 0.25f);
+    const glm::vec2 velocity(0.6f, -0.25f);
     json nodes = {{"src", {{"type", "test.frames"}, {"params", {{"noise", true}}}}},
                   {"depth", {{"type", "test.frames"}, {"params", {{"noise", true}}}}},
                   {"vel", framesNode(glm::vec4(velocity, 0.0f, 0.0f), glm::vec4(velocity, 0.0f, 0.0f))},
@@ -271,25 +275,29 @@ TEST_F(Temporal, PartlyRejectedBilinearHistoryIsRenormalised) {
     json g = graph(nodes, {{"out", "acc.color"}, {"samples", "acc.samples"}}, w, h);
     g["frame"]["frames"] = 2;
     auto out = runGraph(g);
-    int partial = 0, all = 0, none = 0, ambiguous = 0;
+    int partial = 0, all = 0, none = 0, ambiguous = 0, outside = 0, edge = 0;
     double worst = 0.0;
-    for (int y = 1; y < h - 1; ++y)
-        for (int x = 1; x < w - 1; ++x) {
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
             const double here = noiseValue(x, y, 1, 2);
-            // The reprojected point (x + 0.5, y + 0.5) - velocity lies between texels x-1, x and y-1, y.
-            const double fx = 1.0 - velocity.x, fy = 1.0 - velocity.y; // its offset from texel (x-1, y-1): 0.5, 0.75
+            // The reprojected point (x + 0.5, y + 0.5) - velocity, between texels b and b + 1 at offset f; none
+            // outside the frame, and taps past its edge read the edge.
+            const glm::dvec2 prev = glm::dvec2(x, y) + 0.5 - glm::dvec2(velocity);
+            const bool inside = prev.x >= 0.0 && prev.y >= 0.0 && prev.x <= w && prev.y <= h;
+            const glm::dvec2 b = glm::floor(prev - 0.5), f = prev - 0.5 - b;
             glm::dvec4 sum(0.0);
             double total = 0.0;
             int accepted = 0;
             bool nearThreshold = false;
-            for (int j = 0; j < 2; ++j)
+            for (int j = 0; j < 2 && inside; ++j)
                 for (int i = 0; i < 2; ++i) {
-                    const int qx = x - 1 + i, qy = y - 1 + j;
+                    const int qx = std::clamp(int(b.x) + i, 0, w - 1), qy = std::clamp(int(b.y) + j, 0, h - 1);
+                    edge += qx != int(b.x) + i || qy != int(b.y) + j;
                     const double before = noiseValue(qx, qy, 0, 2);
                     const double rel = std::fabs(before - here) / std::max(before, here);
                     nearThreshold = nearThreshold || std::fabs(rel - tolerance) < 1e-3;
                     if (rel > tolerance) continue;
-                    const double wt = (i == 0 ? 1.0 - fx : fx) * (j == 0 ? 1.0 - fy : fy);
+                    const double wt = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
                     for (int c = 0; c < 4; ++c) sum[c] += wt * noiseValue(qx, qy, 0, c);
                     total += wt;
                     ++accepted;
@@ -302,7 +310,10 @@ TEST_F(Temporal, PartlyRejectedBilinearHistoryIsRenormalised) {
             for (int c = 0; c < 4; ++c) current[c] = noiseValue(x, y, 1, c);
             const glm::dvec4 expected = accepted > 0 ? glm::mix(current, sum / total, 0.5) : current;
             const double expectedSamples = accepted > 0 ? 2.0 : 1.0;
-            if (accepted == 4) ++all;
+            if (!inside)
+                ++outside;
+            else if (accepted == 4)
+                ++all;
             else if (accepted == 0) ++none;
             else ++partial;
             for (int c = 0; c < 4; ++c) {
@@ -314,10 +325,12 @@ TEST_F(Temporal, PartlyRejectedBilinearHistoryIsRenormalised) {
             EXPECT_EQ(out.at("samples").at(x, y)[0], float(expectedSamples)) << "pixel " << x << "," << y;
         }
     std::printf("partial rejection: %d pixels with 1-3 of 4 taps accepted, %d with all, %d with none (%d near the "
-                "tolerance skipped); worst |output - CPU| %.2e\n",
-                partial, all, none, ambiguous, worst);
+                "tolerance skipped), %d from outside the frame, %d taps past its edge; worst |output - CPU| %.2e\n",
+                partial, all, none, ambiguous, outside, edge, worst);
     EXPECT_GT(partial, 200);
     EXPECT_GT(none, 10);
+    EXPECT_GT(outside, 20);
+    EXPECT_GT(edge, 20);
 }
 
 // A bright square sliding over a dark wall at ~4 px per frame, accumulated from the G-buffer's base colour (full
@@ -500,6 +513,88 @@ TEST_F(Temporal, GbufferFilterBlendsNormalsAndReducesShininessLikeToksvig) {
     const float* o = out.at("out").at(5, 5);
     EXPECT_LT(glm::length(shading::octDecode({o[0], o[1]}) - nb), 2e-3f);
     EXPECT_NEAR(o[3], shininess, 1e-3);
+}
+
+// gbuffer.temporal_filter under sub-pixel motion: a velocity input moves everything by v = (0.3, 0.7) px a frame, so
+// each pixel's history is the bilinear blend of four history texels around p + 0.5 - v (taps clamped to the frame; none
+// where that point is outside it, the first row here). The normal target changes by column and by row, so each axis'
+// weights show. Expected, written out here from the filter's description: history_0 = n_0; avg = mix(n_1, h / w,
+// feedback), h the weighted sum of the taps of the same surface (view depth within the tolerance) and w their
+// weights; output normal avg / |avg| and shininess 1 - toksvigRoughness(1 - s, |avg|). Two targets: one depth
+// everywhere (both axes' weights, the frame's edges), and the depth alternating by row (the other rows' taps left
+// out, so the kept weights sum to 0.3 or 0.7 and must be renormalised).
+TEST_F(Temporal, GbufferFilterFetchesItsHistoryBilinearlyAlongTheVelocity) {
+    const glm::vec2 ea = shading::octEncode(glm::normalize(glm::vec3(0.2f, 1.0f, -0.1f)));
+    const glm::vec2 eb = shading::octEncode(glm::normalize(glm::vec3(-0.3f, 1.0f, 0.4f)));
+    const glm::vec2 oddColumn(0.10f, -0.04f), oddRow(-0.03f, 0.12f);
+    const glm::vec2 v(0.3f, 0.7f);
+    const float shininess = 0.9f, depth = 6.0f, tolerance = 0.1f;
+    const double feedback = 0.7;
+    const int w = 20, h = 12;
+    for (const bool rowsApart : {false, true}) {
+        const float oddRowDepth = rowsApart ? 3.0f : 0.0f; // 9 m against 6 m: another surface
+        json nodes = {
+            {"src",
+             {{"type", "test.frames"},
+              {"params",
+               {{"a", {ea.x, ea.y, depth, shininess}},
+                {"b", {eb.x, eb.y, depth, shininess}},
+                {"odd_columns", {oddColumn.x, oddColumn.y, 0.0, 0.0}},
+                {"odd_rows", {oddRow.x, oddRow.y, oddRowDepth, 0.0}}}}}},
+            {"motion", framesNode(glm::vec4(v, 0.0f, 0.0f), glm::vec4(v, 0.0f, 0.0f))},
+            {"filter",
+             {{"type", "gbuffer.temporal_filter"},
+              {"params", {{"feedback", feedback}, {"depth_tolerance", tolerance}}},
+              {"in", {{"normal", "src.color"}, {"velocity", "motion.color"}, {"history", "filter.history@prev"}}}}}};
+        json g = graph(nodes, {{"out", "filter.normal"}, {"history", "filter.history"}}, w, h);
+        g["frame"]["frames"] = 2;
+        auto out = runGraph(g);
+        auto at = [&](glm::vec2 e, int x, int y) {
+            return glm::dvec3(
+                shading::octDecode(e + (x % 2 ? oddColumn : glm::vec2(0.0f)) + (y % 2 ? oddRow : glm::vec2(0.0f))));
+        };
+        auto depthAt = [&](int y) { return depth + (y % 2 ? oddRowDepth : 0.0f); };
+        double worstN = 0.0, worstS = 0.0, worstH = 0.0, moved = 0.0;
+        int partial = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const glm::dvec3 n1 = at(eb, x, y);
+                const glm::dvec2 prev = glm::dvec2(x, y) + 0.5 - glm::dvec2(v);
+                glm::dvec3 sum(0.0);
+                double weight = 0.0;
+                if (prev.x >= 0.0 && prev.y >= 0.0 && prev.x <= w && prev.y <= h) {
+                    const glm::dvec2 s = prev - 0.5, b = glm::floor(s), f = s - b;
+                    for (int j = 0; j < 2; ++j)
+                        for (int i = 0; i < 2; ++i) {
+                            const int tx = std::clamp(int(b.x) + i, 0, w - 1), ty = std::clamp(int(b.y) + j, 0, h - 1);
+                            const double d = depthAt(ty), here = depthAt(y);
+                            if (std::abs(d - here) > tolerance * std::max(d, here)) continue;
+                            const double wt = (i ? f.x : 1.0 - f.x) * (j ? f.y : 1.0 - f.y);
+                            sum += wt * at(ea, tx, ty);
+                            weight += wt;
+                        }
+                }
+                partial += weight > 1e-3 && weight < 0.99;
+                const glm::dvec3 avg = weight > 1e-3 ? glm::mix(n1, sum / weight, feedback) : n1;
+                const double len = glm::length(avg);
+                const double s = std::min<double>(
+                    shininess, 1.0 - shading::toksvigRoughness(1.0f - shininess, float(std::min(len, 1.0))));
+                const float* o = out.at("out").at(x, y);
+                worstN = std::max(worstN, glm::length(glm::dvec3(shading::octDecode({o[0], o[1]})) - avg / len));
+                worstS = std::max(worstS, std::fabs(o[3] - s));
+                const float* hh = out.at("history").at(x, y);
+                worstH = std::max(worstH, glm::length(glm::dvec3(hh[0], hh[1], hh[2]) - avg));
+                moved = std::max(moved, glm::length(avg / len - n1));
+            }
+        std::printf("%s: worst normal error %.2e, shininess %.2e, history %.2e; the history moves the normal by up to "
+                    "%.3f; %d pixels renormalise partial weights\n",
+                    rowsApart ? "rows 3 m apart" : "one depth", worstN, worstS, worstH, moved, partial);
+        EXPECT_LT(worstN, 3e-3);
+        EXPECT_LT(worstS, 2e-3);
+        EXPECT_LT(worstH, 2e-3);
+        EXPECT_GT(moved, 0.05);
+        EXPECT_EQ(partial > 0, rowsApart);
+    }
 }
 
 // The Museum's dolly shot (museum.json, 6 frames at 128x72): the filtered G-buffer's shininess is never above the
