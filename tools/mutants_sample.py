@@ -20,9 +20,10 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-# Tools rather than techniques (their own tests are elsewhere), and the path tracers (slow tests; audited apart).
-SKIP = ('shaders/compare/', 'shaders/debug/', 'shaders/pattern/', 'shaders/accel/', 'shaders/common/magma',
-        'shaders/pathtrace/', 'shaders/render/', 'shaders/reference/', 'shaders/bake/lightmap')
+# Tools rather than techniques (their own tests are elsewhere).
+SKIP = ('shaders/compare/', 'shaders/debug/', 'shaders/pattern/', 'shaders/accel/', 'shaders/common/magma')
+# The path tracers: their tests take minutes a mutation, so they are drawn only with --tracers (and then alone).
+TRACERS = ('shaders/pathtrace/', 'shaders/render/', 'shaders/reference/', 'shaders/bake/lightmap')
 
 
 def listed_tests(listing):
@@ -87,6 +88,8 @@ def main():
     parser.add_argument('--per-file', type=int, default=2, help='edits drawn per shader file')
     parser.add_argument('--match', default='', help='only shader files whose path contains this')
     parser.add_argument('--list', type=Path, default=ROOT / 'tests' / 'mutants.txt', help='the list to take tests from')
+    parser.add_argument('--tracers', action='store_true',
+                        help='draw from the path tracers\' shaders instead (slow tests: minutes a mutation)')
     args = parser.parse_args()
     if args.per_file < 1:
         parser.error('--per-file must be at least 1')
@@ -94,7 +97,9 @@ def main():
     tests = listed_tests(args.list)
     out = []
     for path in sorted(tests):
-        if path.startswith(SKIP) or args.match not in path or not (ROOT / path).is_file():
+        if path.startswith(SKIP) or path.startswith(TRACERS) != args.tracers:
+            continue
+        if args.match not in path or not (ROOT / path).is_file():
             continue
         lines = (ROOT / path).read_text().splitlines()
         candidates = []
