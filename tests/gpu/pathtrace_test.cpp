@@ -1581,15 +1581,18 @@ double traceLayersAgainstWall(SceneBuilder& b, int W, int H, const std::function
 // the rarer side) with F0 of each interface's two IORs (0.04 against air, ((1.5 - 1.33) / 2.83)^2 = 0.0036 between
 // glass and water) and pays Beer's law in each medium over its own way through it: the glass's over its two 0.3 m
 // parts, the water's over 0.4 m. What is seen is the wall through the seven layers (computed here per pixel by the
-// adding equations: every internal reflection). Bound: per channel, the mean over the pixels within 1 % (256 spp). The
-// water's F0 against air (0.02) instead of glass is 3 % off; one medium per path (the glass's forgotten after the
-// water) 21 % in green.
+// adding equations: every internal reflection). Bound: per channel, the mean over the pixels within 0.3 % (256 spp;
+// measured within 0.06 % by both tracers on lavapipe). The water's F0 against air (0.02) instead of glass is 3 % off;
+// one medium per path (the glass's forgotten after the water) 21 % in green; the water left into the wrong medium
+// (the slot above the stack's top read, which holds material 0: the water, made first for this) 0.6 % in green.
 PATHTRACE_TEST(NestedVolumesBendReflectAndAbsorbByTheMediaOnBothSides) {
     const double thickness = 1.0, inner = 0.4, depth = 3.0, nGlass = 1.5, nWater = 1.33;
     const glm::vec3 ag(0.9f, 0.5f, 0.9f), aw(0.4f, 0.9f, 0.9f);
     const int W = 40, H = 30;
     SceneBuilder b("pt_nested_volumes");
-    const uint32_t glass = absorbingVolume(b, "glass", ag, 1.0), water = absorbingVolume(b, "water", aw, 1.0, nWater);
+    // The water's material first: an empty slot of a path's media stack holds material 0, so a read one past the
+    // stack's top (for the medium around the innermost) must not find the glass there by chance.
+    const uint32_t water = absorbingVolume(b, "water", aw, 1.0, nWater), glass = absorbingVolume(b, "glass", ag, 1.0);
     const glm::dvec3 centre(0.0, 0.0, -depth - thickness / 2.0);
     volumeBox(b, "glass", {10.0, 10.0, thickness / 2.0}, glass, centre);
     volumeBox(b, "water", {9.5, 9.5, inner / 2.0}, water, centre);
@@ -1608,7 +1611,7 @@ PATHTRACE_TEST(NestedVolumesBendReflectAndAbsorbByTheMediaOnBothSides) {
             return (air + g + wet + w + wet + g + air).through;
         },
         "water in glass");
-    EXPECT_LT(err, 0.01);
+    EXPECT_LT(err, 0.003);
 }
 
 // Overlapping volumes (glTF gives them no priorities: the one entered last wins): a closed glass slab A (IOR 1.5,
