@@ -375,5 +375,50 @@ TEST_F(Reference, TwinsMatchLightingDeferredUnderAnOpenUniformSky) {
     }
 }
 
+// reference.substitute per channel, against its description written out here: out = clamp(color - technique + twin,
+// 0, 60000) per channel, alpha color's. Three test.frames images, each with its own colour and a pattern by column or
+// by row, so that every channel of every input differs from the others (the twins' tests light scenes by a grey sky,
+// where a channel swap shows nothing), and odd rows push red past 60000 and blue below 0.
+TEST_F(Reference, SubstituteReplacesTheTermChannelByChannel) {
+    const int W = 8, H = 6;
+    const glm::vec4 color(1.0f, 2.0f, 3.0f, 0.7f), colorOddColumns(0.5f, -0.25f, 0.125f, 0.0f),
+        colorOddRows(1e5f, 0.0f, 0.0f, 0.0f);
+    const glm::vec4 technique(0.2f, 0.9f, 0.4f, 0.1f), techniqueOddRows(0.0f, 0.0f, 5.0f, 0.0f);
+    const glm::vec4 twin(0.6f, 0.3f, 1.1f, 0.5f), twinOddColumns(0.0f, 0.7f, 0.0f, 0.0f);
+    auto frames = [](glm::vec4 a, glm::vec4 oddColumns, glm::vec4 oddRows) {
+        auto v = [](glm::vec4 x) { return json::array({x.x, x.y, x.z, x.w}); };
+        return json{{"type", "test.frames"},
+                    {"params", {{"a", v(a)}, {"b", v(a)}, {"odd_columns", v(oddColumns)}, {"odd_rows", v(oddRows)}}}};
+    };
+    json nodes = {{"color", frames(color, colorOddColumns, colorOddRows)},
+                  {"technique", frames(technique, glm::vec4(0.0f), techniqueOddRows)},
+                  {"twin", frames(twin, twinOddColumns, glm::vec4(0.0f))},
+                  {"sub",
+                   {{"type", "reference.substitute"},
+                    {"in", {{"color", "color.color"}, {"technique", "technique.color"}, {"twin", "twin.color"}}}}}};
+    const Image out = runGraph(graph(nodes, {{"out", "sub.color"}}, W, H)).at("out");
+    int clamped = 0;
+    double worst = 0.0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const glm::vec4 c =
+                color + (x % 2 ? colorOddColumns : glm::vec4(0.0f)) + (y % 2 ? colorOddRows : glm::vec4(0.0f));
+            const glm::vec4 t = technique + (y % 2 ? techniqueOddRows : glm::vec4(0.0f));
+            const glm::vec4 w = twin + (x % 2 ? twinOddColumns : glm::vec4(0.0f));
+            for (int ch = 0; ch < 4; ++ch) {
+                const double raw = double(c[ch]) - t[ch] + w[ch];
+                const double expected = ch == 3 ? c[3] : std::clamp(raw, 0.0, 60000.0);
+                clamped += ch < 3 && expected != raw;
+                const double got = out.at(x, y)[ch];
+                worst = std::max(worst, std::fabs(got - expected) / std::max(1.0, std::fabs(expected)));
+                EXPECT_NEAR(got, expected, 1e-5 * std::max(1.0, std::fabs(expected)))
+                    << "pixel " << x << "," << y << " channel " << ch;
+            }
+        }
+    std::printf("reference.substitute: %d of %d colour values clamped, worst relative error %.2e\n", clamped, W * H * 3,
+                worst);
+    EXPECT_EQ(clamped, H / 2 * W * 2); // odd rows: red above 60000 and blue below 0
+}
+
 } // namespace
 } // namespace vitrine::test
