@@ -158,28 +158,35 @@ std::vector<std::vector<uint8_t>> regionMasks(const RegionSet& set, const Image&
     return masks;
 }
 
-std::vector<RegionRatio> regionLuminanceRatios(const RegionSet& set, const Image& test, const Image& reference) {
+std::vector<RegionRatio> regionLuminanceRatios(const RegionSet& set, const Image& test, const Image& reference,
+                                               const Image* flipErrorMap) {
     if (test.width != reference.width || test.height != reference.height || test.empty())
         throw UserError("compare --regions: the images differ in size (" + std::to_string(test.width) + "x" +
                         std::to_string(test.height) + " and " + std::to_string(reference.width) + "x" +
                         std::to_string(reference.height) + ")");
+    if (flipErrorMap && (flipErrorMap->width != test.width || flipErrorMap->height != test.height))
+        throw UserError("compare --regions: the FLIP error map is " + std::to_string(flipErrorMap->width) + "x" +
+                        std::to_string(flipErrorMap->height) + ", the images " + std::to_string(test.width) + "x" +
+                        std::to_string(test.height));
     const auto masks = regionMasks(set, reference);
     std::vector<RegionRatio> out;
     for (size_t r = 0; r < set.regions.size(); ++r) {
         RegionRatio rr;
         rr.name = set.regions[r].name;
-        double lt = 0.0, lr = 0.0;
+        double lt = 0.0, lr = 0.0, flip = 0.0;
         for (int y = 0; y < test.height; ++y)
             for (int x = 0; x < test.width; ++x) {
                 if (!masks[r][static_cast<size_t>(y) * test.width + x]) continue;
                 lt += luminance(test.at(x, y));
                 lr += luminance(reference.at(x, y));
+                if (flipErrorMap) flip += flipErrorMap->at(x, y)[0];
                 ++rr.pixels;
             }
         const double nan = std::numeric_limits<double>::quiet_NaN();
         rr.test = rr.pixels ? lt / rr.pixels : nan;
         rr.reference = rr.pixels ? lr / rr.pixels : nan;
         rr.ratio = rr.pixels && lr > 0.0 ? lt / lr : nan;
+        rr.flip = rr.pixels && flipErrorMap ? flip / rr.pixels : nan;
         out.push_back(rr);
     }
     return out;

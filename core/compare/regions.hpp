@@ -54,11 +54,14 @@ struct RegionRatio {
     double test = 0.0;         // mean Rec. 709 luminance of the test over the region
     double reference = 0.0;    // of the reference
     double ratio = 0.0;        // test / reference (NaN when the reference's mean is 0)
+    double flip = 0.0;         // mean of the pair's FLIP error map over the region (NaN without a map, or empty)
 };
 
-// The mean luminance of test and reference over each region (masks from regionMasks(set, reference)). Throws
-// UserError when the images differ in size.
-std::vector<RegionRatio> regionLuminanceRatios(const RegionSet& set, const Image& test, const Image& reference);
+// The mean luminance of test and reference over each region (masks from regionMasks(set, reference)) and, given
+// the pair's FLIP error map (comparePair's flipErrorMap, channel 0; same size), its mean over each region: "FLIP
+// on the floor" as well as over the frame. Throws UserError when the images differ in size.
+std::vector<RegionRatio> regionLuminanceRatios(const RegionSet& set, const Image& test, const Image& reference,
+                                               const Image* flipErrorMap = nullptr);
 
 // The regions drawn over `base` (each region tinted in its own colour, its outline white): which pixels each
 // region took, for the report.

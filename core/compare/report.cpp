@@ -203,7 +203,8 @@ nlohmann::json metricsJson(const ReportInput& input) {
                                 {"pixels", r.pixels},
                                 {"test", finiteOrNull(r.test)},
                                 {"reference", finiteOrNull(r.reference)},
-                                {"ratio", finiteOrNull(r.ratio)}});
+                                {"ratio", finiteOrNull(r.ratio)},
+                                {"flip", finiteOrNull(r.flip)}});
             pairs.push_back({{"test", p.test}, {"reference", p.reference}, {"regions", list}});
         }
         doc["regions"] = {{"source", input.regions->source}, {"pairs", pairs}};

@@ -175,9 +175,11 @@ std::string noiseBadge(const PairMetrics& m) {
                                    : "<span class=\"noise beyond\">beyond reference noise</span>";
 }
 
-// compare --regions: one row per region, one column per pair (mean luminance test / reference).
+// compare --regions: one row per region, one column per pair (mean luminance test / reference, and the pair's FLIP
+// mean over the region).
 std::string regionsSection(const RegionTable& t) {
-    std::string html = "<h3>Regions</h3>\n<p class=\"dim\">Mean luminance ratio per region (test / reference), from " +
+    std::string html = "<h3>Regions</h3>\n<p class=\"dim\">Mean luminance ratio per region (test / reference) and, "
+                       "after it, the pair's FLIP mean over the region, from " +
                        escapeHtml(t.source) + (t.description.empty() ? "" : ": " + escapeHtml(t.description)) +
                        "</p>\n<div class=\"table-scroll\"><table><tr><th>region</th><th>pixels</th>";
     for (const RegionTable::Pair& p : t.pairs)
@@ -188,9 +190,12 @@ std::string regionsSection(const RegionTable& t) {
         html += "<tr><td>" + escapeHtml(t.pairs.front().regions[r].name) + "</td><td>" +
                 std::to_string(t.pairs.front().regions[r].pixels) + "</td>";
         for (const RegionTable::Pair& p : t.pairs) {
-            char cell[32];
-            const double v = p.regions[r].ratio;
-            if (std::isfinite(v)) std::snprintf(cell, sizeof cell, "%.3f", v);
+            char cell[64];
+            const double v = p.regions[r].ratio, f = p.regions[r].flip;
+            if (std::isfinite(v) && std::isfinite(f))
+                std::snprintf(cell, sizeof cell, "%.3f · FLIP %.4f", v, f);
+            else if (std::isfinite(v))
+                std::snprintf(cell, sizeof cell, "%.3f", v);
             else std::snprintf(cell, sizeof cell, "–");
             html += std::string("<td>") + cell + "</td>";
         }

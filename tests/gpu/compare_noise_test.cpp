@@ -261,6 +261,18 @@ TEST_F(CompareNoise, RegionsReportEachRegionsRatioOnTheChosenExrLayer) {
     EXPECT_EQ(regions[0]["pixels"], w * h / 2);
     EXPECT_NEAR(regions[0]["ratio"].get<double>(), 0.8, 1e-5);
     EXPECT_NEAR(regions[1]["ratio"].get<double>(), 1.5, 1e-5);
+    // Each region's FLIP: the mean of flip_a_b.exr (the pair's error map, as written) over the region's pixels.
+    const Image flip = loadExrLayer(dir / "out" / "flip_a_b.exr", "");
+    double flipSum[2] = {0.0, 0.0};
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            flipSum[x < w / 2 ? 0 : 1] += flip.at(x, y)[0];
+    for (int i = 0; i < 2; ++i) {
+        const double expected = flipSum[i] / (w * h / 2);
+        EXPECT_GT(expected, 0.01) << "the halves differ: FLIP must see it";
+        EXPECT_NEAR(regions[i]["flip"].get<double>(), expected, 1e-6) << i;
+    }
+    EXPECT_GT(regions[1]["flip"].get<double>(), regions[0]["flip"].get<double>()) << "x1.5 is further off than x0.8";
     EXPECT_NE(res.output.find("left half"), std::string::npos) << res.output;
     EXPECT_NE(res.output.find("1.500"), std::string::npos) << res.output;
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "out" / "regions.png"));

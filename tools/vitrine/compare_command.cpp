@@ -344,6 +344,9 @@ int compareCommand(const Args& args) {
     };
     // The noise floor first, so the pairs against the reference can be marked as they are computed.
     std::vector<PairJob> jobs;
+    // --regions: each pair's rows, computed with its FLIP error map while that is at hand.
+    std::vector<compare::RegionTable::Pair> regionPairs;
+    std::optional<compare::RegionTable::Pair> halfRegions;
     if (half) jobs.push_back({&*half, &*reference, "reference_half"});
     jobs.push_back({&a, &b, "a_b"});
     if (reference) {
@@ -358,6 +361,15 @@ int compareCommand(const Args& args) {
         compare::PairComparison pair =
             compare::comparePair(job.test->role, job.test->still, job.ref->role, job.ref->still, pairOptions);
         writeExr(out.claim("flip_" + job.name + ".exr"), pair.flipErrorMap, ExrPixelType::Float);
+        if (regions) {
+            compare::RegionTable::Pair rows{
+                job.test->role, job.ref->role,
+                compare::regionLuminanceRatios(*regions, job.test->still, job.ref->still, &pair.flipErrorMap)};
+            if (half && job.test == &*half)
+                halfRegions = std::move(rows);
+            else
+                regionPairs.push_back(std::move(rows));
+        }
         report.flipMaps.push_back(
             writeImage(out, "flip_" + job.name,
                        std::string(hdr ? "HDR" : "LDR") + "-FLIP " + job.test->role + " vs " + job.ref->role,
@@ -385,10 +397,9 @@ int compareCommand(const Args& args) {
         const Input& base = reference ? *reference : b;
         table.overlay = writeImage(out, "regions", "regions of " + regions->source + " over " + base.role,
                                    compare::regionOverlay(*regions, base.still), false);
-        for (const PairJob& job : jobs)
-            if (!(half && job.test == &*half))
-                table.pairs.push_back({job.test->role, job.ref->role,
-                                       compare::regionLuminanceRatios(*regions, job.test->still, job.ref->still)});
+        // The noise floor's pair last: each region's FLIP between the reference's halves, beside the others'.
+        table.pairs = std::move(regionPairs);
+        if (halfRegions) table.pairs.push_back(std::move(*halfRegions));
         report.regions = std::move(table);
     }
 
@@ -423,11 +434,12 @@ int compareCommand(const Args& args) {
         if (report.regions) {
             std::printf("%-22s %8s", "region", "pixels");
             for (const auto& p : report.regions->pairs)
-                std::printf("  %14s", (p.test + "/" + (p.reference == "reference" ? "R" : p.reference)).c_str());
-            std::printf("   (mean luminance ratio)\n");
+                std::printf("  %18s", (p.test + "/" + (p.reference == "reference" ? "R" : p.reference)).c_str());
+            std::printf("   (mean luminance ratio, FLIP mean)\n");
             for (size_t r = 0; r < regions->regions.size(); ++r) {
                 std::printf("%-22s %8d", regions->regions[r].name.c_str(), report.regions->pairs.front().regions[r].pixels);
-                for (const auto& p : report.regions->pairs) std::printf("  %14.3f", p.regions[r].ratio);
+                for (const auto& p : report.regions->pairs)
+                    std::printf("  %10.3f, %6.4f", p.regions[r].ratio, p.regions[r].flip);
                 std::printf("\n");
             }
         }

@@ -130,6 +130,32 @@ TEST(Regions, SplitByTheReferencesBrightness) {
     EXPECT_EQ(masks[1][5 * w + 5], 1);
 }
 
+// Given the pair's FLIP error map, each region's mean of it; without one, NaN; a map of another size is refused.
+TEST(Regions, FlipIsTheErrorMapsMeanOverEachRegion) {
+    const RegionSet set = parseRegions(nlohmann::json::parse(R"({"format": "vitrine-regions/1", "regions": [
+        {"name": "left", "polygons": [[[0, 0], [0.25, 0], [0.25, 1], [0, 1]]]},
+        {"name": "rest", "polygons": [[[0.25, 0], [1, 0], [1, 1], [0.25, 1]]]},
+        {"name": "nothing", "polygons": [[[0.01, 0.01], [0.02, 0.01], [0.01, 0.02]]]}]})"),
+                                       "test");
+    const int w = 8, h = 4;
+    const Image flat = constantImage(w, h, 1.0f, 1.0f, 1.0f);
+    Image error = constantImage(w, h, 0.0f, 0.0f, 0.0f);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            error.at(x, y)[0] = 0.01f * static_cast<float>(x + 10 * y); // channel 0 is the error
+            error.at(x, y)[1] = error.at(x, y)[2] = 0.9f;               // the others are not read
+        }
+    const auto rows = regionLuminanceRatios(set, flat, flat, &error);
+    ASSERT_EQ(rows.size(), 3u);
+    // left: x 0..1, y 0..3 -> mean x 0.5, mean y 1.5; rest: x 2..7 (mean 4.5).
+    EXPECT_NEAR(rows[0].flip, 0.01 * (0.5 + 15.0), 1e-6);
+    EXPECT_NEAR(rows[1].flip, 0.01 * (4.5 + 15.0), 1e-6);
+    EXPECT_TRUE(std::isnan(rows[2].flip)) << "an empty region has no mean";
+    EXPECT_TRUE(std::isnan(regionLuminanceRatios(set, flat, flat)[0].flip)) << "no map, no FLIP";
+    const Image small = constantImage(w / 2, h, 0.0f, 0.0f, 0.0f);
+    EXPECT_THROW(regionLuminanceRatios(set, flat, flat, &small), UserError);
+}
+
 TEST(Regions, TheMuseumsRegionsParseAndEachTakesPixels) {
     const RegionSet set = loadRegions(std::string(VITRINE_SOURCE_DIR) + "/graphs/regions/museum.regions.json");
     EXPECT_GE(set.regions.size(), 7u);
