@@ -22,6 +22,14 @@ float influenceDepth(const ReflectionProbe& probe, const glm::vec3& p) {
     return std::min(std::min(d.x, d.y), d.z);
 }
 
+float projectionDepth(const ReflectionProbe& probe, const glm::vec3& p) {
+    if (!probe.hasProjection()) return influenceDepth(probe, p);
+    ReflectionProbe proxy = probe;
+    proxy.center = probe.projectionCenter;
+    proxy.halfExtents = probe.projectionHalfExtents;
+    return influenceDepth(proxy, p);
+}
+
 float fadeWeight(const ReflectionProbe& probe, const glm::vec3& p) {
     float depth = influenceDepth(probe, p);
     if (probe.fade <= 0.0f) return depth >= 0.0f ? 1.0f : 0.0f;
@@ -112,15 +120,18 @@ private:
     std::string mAt;
 };
 
-const char* const kKeys[] = {"name", "position", "shape",    "center",     "halfExtents", "radius",
-                             "rotation", "fade", "priority", "extensions", "extras"};
+const char* const kKeys[] = {
+    "name",     "position", "shape",    "center",           "halfExtents",           "radius",
+    "rotation", "fade",     "priority", "projectionCenter", "projectionHalfExtents", "extensions",
+    "extras"};
 
 ReflectionProbe readProbe(const Json& j, const Where& where, const std::string& at) {
     if (!j.is_object()) where.fail(at, "expected a JSON object (a probe), got " + brief(j));
     for (const auto& item : j.items()) {
         if (std::find(std::begin(kKeys), std::end(kKeys), item.key()) == std::end(kKeys)) {
             where.fail(where.key(at, item.key()), "unknown key; expected name, position, shape, center, halfExtents "
-                                                  "(box), radius (sphere), rotation (box), fade, priority");
+                                                  "(box), radius (sphere), rotation (box), fade, priority, "
+                                                  "projectionCenter, projectionHalfExtents (box)");
         }
     }
     Reader r(where, j, at);
@@ -145,7 +156,20 @@ ReflectionProbe readProbe(const Json& j, const Where& where, const std::string& 
             r.fail("rotation", "expected a unit quaternion [x, y, z, w], got " + brief(*r.find("rotation")));
         // Unit quaternions written with float precision come back unchanged; only fix visible errors.
         p.rotation = std::abs(length - 1.0f) > 1e-6f ? rotation / length : rotation;
+        if (r.find("projectionHalfExtents")) {
+            p.projectionHalfExtents = glm::vec3(r.numbers("projectionHalfExtents", 3, glm::vec4(0.0f), true));
+            if (!(p.projectionHalfExtents.x > 0.0f && p.projectionHalfExtents.y > 0.0f &&
+                  p.projectionHalfExtents.z > 0.0f))
+                r.fail("projectionHalfExtents",
+                       "expected three numbers > 0, got " + brief(*r.find("projectionHalfExtents")));
+            p.projectionCenter = glm::vec3(r.numbers("projectionCenter", 3, glm::vec4(p.center, 0.0f), false));
+        } else if (r.find("projectionCenter")) {
+            r.fail("projectionCenter", "given without projectionHalfExtents; expected both (the parallax proxy box) "
+                                       "or neither (the influence volume is the proxy)");
+        }
     } else {
+        for (const char* key : {"projectionCenter", "projectionHalfExtents"})
+            if (r.find(key)) r.fail(key, "a sphere's parallax proxy is the sphere; projection boxes are for shape box");
         if (r.find("halfExtents")) r.fail("halfExtents", "a sphere takes radius; halfExtents is for shape box");
         if (r.find("rotation")) r.fail("rotation", "a sphere has no rotation; rotation is for shape box");
         if (!r.find("radius")) r.fail("radius", "missing; expected the sphere's radius in metres (> 0)");
@@ -165,6 +189,12 @@ ReflectionProbe readProbe(const Json& j, const Where& where, const std::string& 
                                std::to_string(-influenceDepth(p, p.position)) +
                                " m beyond its border); expected it inside: ibl.capture renders from it and the "
                                "parallax correction intersects the volume from it");
+    }
+    if (p.hasProjection() && projectionDepth(p, p.position) < -1e-3f) {
+        r.fail("position", "the capture point " + format(p.position) + " lies outside the projection box (" +
+                               std::to_string(-projectionDepth(p, p.position)) +
+                               " m beyond its border); expected it inside: the parallax correction looks up the "
+                               "cube from it towards where reflected rays leave that box");
     }
     return p;
 }
@@ -219,6 +249,10 @@ Json write(const std::vector<ReflectionProbe>& probes) {
         } else {
             j["halfExtents"] = vec3(p.halfExtents);
             j["rotation"] = Json::array({p.rotation.x, p.rotation.y, p.rotation.z, p.rotation.w});
+            if (p.hasProjection()) {
+                j["projectionCenter"] = vec3(p.projectionCenter);
+                j["projectionHalfExtents"] = vec3(p.projectionHalfExtents);
+            }
         }
         j["fade"] = p.fade;
         j["priority"] = p.priority;

@@ -22,6 +22,10 @@ inline bool insideInfluence(const ReflectionProbe& probe, const glm::vec3& p, fl
     return influenceDepth(probe, p) >= -margin;
 }
 
+// Signed distance from p to the border of the probe's parallax proxy (its projection box, else the influence
+// volume), positive inside.
+float projectionDepth(const ReflectionProbe& probe, const glm::vec3& p);
+
 // The fade weight of scene.hpp in [0, 1]: 0 on and outside the border, ramping linearly to 1 at `fade` metres
 // inside (a step at the border when fade is 0). A probe's blend weight is this times 16^priority. The CPU
 // reference of what ibl.localized draws.

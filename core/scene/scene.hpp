@@ -268,6 +268,12 @@ struct ReflectionProbe {
     // Overlapping probes blend by weight; a probe's weight is its fade weight times 16^priority, so a
     // higher-priority probe (an alcove inside a hall) dominates where both apply.
     int32_t priority = 0;
+    // The parallax correction's proxy [Lagarde12], apart from the influence volume: a box in the probe's own axes
+    // (`rotation`) standing for the surroundings the probe sees, e.g. the whole room around a small doorway volume.
+    // Box probes only; zero half extents (the default): the influence volume is the proxy.
+    glm::vec3 projectionCenter{0.0f};
+    glm::vec3 projectionHalfExtents{0.0f};
+    bool hasProjection() const { return projectionHalfExtents != glm::vec3(0.0f); }
 };
 
 // World transforms of every node and instance at one time.

@@ -1,6 +1,7 @@
 // Scene::contentHash() and Scene::validate(): the two whole-scene walks.
 
 #include "core/scene/hash.hpp"
+#include "core/scene/probes.hpp"
 #include "core/scene/scene.hpp"
 
 #include "core/base/error.hpp"
@@ -264,6 +265,10 @@ uint64_t Scene::hashContent(bool withProbes, bool withLightmapUvs) const {
             h.value(p.rotation);
             h.value(p.fade);
             h.value(p.priority);
+            if (p.hasProjection()) { // hashed only when set, so probes without a proxy keep their hashes
+                h.value(p.projectionCenter);
+                h.value(p.projectionHalfExtents);
+            }
         }
     }
     return h.result();
@@ -384,6 +389,14 @@ void Scene::validate() const {
         if (!(p.halfExtents.x > 0.0f) || (p.shape == ProbeShape::Box && !(p.halfExtents.y > 0.0f && p.halfExtents.z > 0.0f)))
             c.fail(e, "influence volume has no extent");
         if (!(p.fade >= 0.0f)) c.fail(e, "fade is negative");
+        if (p.hasProjection()) {
+            if (p.shape != ProbeShape::Box) c.fail(e, "has a projection box but is a sphere (its proxy is the sphere)");
+            if (!(p.projectionHalfExtents.x > 0.0f && p.projectionHalfExtents.y > 0.0f &&
+                  p.projectionHalfExtents.z > 0.0f))
+                c.fail(e, "projection box has no extent");
+            else if (projectionDepth(p, p.position) < -1e-3f)
+                c.fail(e, "capture point lies outside its projection box");
+        }
     }
     for (size_t i = 0; i < cameraPaths.size(); ++i) {
         const CameraPath& p = cameraPaths[i];

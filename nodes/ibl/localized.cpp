@@ -99,7 +99,18 @@ NodeSchema schema() {
          {},
          {},
          {},
-         "Box/sphere-projected lookup [Lagarde12]: exact for mirrors, wrong for rough surfaces (off as in the demo)"},
+         "Box/sphere-projected lookup [Lagarde12]: the reflected ray meets the probe's proxy (its projection box, "
+         "else its influence volume) and the cube is read towards that point from the capture point. Exact for mirrors "
+         "whose surroundings lie on the proxy, approximate for rough surfaces (the demo shipped without it)"},
+        {"dominant_direction",
+         ParamType::Bool,
+         true,
+         {},
+         {},
+         {},
+         "Read a rough lobe's prefiltered cube along its dominant direction [Lagarde14, 4.9.3], bent from the mirror "
+         "direction towards the normal as roughness grows: mix(n, r, s (sqrt(s) + a)), a = roughness^2, s = 1 - a. "
+         "Off: the mirror direction (the demo)"},
         {"sky_fallback",
          ParamType::Float,
          0.15,
@@ -240,6 +251,9 @@ private:
             g.axisZ = glm::vec4(r[2], p.halfExtents.z);
             g.capture = glm::vec4(p.position, p.fade);
             g.weight = glm::vec4(scale, static_cast<float>(p.priority - top), 0.0f, 0.0f);
+            bool proxy = !sphere && p.hasProjection();
+            g.proxyCenter = glm::vec4(proxy ? p.projectionCenter : p.center, 0.0f);
+            g.proxyHalf = glm::vec4(proxy ? p.projectionHalfExtents : p.halfExtents, 0.0f);
             mProbes.push_back(g);
         }
     }
@@ -258,7 +272,8 @@ private:
         u->viewProj = cam.viewProj;
         u->invViewProj = cam.invViewProj;
         u->cameraPos = glm::vec4(cam.state.position, static_cast<float>(mProbes.size()));
-        u->params = {mBlendB ? 1.0f : 0.0f, p.getBool("parallax") ? 1.0f : 0.0f, p.getFloat("sky_fallback"), 0.0f};
+        u->params = {mBlendB ? 1.0f : 0.0f, p.getBool("parallax") ? 1.0f : 0.0f, p.getFloat("sky_fallback"),
+                     p.getBool("dominant_direction") ? 1.0f : 0.0f};
         std::copy(mProbes.begin(), mProbes.end(), u->probes);
 
         struct Image {

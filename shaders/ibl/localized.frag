@@ -49,7 +49,7 @@ void main() {
     vec3 n = octDecode(g0.xy);
     float roughness = roughnessFromShininess(g0.w);
     vec3 v = normalize(u.cameraPos.xyz - world);
-    vec3 r = reflect(-v, n);
+    vec3 r = u.params.w > 0.5 ? specularDominantDirection(n, reflect(-v, n), roughness) : reflect(-v, n);
     vec3 dir = u.params.y > 0.5 ? parallaxDirection(pr, world, r) : r;
     float mips = float(textureQueryLevels(in_cubes));
     vec3 c = textureLod(in_cubes, vec4(dir, float(vProbe)), iblMipForRoughness(roughness, mips)).rgb;

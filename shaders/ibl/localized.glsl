@@ -28,19 +28,32 @@ float probeWeight(LocalizedProbe pr, float d) {
     return fade * exp2(4.0 * pr.weight.y) * pr.weight.x; // 16^p = 2^(4p), exact
 }
 
+// The direction a rough lobe is looked up along [Lagarde14, 4.9.3]: the GGX lobe's mass leans from the mirror
+// direction r towards the normal n as roughness grows (most at grazing angles, where r skims the surface), so the
+// prefiltered cube is read between them: mix(n, r, s (sqrt(s) + a)) with a = roughness^2 (GGX alpha), s = 1 - a.
+vec3 specularDominantDirection(vec3 n, vec3 r, float roughness) {
+    float a = roughness * roughness;
+    float s = 1.0 - a;
+    return normalize(mix(n, r, s * (sqrt(s) + a)));
+}
+
 // Parallax correction [Lagarde12]: the lookup direction from the capture point towards where the reflected ray
-// from `world` along `r` leaves the influence volume (box: slabs in the box's frame; sphere: the far root). Exact
-// for a mirror whose surroundings lie on the volume's boundary.
+// from `world` along `r` leaves the probe's proxy: its projection box, else the influence volume (box: slabs in
+// the box's frame; sphere: the far root). Exact for a mirror whose surroundings lie on the proxy's boundary.
 vec3 parallaxDirection(LocalizedProbe pr, vec3 world, vec3 r) {
-    vec3 d = world - pr.center.xyz;
+    vec3 d = world - pr.proxyCenter.xyz;
     float t;
     if (pr.center.w > 0.5) {
         float b = dot(d, r);
-        float c = dot(d, d) - pr.axisX.w * pr.axisX.w;
+        float c = dot(d, d) - pr.proxyHalf.x * pr.proxyHalf.x;
         t = -b + sqrt(max(b * b - c, 0.0));
     } else {
-        vec3 h = vec3(pr.axisX.w, pr.axisY.w, pr.axisZ.w);
-        vec3 p = vec3(dot(d, pr.axisX.xyz), dot(d, pr.axisY.xyz), dot(d, pr.axisZ.xyz));
+        vec3 h = pr.proxyHalf.xyz;
+        vec3 local = vec3(dot(d, pr.axisX.xyz), dot(d, pr.axisY.xyz), dot(d, pr.axisZ.xyz));
+        // A point of the influence volume outside the projection box (a window's reveal, a skylight's well) starts
+        // from the box's nearest point: from outside, the ray could leave the box behind it.
+        vec3 p = clamp(local, -h, h);
+        world += mat3(pr.axisX.xyz, pr.axisY.xyz, pr.axisZ.xyz) * (p - local);
         vec3 rl = vec3(dot(r, pr.axisX.xyz), dot(r, pr.axisY.xyz), dot(r, pr.axisZ.xyz));
         vec3 inv = 1.0 / rl; // +-inf on an axis the ray is parallel to: that slab never bounds t
         vec3 tExit = max((h - p) * inv, (-h - p) * inv);

@@ -2,7 +2,8 @@
 #define IBL_LOCALIZED_H
 #include "../common/shared.h"
 
-#define IBL_LOCALIZED_MAX_PROBES 128
+// 160 + 128 x 120 bytes: within the 16 KiB every Vulkan device allows a uniform buffer.
+#define IBL_LOCALIZED_MAX_PROBES 120
 
 #ifdef __cplusplus
 namespace vitrine::gpu_types {
@@ -16,6 +17,8 @@ struct LocalizedProbe {
     vec4 axisZ;   // xyz: local z; w: half extent
     vec4 capture; // xyz: capture point (world); w: fade distance (m)
     vec4 weight;  // x: the node's weight scale (see nodes/ibl/localized.cpp); y: priority minus the highest; zw unused
+    vec4 proxyCenter; // xyz: the parallax proxy's centre (world): the projection box's, else the volume's; w unused
+    vec4 proxyHalf;   // xyz: its half extents along axisX/Y/Z (sphere: x the radius); w unused
 };
 
 // Uniforms of every pass of ibl.localized.
@@ -23,13 +26,14 @@ struct LocalizedUniforms {
     mat4 viewProj;    // jittered, as the G-buffer was rasterised
     mat4 invViewProj; // its inverse
     vec4 cameraPos;   // xyz: world; w: number of probes
-    vec4 params;      // x: blend (0 "a", 1 "b"); y: parallax (1/0); z: sky fallback scale; w: unused
+    vec4 params;      // x: blend (0 "a", 1 "b"); y: parallax (1/0); z: sky fallback scale; w: dominant direction (1/0)
     LocalizedProbe probes[IBL_LOCALIZED_MAX_PROBES];
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(LocalizedProbe) == 96);
-static_assert(sizeof(LocalizedUniforms) == 160 + 96 * IBL_LOCALIZED_MAX_PROBES);
+static_assert(sizeof(LocalizedProbe) == 128);
+static_assert(sizeof(LocalizedUniforms) == 160 + 128 * IBL_LOCALIZED_MAX_PROBES);
+static_assert(sizeof(LocalizedUniforms) <= 16384);
 }
 #endif
 #endif

@@ -31,6 +31,7 @@ using namespace lighting;
 struct Probe {
     glm::dvec3 center{0.0}, half{1.0}, position{0.0};
     glm::dquat rotation{1, 0, 0, 0};
+    glm::dvec3 projectionCenter{0.0}, projectionHalf{0.0}; // a box's parallax proxy; zero: the volume
     bool sphere = false;
     double fade = 0.5;
     int priority = 0;
@@ -44,7 +45,9 @@ struct Probe {
                 {"rotation", {q.w, q.x, q.y, q.z}},
                 {"sphere", sphere},
                 {"fade", fade},
-                {"priority", priority}};
+                {"priority", priority},
+                {"projection_center", {projectionCenter.x, projectionCenter.y, projectionCenter.z}},
+                {"projection_half", {projectionHalf.x, projectionHalf.y, projectionHalf.z}}};
     }
     // Signed distance to the volume's border, positive inside.
     double border(glm::dvec3 p) const {
@@ -55,17 +58,23 @@ struct Probe {
         return std::min(in.x, std::min(in.y, in.z));
     }
     double weight(glm::dvec3 p) const { return std::clamp(border(p) / fade, 0.0, 1.0) * std::pow(16.0, priority); }
-    // Where the ray (p, r) from inside leaves the volume.
+    // Where the ray (p, r) from inside leaves the parallax proxy: the projection box, else the volume. A point of the
+    // volume outside the projection box starts from the box's nearest point.
     glm::dvec3 exit(glm::dvec3 p, glm::dvec3 r) const {
-        glm::dvec3 d = p - center;
+        bool proxy = !sphere && projectionHalf != glm::dvec3(0.0);
+        glm::dvec3 d = p - (proxy ? projectionCenter : center);
+        glm::dvec3 h = proxy ? projectionHalf : half;
         if (sphere) {
-            double b = glm::dot(d, r), c = glm::dot(d, d) - half.x * half.x;
+            double b = glm::dot(d, r), c = glm::dot(d, d) - h.x * h.x;
             return p + r * (-b + std::sqrt(b * b - c));
         }
         glm::dvec3 pl = glm::inverse(rotation) * d, rl = glm::inverse(rotation) * r;
+        glm::dvec3 inside = glm::clamp(pl, -h, h);
+        p += rotation * (inside - pl);
+        pl = inside;
         double t = std::numeric_limits<double>::infinity();
         for (int a = 0; a < 3; ++a)
-            if (std::abs(rl[a]) > 1e-12) t = std::min(t, ((rl[a] > 0 ? half[a] : -half[a]) - pl[a]) / rl[a]);
+            if (std::abs(rl[a]) > 1e-12) t = std::min(t, ((rl[a] > 0 ? h[a] : -h[a]) - pl[a]) / rl[a]);
         return p + r * t;
     }
 };
@@ -294,7 +303,9 @@ FaceTexel faceTexel(glm::dvec3 d, int size) {
 
 // Parallax correction: a mirror floor inside a box probe whose cube holds each texel's own coordinates. With it on,
 // the floor reflects the texel where the reflected ray meets the box, seen from the capture point (within 1
-// texel); off, the lookup is the plain reflection direction, measurably elsewhere.
+// texel); off, the lookup is the plain reflection direction, measurably elsewhere. The same for a sphere, and for a
+// box whose proxy is a projection box of its own (larger, off-centre, in the box's axes): the ray meets that box,
+// most pixels measurably far from where it leaves the influence volume.
 TEST_F(IblLocalized, ParallaxCorrectionHitsTheExpectedTexel) {
     const int W = 64, H = 48, kCube = 64;
     SceneBuilder b("ibl_parallax");
@@ -303,9 +314,15 @@ TEST_F(IblLocalized, ParallaxCorrectionHitsTheExpectedTexel) {
     b.node("floor", static_cast<int32_t>(b.mesh("floor", floor, b.material("mirror", glm::vec3(1.0f), 1.0f, 1.0f))));
     b.camera({-2.0f, 2.5f, 3.0f}, {0.5f, 0.0f, -1.0f}, 1.0f);
     b.sun({0.3f, 1.0f, 0.2f});
-    for (bool sphere : {false, true}) {
+    for (int kind : {0, 1, 2}) { // box, sphere, box with a projection box
+        bool sphere = kind == 1;
         Probe p;
         p.sphere = sphere;
+        if (kind == 2) {
+            // Off-centre and larger but for its -x side, which leaves a strip of the floor outside it.
+            p.projectionCenter = {1.6, 2.6, 0.7};
+            p.projectionHalf = {3.0, 3.0, 7.5};
+        }
         p.center = sphere ? glm::dvec3(0.0, 0.5, 0.0) : glm::dvec3(0.0, 1.9, 0.0);
         p.half = sphere ? glm::dvec3(6.0) : glm::dvec3(4.0, 2.0, 4.0);
         p.rotation = sphere ? glm::dquat(1, 0, 0, 0) : glm::angleAxis(0.3, glm::dvec3(0, 1, 0));
@@ -315,7 +332,9 @@ TEST_F(IblLocalized, ParallaxCorrectionHitsTheExpectedTexel) {
             graph(iblNodes(b.write(), {p}, {{"on", {{"parallax", true}}}, {"off", json::object()}}, "texels", kCube),
                   {{"on", "on.radiance"}, {"off", "off.radiance"}}, W, H));
         Pinhole cam(b.s, W, H);
-        int checked = 0, offFar = 0;
+        Probe volumeOnly = p;
+        volumeOnly.projectionHalf = glm::dvec3(0.0);
+        int checked = 0, offFar = 0, proxyFar = 0, outside = 0;
         double worstOn = 0.0, worstPlain = 0.0;
         for (int y = 0; y < H; ++y)
             for (int x = 0; x < W; ++x) {
@@ -330,23 +349,91 @@ TEST_F(IblLocalized, ParallaxCorrectionHitsTheExpectedTexel) {
                 glm::dvec3 on = rgb(out.at("on"), x, y), off = rgb(out.at("off"), x, y);
                 if (expected.edge > 1.5) {
                     ++checked;
-                    ASSERT_EQ(static_cast<int>(std::lround(on.x)), expected.face) << x << "," << y;
+                    ASSERT_EQ(static_cast<int>(std::lround(on.x)), expected.face) << x << "," << y << " kind " << kind;
                     double e = glm::length(glm::dvec2(on.y, on.z) - expected.st);
-                    EXPECT_LT(e, 1.0) << "pixel " << x << "," << y << (sphere ? " (sphere)" : " (box)");
+                    EXPECT_LT(e, 1.0) << "pixel " << x << "," << y << " kind " << kind;
                     worstOn = std::max(worstOn, e);
                     bool sameFace = static_cast<int>(std::lround(off.x)) == expected.face;
                     if (!sameFace || glm::length(glm::dvec2(off.y, off.z) - expected.st) > 3.0) ++offFar;
+                    FaceTexel volume = faceTexel(volumeOnly.exit(pos, r) - p.position, kCube);
+                    if (volume.face != expected.face || glm::length(volume.st - expected.st) > 3.0) ++proxyFar;
+                    glm::dvec3 local = glm::inverse(p.rotation) * (pos - p.projectionCenter);
+                    if (kind == 2 && glm::any(glm::greaterThan(glm::abs(local), p.projectionHalf))) ++outside;
                 }
                 if (plain.edge > 1.5 && static_cast<int>(std::lround(off.x)) == plain.face)
                     worstPlain = std::max(worstPlain, glm::length(glm::dvec2(off.y, off.z) - plain.st));
             }
+        const char* names[] = {"box", "sphere", "box, projection box"};
         std::printf("parallax (%s): %d pixels, worst error %.3f texels on; off: %d of them > 3 texels away; off vs the "
-                    "plain reflection: worst %.3f texels\n",
-                    sphere ? "sphere" : "box", checked, worstOn, offFar, worstPlain);
+                    "plain reflection: worst %.3f texels; %d pixels > 3 texels from the volume's exit, %d outside the "
+                    "projection box\n",
+                    names[kind], checked, worstOn, offFar, worstPlain, proxyFar, outside);
         EXPECT_GT(checked, W * H / 4);
         EXPECT_GT(offFar, checked * 3 / 4);
+        if (kind == 2) {
+            EXPECT_GT(proxyFar, checked / 2);
+            EXPECT_GT(outside, checked / 10);
+        }
         EXPECT_LT(worstPlain, 1.0);
     }
+}
+
+// The dominant direction [Lagarde14, 4.9.3]: a rough floor (roughness 0.6) under a box probe whose cube holds each
+// texel's own coordinates (one mip, so the lookup's direction alone decides the texel). On (the default), each
+// pixel reads the texel along mix(n, r, s (sqrt(s) + a)), a = roughness^2, s = 1 - a, normalised, with the
+// roughness the G-buffer stored (within 1 texel); off, the mirror direction r; most pixels' two texels lie apart.
+TEST_F(IblLocalized, RoughLobesAreReadAlongTheirDominantDirection) {
+    const int W = 64, H = 48, kCube = 64;
+    SceneBuilder b("ibl_dominant");
+    std::vector<Tri> floor;
+    addQuad(floor, {0, 0, 0}, {3.9f, 0, 0}, {0, 0, 3.9f}, {0, 1, 0});
+    b.node("floor", static_cast<int32_t>(b.mesh("floor", floor, b.material("rough", glm::vec3(1.0f), 1.0f, 0.4f))));
+    b.camera({-2.0f, 2.5f, 3.0f}, {0.5f, 0.0f, -1.0f}, 1.0f);
+    b.sun({0.3f, 1.0f, 0.2f});
+    Probe p;
+    p.center = {0.0, 1.9, 0.0};
+    p.half = {4.0, 2.0, 4.0};
+    p.position = {1.0, 1.2, -0.5};
+    p.fade = 0.05;
+    auto out = runGraph(
+        graph(iblNodes(b.write(), {p},
+                       {{"on", {{"parallax", false}}}, {"off", {{"parallax", false}, {"dominant_direction", false}}}},
+                       "texels", kCube),
+              {{"on", "on.radiance"}, {"off", "off.radiance"}, {"normal", "gbuffer.normal"}}, W, H));
+    Pinhole cam(b.s, W, H);
+    int checked = 0, apart = 0;
+    double worstOn = 0.0, worstOff = 0.0, meanRoughness = 0.0;
+    const glm::dvec3 n(0, 1, 0);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 d = cam.ray(x, y);
+            if (d.y >= -1e-3) continue;
+            glm::dvec3 pos = cam.position + d * (-cam.position.y / d.y);
+            if (std::max(std::abs(pos.x), std::abs(pos.z)) > 3.8 || p.border(pos) < 0.06) continue;
+            glm::dvec3 r = glm::reflect(d, n);
+            double roughness = 1.0 - value(out.at("normal"), x, y, 3);
+            double a = roughness * roughness, sm = 1.0 - a;
+            glm::dvec3 dominant = glm::normalize(glm::mix(n, r, sm * (std::sqrt(sm) + a)));
+            FaceTexel expected = faceTexel(dominant, kCube), plain = faceTexel(r, kCube);
+            if (expected.edge < 1.5 || plain.edge < 1.5) continue;
+            ++checked;
+            meanRoughness += roughness;
+            glm::dvec3 on = rgb(out.at("on"), x, y), off = rgb(out.at("off"), x, y);
+            ASSERT_EQ(static_cast<int>(std::lround(on.x)), expected.face) << x << "," << y;
+            ASSERT_EQ(static_cast<int>(std::lround(off.x)), plain.face) << x << "," << y;
+            double eOn = glm::length(glm::dvec2(on.y, on.z) - expected.st);
+            double eOff = glm::length(glm::dvec2(off.y, off.z) - plain.st);
+            EXPECT_LT(eOn, 1.0) << "pixel " << x << "," << y << " (dominant direction)";
+            EXPECT_LT(eOff, 1.0) << "pixel " << x << "," << y << " (mirror direction)";
+            worstOn = std::max(worstOn, eOn);
+            worstOff = std::max(worstOff, eOff);
+            if (expected.face != plain.face || glm::length(expected.st - plain.st) > 3.0) ++apart;
+        }
+    std::printf("dominant direction: %d pixels (roughness %.3f), worst error %.3f texels on, %.3f off (mirror); %d "
+                "pixels' two texels > 3 texels apart\n",
+                checked, meanRoughness / std::max(checked, 1), worstOn, worstOff, apart);
+    EXPECT_GT(checked, W * H / 4);
+    EXPECT_GT(apart, checked * 3 / 4);
 }
 
 // The scene of the count, resolve and lighting tests: a floor and a wall, three overlapping volumes (a box, a

@@ -314,7 +314,8 @@ NodeSchema lutSchema() {
 }
 
 // scene.gltf plus reflection probes given as JSON (`probe_list`: [{"center": [x, y, z], "half": [x, y, z],
-// "rotation": [w, x, y, z], "position": [x, y, z], "sphere": bool, "fade": f, "priority": i}, ...]).
+// "rotation": [w, x, y, z], "position": [x, y, z], "sphere": bool, "fade": f, "priority": i, "projection_center":
+// [x, y, z], "projection_half": [x, y, z]}, ...]).
 class GltfProbes final : public SceneNode {
 public:
     void setup(SetupContext& ctx) override {
@@ -336,6 +337,8 @@ public:
             p.shape = j.value("sphere", false) ? scene::ProbeShape::Sphere : scene::ProbeShape::Box;
             p.fade = j.value("fade", 0.5f);
             p.priority = j.value("priority", 0);
+            p.projectionCenter = v3("projection_center", glm::vec3(0.0f));
+            p.projectionHalfExtents = v3("projection_half", glm::vec3(0.0f));
             s->probes.push_back(p);
         }
         publish(ctx, std::move(s));

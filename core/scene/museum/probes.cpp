@@ -1,7 +1,8 @@
 // The museum's reflection probes, placed the way the demo placed its cube maps: every room split into a few
 // boxes that follow its walls, every aisle bay of the hall (the alcoves between the columns) a box of its own that
 // outranks the hall's, every doorway a small box that outranks both rooms and the bay it opens into. Axis-aligned
-// boxes only; priorities 0 (rooms), 1 (bays), 2 (doorways).
+// boxes only; priorities 0 (rooms), 1 (bays), 2 (doorways). Each probe's projection box (the parallax proxy) is
+// the room it sees: the hall for the nave slices and the bays, the gallery for its quarters, both rooms for a doorway.
 //
 // Boxes reach kWall past a room's walls, so the reveals of windows and doors and the wall faces themselves lie
 // inside; where two boxes of one room meet, each reaches half its fade past the shared plane, so their weights
@@ -28,8 +29,10 @@ constexpr int32_t kBayPriority = 1;  // over the nave (and, inside the wall, the
 constexpr int32_t kDoorPriority = 2; // over both rooms and the aisle bay a doorway opens into
 
 ReflectionProbe box(const std::string& name, glm::vec3 lo, glm::vec3 hi, glm::vec3 capture, float fade,
-                    int32_t priority) {
+                    int32_t priority, const Aabb& proxy) {
     ReflectionProbe p;
+    p.projectionCenter = proxy.center();
+    p.projectionHalfExtents = 0.5f * (proxy.max - proxy.min);
     p.name = name;
     p.position = capture;
     p.shape = ProbeShape::Box;
@@ -56,8 +59,8 @@ void gallery(Scene& s, const std::string& name, const Aabb& room, float top) {
             glm::vec2 z = cell(room.min.z, room.max.z, 2, k, kWall, 0.5f * kRoomFade);
             glm::vec2 cx = cell(room.min.x, room.max.x, 2, i, 0.0f, 0.0f), cz = cell(room.min.z, room.max.z, 2, k, 0.0f, 0.0f);
             glm::vec3 capture(0.5f * (cx.x + cx.y), kEye, 0.5f * (cz.x + cz.y));
-            s.probes.push_back(box(name + "_" + quarter[k][i], {x.x, -kWall, z.x}, {x.y, top, z.y}, capture,
-                                   kRoomFade, 0));
+            s.probes.push_back(
+                box(name + "_" + quarter[k][i], {x.x, -kWall, z.x}, {x.y, top, z.y}, capture, kRoomFade, 0, room));
         }
     }
 }
@@ -65,15 +68,24 @@ void gallery(Scene& s, const std::string& name, const Aabb& room, float top) {
 } // namespace
 
 void placeProbes(Scene& s) {
+    // Parallax proxies: what each probe sees is its room, so the room is its projection box (the hall for the
+    // nave and the bays, the two rooms a doorway joins for it), apart from the smaller volumes they apply in (which
+    // reach into the walls' reveals and the skylight wells: ibl.localized starts those points on the box's border).
+    const float hallTop = kHallH + 0.7f, galleryTop = kRoomH + 0.6f;
+    const Aabb hall{{-kHallX, 0.0f, -kHallZ}, {kHallX, kHallH, kHallZ}};
+    const Aabb west{{kWestX0, 0, -kSideZ}, {kWestX1, kRoomH, kSideZ}};
+    const Aabb east{{kEastX0, 0, -kSideZ}, {kEastX1, kRoomH, kSideZ}};
+    const Aabb north{{-kNorthX, 0, kNorthZ0}, {kNorthX, kRoomH, kNorthZ1}};
+    auto join = [](const Aabb& a, const Aabb& b) { return Aabb{glm::min(a.min, b.min), glm::max(a.max, b.max)}; };
     // The nave: eight 4 m slices of the hall between the arcades, up into the skylight wells (0.6 m of roof).
     const int slices = 8;
-    const float naveZ = kColumnZ + kWall, hallTop = kHallH + 0.7f;
+    const float naveZ = kColumnZ + kWall;
     for (int i = 0; i < slices; ++i) {
         glm::vec2 x = cell(-kHallX, kHallX, slices, i, kWall, 0.5f * kRoomFade);
         float cx = -kHallX + (i + 0.5f) * (2 * kHallX / slices);
         // Off the axis towards the south: the exhibits stand at z = +1 and the robot walks at z ≈ 3.3.
         s.probes.push_back(box("hall_nave_" + std::to_string(i), {x.x, -kWall, -naveZ}, {x.y, hallTop, naveZ},
-                               {cx, kEye, -0.5f}, kRoomFade, 0));
+                               {cx, kEye, -0.5f}, kRoomFade, 0, hall));
     }
     // The aisles: one bay between each pair of columns plus the two short ends, from just inside the arcade's
     // centre plane to the outer wall; they outrank the nave where both apply.
@@ -91,25 +103,24 @@ void placeProbes(Scene& s) {
             float z0 = sign * bayInner, z1 = sign * bayOuter;
             glm::vec3 capture(0.5f * (edges[b] + edges[b + 1]), kEye, sign * bayCapture);
             s.probes.push_back(box(prefix + std::to_string(b), {x0, -kWall, std::min(z0, z1)},
-                                   {x1, kHallH + 0.1f, std::max(z0, z1)}, capture, kBayFade, kBayPriority));
+                                   {x1, kHallH + 0.1f, std::max(z0, z1)}, capture, kBayFade, kBayPriority, hall));
         }
     }
     // Doorways: the hall's wall (kWall) plus the gallery's lining in front of it, and the architraves (0.2 m) around.
     const float depth = kWall + 0.01f, reach = 0.4f, frame = 0.2f, doorTop = kDoorH + 0.3f;
     s.probes.push_back(box("door_west", {-kHallX - depth - reach, -kWall, -kDoorHalf - frame},
                            {-kHallX + reach, doorTop, kDoorHalf + frame}, {-kHallX - 0.5f * depth, kEye, 0.0f},
-                           kDoorFade, kDoorPriority));
+                           kDoorFade, kDoorPriority, join(hall, west)));
     s.probes.push_back(box("door_east", {kHallX - reach, -kWall, -kDoorHalf - frame},
                            {kHallX + depth + reach, doorTop, kDoorHalf + frame}, {kHallX + 0.5f * depth, kEye, 0.0f},
-                           kDoorFade, kDoorPriority));
+                           kDoorFade, kDoorPriority, join(hall, east)));
     s.probes.push_back(box("door_north", {-kDoorHalf - frame, -kWall, kHallZ - reach},
                            {kDoorHalf + frame, doorTop, kHallZ + depth + reach}, {0.0f, kEye, kHallZ + 0.5f * depth},
-                           kDoorFade, kDoorPriority));
+                           kDoorFade, kDoorPriority, join(hall, north)));
     // The galleries: 2 × 2 boxes each, up into the north gallery's skylight well (0.5 m of roof).
-    const float galleryTop = kRoomH + 0.6f;
-    gallery(s, "west_gallery", Aabb{{kWestX0, 0, -kSideZ}, {kWestX1, kRoomH, kSideZ}}, galleryTop);
-    gallery(s, "east_gallery", Aabb{{kEastX0, 0, -kSideZ}, {kEastX1, kRoomH, kSideZ}}, galleryTop);
-    gallery(s, "north_gallery", Aabb{{-kNorthX, 0, kNorthZ0}, {kNorthX, kRoomH, kNorthZ1}}, galleryTop);
+    gallery(s, "west_gallery", west, galleryTop);
+    gallery(s, "east_gallery", east, galleryTop);
+    gallery(s, "north_gallery", north, galleryTop);
 }
 
 } // namespace vitrine::scene::museum

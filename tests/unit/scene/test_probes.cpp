@@ -29,6 +29,8 @@ std::vector<ReflectionProbe> oddProbes() {
     box.rotation = glm::angleAxis(0.7f, glm::normalize(glm::vec3(0.2f, 1.0f, -0.1f)));
     box.fade = 0.35f;
     box.priority = 2;
+    box.projectionCenter = {0.4f, 0.6f, -2.4f};
+    box.projectionHalfExtents = {3.3f, 2.1f, 2.0f / 7.0f + 2.5f};
     ReflectionProbe sphere;
     sphere.name = "sphere";
     sphere.shape = ProbeShape::Sphere;
@@ -52,6 +54,8 @@ void expectSameProbes(const std::vector<ReflectionProbe>& a, const std::vector<R
         EXPECT_EQ(a[i].rotation, b[i].rotation);
         EXPECT_EQ(a[i].fade, b[i].fade);
         EXPECT_EQ(a[i].priority, b[i].priority);
+        EXPECT_EQ(a[i].projectionCenter, b[i].projectionCenter);
+        EXPECT_EQ(a[i].projectionHalfExtents, b[i].projectionHalfExtents);
     }
 }
 
@@ -222,6 +226,53 @@ TEST_F(ProbeGltfErrors, EachKeyNamesItsPath) {
     expectProbeError({{"priority", 1.5}}, ".priority", "expected an integer in [-8, 8], got 1.5");
     expectProbeError({{"name", 7}}, ".name", "expected a string");
     expectProbeError({{"fadeDistance", 1}}, ".fadeDistance", "unknown key");
+    expectProbeError({{"projectionHalfExtents", {1, 0, 1}}}, ".projectionHalfExtents",
+                     "expected three numbers > 0, got [1,0,1]");
+    expectProbeError({{"projectionHalfExtents", {4, 4}}}, ".projectionHalfExtents", "expected an array of 3 numbers");
+    expectProbeError({{"projectionCenter", {0, 1, 0}}}, ".projectionCenter",
+                     "given without projectionHalfExtents; expected both");
+    expectProbeError({{"projectionHalfExtents", {4, 4, 4}}, {"projectionCenter", {0, "1", 0}}}, ".projectionCenter",
+                     "expected an array of 3 finite numbers");
+    expectProbeError(
+        {{"shape", "sphere"}, {"halfExtents", nullptr}, {"radius", 2}, {"projectionHalfExtents", {4, 4, 4}}},
+        ".projectionHalfExtents", "a sphere's parallax proxy is the sphere");
+}
+
+TEST_F(ProbeGltfErrors, CapturePointOutsideItsProjectionBox) {
+    // Inside the influence volume (half height 2 around y = 1), 0.25 m above the projection box (half height 1.25
+    // around y = 0.5... its top at 1.75, the capture point at 2).
+    expectProbeError({{"center", {0, 1, 0}},
+                      {"position", {0, 2, 0}},
+                      {"projectionCenter", {0, 0.5, 0}},
+                      {"projectionHalfExtents", {5, 1.25, 5}}},
+                     ".position", "lies outside the projection box (0.25");
+    // The projection box takes the influence volume's centre when it has none of its own.
+    Json doc = test::readJson(test::dataDir() / "quad.gltf");
+    doc["scenes"][0]["extensions"]["VITRINE_reflection_probes"] = {{"probes",
+                                                                    {{{"position", {0, 1, 0}},
+                                                                      {"center", {0, 1, 0}},
+                                                                      {"halfExtents", {1, 2, 1}},
+                                                                      {"projectionHalfExtents", {6, 3, 6}}}}}};
+    auto file = test::scratchDir() / "projection.gltf";
+    test::writeText(file, doc.dump());
+    auto probes = loadGltf(file).probes;
+    ASSERT_EQ(probes.size(), 1u);
+    EXPECT_EQ(probes[0].projectionCenter, glm::vec3(0, 1, 0));
+    EXPECT_EQ(probes[0].projectionHalfExtents, glm::vec3(6, 3, 6));
+    // Scene::validate() holds a probe built in code to the same rules (an internal error: code built it).
+    Scene scene = loadGltf(file);
+    auto invalid = [&](const std::string& what) {
+        try {
+            scene.validate();
+            ADD_FAILURE() << "validate() accepted it; expected: " << what;
+        } catch (const std::exception& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    };
+    scene.probes[0].projectionCenter = {0, 10, 0};
+    invalid("capture point lies outside its projection box");
+    scene.probes[0].shape = ProbeShape::Sphere;
+    invalid("has a projection box but is a sphere");
 }
 
 TEST_F(ProbeGltfErrors, CapturePointOutsideItsVolume) {
@@ -340,6 +391,9 @@ TEST(ProbeHash, EveryFieldChangesTheContentHash) {
     EXPECT_TRUE(changed([](ReflectionProbe& p) { p.rotation = glm::quat(1, 0, 0, 0); }));
     EXPECT_TRUE(changed([](ReflectionProbe& p) { p.fade += 0.01f; }));
     EXPECT_TRUE(changed([](ReflectionProbe& p) { p.priority += 1; }));
+    EXPECT_TRUE(changed([](ReflectionProbe& p) { p.projectionCenter.x += 0.01f; }));
+    EXPECT_TRUE(changed([](ReflectionProbe& p) { p.projectionHalfExtents.y += 0.01f; }));
+    EXPECT_TRUE(changed([](ReflectionProbe& p) { p.projectionHalfExtents = glm::vec3(0.0f); }));
     Scene reordered = scene;
     std::swap(reordered.probes[0], reordered.probes[1]);
     EXPECT_NE(reordered.contentHash(), base) << "the order decides the cube-map layers";
