@@ -44,14 +44,38 @@ NodeSchema schema() {
     s.outputs = {out};
     s.params = {
         {"resolution_scale", ParamType::Float, 0.5, 0.125, 1.0, {}, "Output size relative to the G-buffer"},
-        {"max_taps", ParamType::Int, 32, 1.0, 1024.0, {},
+        {"max_taps",
+         ParamType::Int,
+         32,
+         1.0,
+         1024.0,
+         {},
          "Hi-Z fetches per ray at most (rays leaving a floor at grazing angles need about 32 to reach what it "
-         "reflects: the Museum's floor at 16 found most of its hits nowhere)"},
-        {"max_rays", ParamType::Int, 4, 1.0, 4.0, {}, "Rays per pixel at most (1 for mirrors, more as roughness grows)"},
+         "reflects: the Museum's floor at 16 found most of its hits nowhere; at 32 it misses the columns' "
+         "reflections below them, whose rays skim the floor a texel per fetch: museum.json sets 64)"},
+        {"max_rays",
+         ParamType::Int,
+         4,
+         1.0,
+         4.0,
+         {},
+         "Rays per pixel at most (1 for mirrors, more as roughness grows)"},
         {"thickness", ParamType::Float, 0.3, 1e-4, 100.0, {}, "Depth (m) assumed behind every visible surface"},
         {"max_distance", ParamType::Float, 30.0, 0.01, 1e5, {}, "Ray length (m); the last quarter fades out"},
-        {"edge_fade", ParamType::Float, 0.05, 1e-4, 0.5, {}, "Fraction of the screen over which hits fade at its edges"},
-        {"max_roughness", ParamType::Float, 0.7, 0.01, 1.0, {}, "Roughness beyond which there is no SSR (fading over the last quarter)"},
+        {"edge_fade",
+         ParamType::Float,
+         0.05,
+         1e-4,
+         0.5,
+         {},
+         "Fraction of the screen over which hits fade at its edges"},
+        {"max_roughness",
+         ParamType::Float,
+         0.7,
+         0.01,
+         1.0,
+         {},
+         "Roughness beyond which there is no SSR (fading over the last quarter)"},
     };
     return s;
 }
