@@ -15,19 +15,24 @@
 
 namespace vitrine::scene {
 
+namespace {
+
+// Signed distance from p to the border of a box (centre, half extents, box -> world rotation), positive inside.
+float boxDepth(const glm::vec3& center, const glm::vec3& halfExtents, const glm::quat& rotation, const glm::vec3& p) {
+    glm::vec3 d = halfExtents - glm::abs(glm::conjugate(rotation) * (p - center));
+    return std::min(std::min(d.x, d.y), d.z);
+}
+
+} // namespace
+
 float influenceDepth(const ReflectionProbe& probe, const glm::vec3& p) {
     if (probe.shape == ProbeShape::Sphere) return probe.halfExtents.x - glm::length(p - probe.center);
-    glm::vec3 local = glm::conjugate(probe.rotation) * (p - probe.center);
-    glm::vec3 d = probe.halfExtents - glm::abs(local);
-    return std::min(std::min(d.x, d.y), d.z);
+    return boxDepth(probe.center, probe.halfExtents, probe.rotation, p);
 }
 
 float projectionDepth(const ReflectionProbe& probe, const glm::vec3& p) {
     if (!probe.hasProjection()) return influenceDepth(probe, p);
-    ReflectionProbe proxy = probe;
-    proxy.center = probe.projectionCenter;
-    proxy.halfExtents = probe.projectionHalfExtents;
-    return influenceDepth(proxy, p);
+    return boxDepth(probe.projectionCenter, probe.projectionHalfExtents, probe.rotation, p);
 }
 
 float fadeWeight(const ReflectionProbe& probe, const glm::vec3& p) {

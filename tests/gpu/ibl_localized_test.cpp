@@ -301,6 +301,17 @@ FaceTexel faceTexel(glm::dvec3 d, int size) {
     return {face, st, edge};
 }
 
+// The scene of the lookup-direction tests: a metallic white floor quad (y = 0, x and z in [0, 3.9] before the
+// probes' rotations matter) of the given shininess, seen from above at a slant, under a sun.
+void buildLookupFloor(SceneBuilder& b, const char* material, float shininess) {
+    std::vector<Tri> floor;
+    addQuad(floor, {0, 0, 0}, {3.9f, 0, 0}, {0, 0, 3.9f}, {0, 1, 0});
+    b.node("floor",
+           static_cast<int32_t>(b.mesh("floor", floor, b.material(material, glm::vec3(1.0f), 1.0f, shininess))));
+    b.camera({-2.0f, 2.5f, 3.0f}, {0.5f, 0.0f, -1.0f}, 1.0f);
+    b.sun({0.3f, 1.0f, 0.2f});
+}
+
 // Parallax correction: a mirror floor inside a box probe whose cube holds each texel's own coordinates. With it on,
 // the floor reflects the texel where the reflected ray meets the box, seen from the capture point (within 1
 // texel); off, the lookup is the plain reflection direction, measurably elsewhere. The same for a sphere, and for a
@@ -309,11 +320,7 @@ FaceTexel faceTexel(glm::dvec3 d, int size) {
 TEST_F(IblLocalized, ParallaxCorrectionHitsTheExpectedTexel) {
     const int W = 64, H = 48, kCube = 64;
     SceneBuilder b("ibl_parallax");
-    std::vector<Tri> floor;
-    addQuad(floor, {0, 0, 0}, {3.9f, 0, 0}, {0, 0, 3.9f}, {0, 1, 0});
-    b.node("floor", static_cast<int32_t>(b.mesh("floor", floor, b.material("mirror", glm::vec3(1.0f), 1.0f, 1.0f))));
-    b.camera({-2.0f, 2.5f, 3.0f}, {0.5f, 0.0f, -1.0f}, 1.0f);
-    b.sun({0.3f, 1.0f, 0.2f});
+    buildLookupFloor(b, "mirror", 1.0f);
     for (int kind : {0, 1, 2}) { // box, sphere, box with a projection box
         bool sphere = kind == 1;
         Probe p;
@@ -385,11 +392,7 @@ TEST_F(IblLocalized, ParallaxCorrectionHitsTheExpectedTexel) {
 TEST_F(IblLocalized, RoughLobesAreReadAlongTheirDominantDirection) {
     const int W = 64, H = 48, kCube = 64;
     SceneBuilder b("ibl_dominant");
-    std::vector<Tri> floor;
-    addQuad(floor, {0, 0, 0}, {3.9f, 0, 0}, {0, 0, 3.9f}, {0, 1, 0});
-    b.node("floor", static_cast<int32_t>(b.mesh("floor", floor, b.material("rough", glm::vec3(1.0f), 1.0f, 0.4f))));
-    b.camera({-2.0f, 2.5f, 3.0f}, {0.5f, 0.0f, -1.0f}, 1.0f);
-    b.sun({0.3f, 1.0f, 0.2f});
+    buildLookupFloor(b, "rough", 0.4f);
     Probe p;
     p.center = {0.0, 1.9, 0.0};
     p.half = {4.0, 2.0, 4.0};
