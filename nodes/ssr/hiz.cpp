@@ -76,6 +76,16 @@ NodeSchema schema() {
          1.0,
          {},
          "Roughness beyond which there is no SSR (fading over the last quarter)"},
+        {"cone_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         4.0,
+         {},
+         "Scale of the cone whose footprint at the hit picks the colour pyramid's level: 1 is the GGX lobe's share "
+         "of each ray (half-angle tan 1.29 alpha / sqrt(rays)) [Uludag14]; 0 reads level 0 and leaves the lobe to "
+         "the rays and the temporal accumulation. Each ray is already a sample of the lobe, so the full cone blurs "
+         "by the lobe twice, and isotropically where a grazing lobe is long and thin (museum.json: 0.5)"},
     };
     return s;
 }
@@ -123,6 +133,7 @@ public:
         bool reproject = ctx.hasInput("velocity") && ctx.frameIndex() > 0;
         u.config = {static_cast<uint32_t>(p.getInt("max_taps")), static_cast<uint32_t>(p.getInt("max_rays")),
                     reproject ? SSR_VELOCITY : 0u, ctx.frameIndex()};
+        u.cone = {p.getFloat("cone_scale"), 0.0f, 0.0f, 0.0f};
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("reflection").desc();
         ctx.dispatch(mPipeline, nullptr, 0, out.width, out.height);

@@ -9,9 +9,9 @@
 // Hi-Z screen-space cone-traced reflections [Uludag14] as the Museum demo used them (MUSEUM_SPEC §5): per
 // pixel 1-4 rays by roughness, each a GGX visible normal [Heitz18] reflected; each ray marched through the
 // min/max Hi-Z pyramid in screen space (x, y in pixels, reverse-Z depth: a straight line there) with at most
-// max_taps fetches; at the hit the colour pyramid is read at the level of the ray's cone footprint. The
-// confidence of a hit is the product of a screen-edge fade, a back-face test, a thickness test and a ray-length
-// fade; a ray that leaves the screen, runs out of taps or misses has none. No spatial filter. The output is
+// max_taps fetches; at the hit the colour pyramid is read at the level of the ray's cone footprint (times
+// cone_scale). The confidence of a hit is the product of a screen-edge fade, a back-face test, a thickness test and a
+// ray-length fade; a ray that leaves the screen, runs out of taps or misses has none. No spatial filter. The output is
 // premultiplied, (radiance x confidence, confidence), so that whatever filters it next (the temporal accumulation's
 // running mean, the composite's bilinear upsampling) is linear: a pixel that found nothing is (0, 0) and lowers the
 // confidence of its neighbours' mix without darkening its colour.
@@ -166,8 +166,8 @@ vec4 traceRay(vec3 origin, vec3 n, vec3 o, vec3 r, float coneTan) {
     float fLength = clamp((u.params.y - dist) / (0.25 * u.params.y), 0.0, 1.0);
     float confidence = fThickness * fBackFace * fEdge * fLength;
 
-    // Cone tracing: the lobe's footprint at the hit, in pixels across, picks the pyramid level.
-    float pixels = 2.0 * dist * coneTan * u.cameraFwd.w * 0.5 * size.y / max(hitDepth, 1e-4);
+    // Cone tracing: the lobe's footprint at the hit, in pixels across, times cone_scale picks the pyramid level.
+    float pixels = u.cone.x * 2.0 * dist * coneTan * u.cameraFwd.w * 0.5 * size.y / max(hitDepth, 1e-4);
     float lod = log2(max(pixels, 1.0));
     vec2 uvColor = uvHit;
     if ((u.config.z & SSR_VELOCITY) != 0u) uvColor -= texelFetch(in_velocity, texel, 0).xy / size;

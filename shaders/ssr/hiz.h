@@ -18,10 +18,11 @@ struct SsrUniforms {
     vec4 params;      // x: thickness (m), y: max distance (m), z: edge fade (fraction of the screen), w: max roughness
     ivec4 size;       // xy: depth (level 0) size; z: Hi-Z levels; w: colour pyramid levels
     uvec4 config;     // x: max taps per ray, y: max rays per pixel, z: flags (SSR_*), w: frame index
+    vec4 cone;        // x: cone_scale (the footprint that picks the colour pyramid's level, x the lobe's); yzw unused
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SsrUniforms) == 2 * 64 + 6 * 16);
+static_assert(sizeof(SsrUniforms) == 2 * 64 + 7 * 16);
 }
 #endif
 #endif
