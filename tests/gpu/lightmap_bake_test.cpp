@@ -694,10 +694,12 @@ TEST_F(LightmapBake, MuseumLightIsDistributedMoreLikeTheReference) {
         return runGraphFile((root / file).string(), sets).at("hdr");
     };
     // The lightmaps' own effect: the museum's lighting without the terms that sit on top of the baked light (the
-    // reflection probes' specular, screen-space AO, the temporal normal filter), in both graphs.
+    // reflection probes' specular, screen-space AO, the temporal normal filter), in both graphs (ssr.composite, which
+    // weighs SSR by the probes' LUT, then by Karis' fit as the sky's term is weighed).
     const nlohmann::json bakedOnly = nlohmann::json::parse(R"({"nodes": {
         "capture": null, "ibl": null, "ao": null, "ao_accumulate": null, "gfilter": null,
-        "lighting": {"in": {"ibl_specular": null, "ibl_diffuse": null, "ao": null, "normal": "gbuffer.normal"}}}})");
+        "lighting": {"in": {"ibl_specular": null, "ibl_diffuse": null, "ao": null, "normal": "gbuffer.normal"}},
+        "ssr_composite": {"in": {"brdf_lut": null}}}})");
     auto lit = [&](const std::string& file, std::vector<std::string> sets) {
         sets.insert(sets.begin(), common.begin(), common.end());
         sets.push_back("outputs.hdr=lighting.color");
