@@ -937,18 +937,10 @@ TEST_F(Ssr, CompositeWeighsReflectionsByTheLobesAlbedoAtGrazingViews) {
     const Pinhole cam(b.s, W, H);
 
     auto run = [&](bool lut) {
-        json nodes = baseNodes(glb);
+        json nodes = ssrNodes(glb, {{"resolution_scale", 1.0}});
+        nodes.erase("coords");
         nodes["lighting"] = lightingNode(json::object(), false);
-        nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-        nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "lighting.color"}}}};
-        nodes["ssr"] = {{"type", "ssr.hiz"},
-                        {"in",
-                         {{"normal", "gbuffer.normal"},
-                          {"depth", "gbuffer.depth"},
-                          {"hiz", "hiz.hiz"},
-                          {"color", "pyramid.pyramid"},
-                          {"camera", "scene.camera"}}},
-                        {"params", {{"resolution_scale", 1.0}}}};
+        nodes["pyramid"]["in"]["color"] = "lighting.color";
         nodes["composite"] = compositeNode("ssr.reflection");
         if (lut) {
             nodes["capture"] = {{"type", "ibl.capture"},
