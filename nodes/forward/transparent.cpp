@@ -52,7 +52,8 @@ NodeSchema schema() {
         tex("shadow_map", "shadow.directional's atlas"),
         {"cascades", PortKind::Buffer, {}, false, Usage::Sampled, "shadow.directional's cascades"},
         tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
-        tex("sky", "A sky node's cube map (reflections)"),
+        tex("sky", "A sky node's cube map (reflections), or ibl.environment's prefiltered one (mips: rough "
+                   "surfaces read the mip of their roughness)"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera (the sort's eye point)"},
         {"volume",
          PortKind::Texture,
@@ -261,7 +262,8 @@ private:
             b[i + 1] = {i + 1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
         // Linear filtering for the sky's cube map; everything else is read with texelFetch (and the shadow map's
         // depth format may not be filterable).
-        const SamplerDesc samplers[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST},
+        // Linear between mips too: a sky from ibl.environment is read at the mip of the roughness.
+        const SamplerDesc samplers[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR},
                                         {VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST}}; // kLinear, kNearest
         mSets = DescriptorSets(c, b, 1, samplers, "forward.transparent.set");
         mSet = mSets.allocate();

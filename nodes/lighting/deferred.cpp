@@ -30,7 +30,8 @@ NodeSchema schema() {
         tex("shadow_map", "shadow.directional's atlas (without it the sun is unshadowed)", true),
         {"cascades", PortKind::Buffer, {}, true, Usage::Sampled, "shadow.directional's cascades"},
         tex("sky_sh", "A sky node's `sh`: SH9 radiance, sun illuminance (lux) and direction"),
-        tex("sky", "A sky node's cubemap (background and mirror reflections)"),
+        tex("sky", "A sky node's cubemap (background and mirror reflections), or ibl.environment's prefiltered one "
+                   "(mips: rough surfaces read the mip of their roughness)"),
         {"camera", PortKind::Camera, {}, false, Usage::Sampled, "The frame's camera"},
         tex("volume", "bake.lightmap's irradiance volume (diffuse and specular stand-in for what has no lightmap)",
             true),
@@ -50,6 +51,10 @@ NodeSchema schema() {
         tex("ibl_diffuse",
             "ibl.localized's diffuse: the indirect diffuse of pixels with neither lightmap nor irradiance volume "
             "(x vertex AO x cavity)",
+            true),
+        tex("brdf_lut",
+            "ibl.environment's (or ibl.capture's) split-sum BRDF LUT: the sky's and the volume's indirect specular "
+            "are weighed by it (f0 A + f90 B) instead of Karis' analytic fit",
             true),
     };
     OutputPort color;
@@ -108,7 +113,7 @@ public:
             u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
         }
         u.volumeCounts.w = (ctx.hasInput("ibl_specular") ? 1u : 0u) | (ctx.hasInput("ibl_diffuse") ? 2u : 0u) |
-                           (ctx.hasInput("ao") ? 4u : 0u);
+                           (ctx.hasInput("ao") ? 4u : 0u) | (ctx.hasInput("brdf_lut") ? 8u : 0u);
         if (mScene) u.lights = packPunctualLights(*mScene);
         ctx.setUniforms(u);
         const ImageDesc& out = ctx.output("color").desc();

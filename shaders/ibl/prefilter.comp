@@ -4,7 +4,8 @@
 #include "ibl/ggx_sampling.glsl"
 #include "common/cubemap.glsl"
 
-// GGX prefilter of one mip of the probes' cube-map array [Karis13]: with n = v = r, the texel holds
+// GGX prefilter of one mip of a cube-map array (ibl.capture's probes, ibl.environment's sky) [Karis13]: with
+// n = v = r, the texel holds
 //   sum_k L(l_k) (n.l_k) / sum_k (n.l_k),  h_k ~ D(h) (n.h),  l_k = reflect(-v, h_k),
 // the radiance convolved with the lobe of this mip's roughness. Filtered importance sampling (GPU Gems 3
 // ch. 20, Karis13): each sample reads the mip-filtered source at the level whose texel covers the sample's
@@ -13,7 +14,11 @@
 // (gpu.IblCapture.PrefilteredMips: worst 3.4 % with it at 64 samples, 1.2 % without at 512).
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 1, binding = 0) uniform samplerCubeArray source;
-layout(set = 1, binding = 1, rgba16f) uniform writeonly image2DArray target;
+// ibl.capture's probes are RGBA16F; ibl.environment's sky is RGBA32F (a sky's radiance passes half float's range).
+#ifndef PREFILTER_TARGET_FORMAT
+#define PREFILTER_TARGET_FORMAT rgba16f
+#endif
+layout(set = 1, binding = 1, PREFILTER_TARGET_FORMAT) uniform writeonly image2DArray target;
 
 void main() {
     ivec2 g = ivec2(gl_GlobalInvocationID.xy);

@@ -13,7 +13,8 @@
 //   - others take diffuse from bake.lightmap's irradiance volume when it is connected;
 //   - without either, the open sky's SH irradiance scaled by `sky_ambient` stands in;
 // indirect specular: ibl.localized's where connected, else the volume's SH radiance along the mirror direction
-// where there is a volume, else the sky blurred towards its SH by roughness. Cavity and vertex AO
+// where there is a volume, else the sky (ibl.environment's prefiltered mip of the roughness, or a sky of one level
+// blurred towards its SH), weighed by ibl.environment's split-sum LUT or Karis' fit. Cavity and vertex AO
 // darken the ambient terms; emissive is added.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D in_normal;
@@ -33,6 +34,7 @@ layout(binding = 13) uniform sampler2D in_ibl_specular;
 layout(binding = 14) uniform sampler2D in_ibl_diffuse;
 layout(binding = 15) writeonly uniform image2D out_diffuse_indirect;
 layout(binding = 16) uniform sampler2D in_sheen;
+layout(binding = 17) uniform sampler2D in_brdf_lut; // ibl.environment's split-sum LUT (flag 8)
 #define VITRINE_LIGHTS u.lights
 #define VITRINE_SHADOW u.shadow
 #include "lighting/sun_shadow.glsl"
@@ -98,8 +100,14 @@ void main() {
     if (!lightmapped) diffuse = skyDiffuse(baked ? volume : sh, n, diffuseAlbedo(baseColor, metallic)) * occlusion;
     vec3 f0 = specularF0With(baseColor, metallic, 0.04, dielectric);
     float f90 = specularF90(metallic, dielectric);
-    vec3 specular = (baked ? volumeSpecularF90(volume, n, v, f0, f90, roughness)
-                           : skySpecularF90(in_sky, sh, n, v, f0, f90, roughness)) *
+    // The split sum's BRDF factor: the LUT where connected (what the environment's lobe reflects, as ibl.localized
+    // weighs the probes), else Karis' analytic fit.
+    bool brdfLut = (u.volumeCounts.w & 8u) != 0u;
+    float NoVc = clamp(dot(n, v), 1e-4, 1.0);
+    vec3 brdf = brdfLut ? environmentBrdfLut(in_brdf_lut, f0, f90, roughness, NoVc)
+                        : environmentBrdfF90(f0, f90, roughness, NoVc);
+    vec3 specular = (baked ? volumeSpecularWith(volume, n, v, brdf)
+                           : skySpecularWith(in_sky, sh, n, v, brdf, roughness)) *
                     occlusion;
     // ibl.localized (when connected) replaces the stand-ins: its probes carry the room's own light and occlusion,
     // so only the material's vertex AO and cavity darken it.
@@ -139,8 +147,10 @@ void main() {
     if (coat.x > 0.0) {
         vec3 coatDirect = vec3(clearcoatSpecularCosine(n, v, l, coat.y)) * sunE * visibility * cavity;
         coatDirect += shadePunctualClearcoat(world, n, v, coat.y) * cavity;
-        vec3 coatSpecular = (baked ? volumeSpecular(volume, n, v, vec3(kClearcoatF0), coat.y)
-                                   : skySpecular(in_sky, sh, n, v, vec3(kClearcoatF0), coat.y)) *
+        vec3 coatBrdf = brdfLut ? environmentBrdfLut(in_brdf_lut, vec3(kClearcoatF0), 1.0, coat.y, NoVc)
+                                : environmentBrdf(vec3(kClearcoatF0), coat.y, NoVc);
+        vec3 coatSpecular = (baked ? volumeSpecularWith(volume, n, v, coatBrdf)
+                                   : skySpecularWith(in_sky, sh, n, v, coatBrdf, coat.y)) *
                             occlusion;
         float NoV = dot(n, v);
         color = clearcoatLayer(color, coat.x, NoV, coatDirect + coatSpecular);

@@ -14,7 +14,7 @@ struct DeferredUniforms {
     vec4 cameraPos;    // world
     vec4 params;       // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
     vec4 volumeOrigin; // bake.lightmap's irradiance volume: xyz probe (0, 0, 0), w spacing (m)
-    uvec4 volumeCounts; // xyz probes per axis (0: no volume connected); w: bits 0 ibl_specular, 1 ibl_diffuse, 2 ao connected
+    uvec4 volumeCounts; // xyz probes per axis (0: no volume connected); w: bits 0 ibl_specular, 1 ibl_diffuse, 2 ao, 3 brdf_lut connected
     ShadowCascades shadow;
     PunctualLights lights; // the scene's point and spot lights (none without a scene input)
 };

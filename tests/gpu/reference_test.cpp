@@ -16,10 +16,12 @@
 
 #include "core/image/io.hpp"
 #include "core/shading/brdf.hpp"
+#include "core/shading/environment.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 namespace vitrine::test {
 namespace {
@@ -37,6 +39,30 @@ json uniformSky(const std::filesystem::path& glb, double c) {
     const auto file = glb.parent_path() / (glb.stem().string() + "_sky.exr");
     writeExr(file, sky, ExrPixelType::Float);
     return {{"type", "sky.hdri"}, {"params", {{"path", file.string()}, {"intensity", c}, {"size", 16}}}};
+}
+
+// A sky of radiance c * f(direction) (no sun: f must stay below 100 x its median) as sky.hdri over an equirect .exr.
+json equirectSky(const std::filesystem::path& glb, double c, int faceSize, const std::function<double(glm::dvec3)>& f) {
+    Image sky(256, 128);
+    for (int y = 0; y < sky.height; ++y)
+        for (int x = 0; x < sky.width; ++x) {
+            const double v = f(shading::equirectDirection((x + 0.5) / sky.width, (y + 0.5) / sky.height));
+            float* t = sky.at(x, y);
+            t[0] = t[1] = t[2] = static_cast<float>(v);
+            t[3] = 1.0f;
+        }
+    const auto file = glb.parent_path() / (glb.stem().string() + "_sky.exr");
+    writeExr(file, sky, ExrPixelType::Float);
+    return {{"type", "sky.hdri"}, {"params", {{"path", file.string()}, {"intensity", c}, {"size", faceSize}}}};
+}
+
+// ibl.environment of the sky node `sky`: lighting.deferred reads its prefiltered cube and LUT with useIt.
+json environmentNode() {
+    return {{"type", "ibl.environment"}, {"in", {{"sky", "sky.cubemap"}, {"sky_sh", "sky.sh"}}}};
+}
+void useEnvironment(json& lighting) {
+    lighting["in"]["sky"] = "environment.cubemap";
+    lighting["in"]["brdf_lut"] = "environment.brdf_lut";
 }
 
 json twinNode(const char* type, json params) {
@@ -296,82 +322,200 @@ TEST_F(Reference, DiffuseIndirectUnderASquareOccluderMatchesTheFormFactor) {
 // under a uniform sky C, lit by lighting.deferred's open-sky stand-ins at sky_ambient 1 (nothing occludes the sky).
 // Diffuse: the sky's SH irradiance of a constant sky is pi C exactly, so lighting.deferred's diffuse_indirect and
 // reference.diffuse_indirect are both diffuseAlbedo C (the G-buffer's base colour is UNORM8: 0.4 % at 0.5); bound
-// 1.5 % on the mean. Specular on a mirror metal (F0 = base colour 0.9): the sky along the mirror direction times
-// Karis' split-sum fit E(F0, 0, NoV) against the traced C F(NoV); the fit's own error for this F0 at the angles seen
-// measured -2.5 % on the mean (lavapipe; a deterministic gap, the mirror's samples barely vary), so the bound is
-// 3.5 %. (On a dielectric mirror, F0 0.04, the fit is +9 % on the mean and +23 % at NoV 0.78: printed, not
-// bounded, as the measure of that approximation.) reference.substitute of the diffuse
-// term gives lit - diffuse_indirect + twin at every pixel.
+// 1.5 % on the mean. Specular on a mirror (a metal, F0 = base colour 0.9; a dielectric, F0 0.04; a dielectric of
+// KHR_materials_specular 0.5, F0 0.02 and F90 0.5, with the LUT only): the sky along
+// the mirror direction times the split sum's BRDF factor against the traced C F(NoV), twice:
+//   - with ibl.environment's LUT (its prefiltered cube is C at every mip here): the factor is the lobe's directional
+//     albedo, so the two agree to the LUT's resolution and the G-buffer's 8 bits: bounds 1.5 % on the mean and 3 %
+//     at the largest NoV;
+//   - with Karis' analytic fit (the sky node's cube, no LUT): the fit's own error, measured -2.5 % on the mean for
+//     the metal (bound 3.5 %) and +9 % on the mean, +23 % at NoV 0.78 for the dielectric (asserted above 5 % and
+//     12 %: the test sees the approximation the LUT replaced).
+// reference.substitute of the diffuse term gives lit - diffuse_indirect + twin at every pixel.
 TEST_F(Reference, TwinsMatchLightingDeferredUnderAnOpenUniformSky) {
     const int W = 48, H = 32;
     const double C = 100.0;
     struct Case {
         const char* name;
         glm::vec3 base;
-        float metallic, shininess;
+        float metallic, shininess, specular;
     };
-    for (const Case& c : {Case{"metal_mirror", glm::vec3(0.9f), 1.0f, 1.0f},
-                          Case{"dielectric_mirror", glm::vec3(0.5f), 0.0f, 1.0f}}) {
-        SCOPED_TRACE(c.name);
-        SceneBuilder b(std::string("twin_vs_deferred_") + c.name);
-        b.node("plane", static_cast<int32_t>(b.mesh("plane", floorQuad(), b.material(c.name, c.base, c.metallic,
-                                                                                     c.shininess))));
-        b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
-        auto glb = b.write();
-        json nodes = twinNodes(glb, C);
-        nodes["gbuffer"] = {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}};
-        nodes["lighting"] = lightingNode({{"sky_ambient", 1.0}}, false);
-        nodes["reflections"] = twinNode("reference.reflections", {{"spp", 16}});
-        nodes["diffuse"] = twinNode("reference.diffuse_indirect", {{"spp", 8}});
-        nodes["swap"] = {{"type", "reference.substitute"},
-                         {"in",
-                          {{"color", "lighting.color"},
-                           {"technique", "lighting.diffuse_indirect"},
-                           {"twin", "diffuse.color"}}}};
-        auto out = runGraph(graph(nodes,
-                                  {{"lit", "lighting.color"},
-                                   {"swapped", "swap.color"},
-                                   {"specular", "lighting.specular_indirect"},
-                                   {"diffuse", "lighting.diffuse_indirect"},
-                                   {"specular_traced", "reflections.color"},
-                                   {"diffuse_traced", "diffuse.color"}},
-                                  W, H));
-        Pinhole cam(b.s, W, H);
-        double specRatio = 0.0, diffRatio = 0.0, specNormal = 0.0, maxNoV = 0.0;
-        int n = 0, nd = 0;
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                glm::dvec3 d = cam.ray(x, y);
-                if (d.y > -0.15) continue;
-                const glm::dvec3 s = rgb(out.at("specular"), x, y), st = rgb(out.at("specular_traced"), x, y);
-                // reference.substitute: lit - technique + twin (the diffuse term here).
-                const glm::dvec3 swapped = glm::max(rgb(out.at("lit"), x, y) - rgb(out.at("diffuse"), x, y) +
-                                                        rgb(out.at("diffuse_traced"), x, y),
-                                                    glm::dvec3(0.0));
-                EXPECT_LT(relErr(rgb(out.at("swapped"), x, y), swapped), 2e-3) << x << "," << y;
-                specRatio += s.g / st.g;
-                if (-d.y > maxNoV) {
-                    maxNoV = -d.y;
-                    specNormal = s.g / st.g;
-                }
-                ++n;
-                if (c.metallic < 0.5f) {
-                    diffRatio += rgb(out.at("diffuse"), x, y).g / rgb(out.at("diffuse_traced"), x, y).g;
-                    ++nd;
-                }
+    for (const Case& c : {Case{"metal_mirror", glm::vec3(0.9f), 1.0f, 1.0f, 1.0f},
+                          Case{"dielectric_mirror", glm::vec3(0.5f), 0.0f, 1.0f, 1.0f},
+                          Case{"dielectric_mirror_specular_0.5", glm::vec3(0.5f), 0.0f, 1.0f, 0.5f}})
+        for (const bool lut : {true, false}) {
+            if (!lut && c.specular < 1.0f) continue; // Karis' fit is measured on the first two
+            SCOPED_TRACE(std::string(c.name) + (lut ? " with ibl.environment's LUT" : " with Karis' fit"));
+            SceneBuilder b(std::string("twin_vs_deferred_") + c.name);
+            const uint32_t material = b.material(c.name, c.base, c.metallic, c.shininess);
+            b.s.materials[material].specular = c.specular;
+            b.node("plane", static_cast<int32_t>(b.mesh("plane", floorQuad(), material)));
+            b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+            auto glb = b.write();
+            json nodes = twinNodes(glb, C);
+            nodes["gbuffer"] = {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}};
+            nodes["lighting"] = lightingNode({{"sky_ambient", 1.0}}, false);
+            if (lut) {
+                nodes["environment"] = environmentNode();
+                useEnvironment(nodes["lighting"]);
             }
-        ASSERT_GT(n, 300);
-        specRatio /= n;
-        std::printf("%s: specular_indirect / reflections twin %.4f (mean), %.4f at the largest NoV (%.2f)", c.name,
-                    specRatio, specNormal, maxNoV);
-        if (nd > 0) std::printf("; diffuse_indirect / twin %.4f", diffRatio / nd);
-        std::printf("\n");
-        if (c.metallic > 0.5f) {
-            EXPECT_NEAR(specRatio, 1.0, 0.035);
+            nodes["reflections"] = twinNode("reference.reflections", {{"spp", 16}});
+            nodes["diffuse"] = twinNode("reference.diffuse_indirect", {{"spp", 8}});
+            nodes["swap"] = {
+                {"type", "reference.substitute"},
+                {"in",
+                 {{"color", "lighting.color"}, {"technique", "lighting.diffuse_indirect"}, {"twin", "diffuse.color"}}}};
+            auto out = runGraph(graph(nodes,
+                                      {{"lit", "lighting.color"},
+                                       {"swapped", "swap.color"},
+                                       {"specular", "lighting.specular_indirect"},
+                                       {"diffuse", "lighting.diffuse_indirect"},
+                                       {"specular_traced", "reflections.color"},
+                                       {"diffuse_traced", "diffuse.color"}},
+                                      W, H));
+            Pinhole cam(b.s, W, H);
+            double specRatio = 0.0, diffRatio = 0.0, specNormal = 0.0, maxNoV = 0.0;
+            int n = 0, nd = 0;
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    glm::dvec3 d = cam.ray(x, y);
+                    if (d.y > -0.15) continue;
+                    const glm::dvec3 s = rgb(out.at("specular"), x, y), st = rgb(out.at("specular_traced"), x, y);
+                    // reference.substitute: lit - technique + twin (the diffuse term here).
+                    const glm::dvec3 swapped = glm::max(rgb(out.at("lit"), x, y) - rgb(out.at("diffuse"), x, y) +
+                                                            rgb(out.at("diffuse_traced"), x, y),
+                                                        glm::dvec3(0.0));
+                    EXPECT_LT(relErr(rgb(out.at("swapped"), x, y), swapped), 2e-3) << x << "," << y;
+                    specRatio += s.g / st.g;
+                    if (-d.y > maxNoV) {
+                        maxNoV = -d.y;
+                        specNormal = s.g / st.g;
+                    }
+                    ++n;
+                    if (c.metallic < 0.5f) {
+                        diffRatio += rgb(out.at("diffuse"), x, y).g / rgb(out.at("diffuse_traced"), x, y).g;
+                        ++nd;
+                    }
+                }
+            ASSERT_GT(n, 300);
+            specRatio /= n;
+            std::printf("%s, %s: specular_indirect / reflections twin %.4f (mean), %.4f at the largest NoV (%.2f)",
+                        c.name, lut ? "LUT" : "Karis' fit", specRatio, specNormal, maxNoV);
+            if (nd > 0) std::printf("; diffuse_indirect / twin %.4f", diffRatio / nd);
+            std::printf("\n");
+            if (lut) {
+                EXPECT_NEAR(specRatio, 1.0, 0.015);
+                EXPECT_NEAR(specNormal, 1.0, 0.03);
+            } else if (c.metallic > 0.5f) {
+                EXPECT_NEAR(specRatio, 1.0, 0.035);
+            } else {
+                EXPECT_GT(specRatio, 1.05) << "Karis' fit on a dielectric mirror was measured +9 % on the mean";
+                EXPECT_GT(specNormal, 1.12) << "and +23 % at NoV 0.78";
+            }
+            if (nd > 0) {
+                EXPECT_NEAR(diffRatio / nd, 1.0, 0.015);
+            }
         }
-        if (nd > 0) {
-            EXPECT_NEAR(diffRatio / nd, 1.0, 0.015);
+}
+
+// Under a sky that is not uniform, the split sum with ibl.environment (its GGX-prefiltered mips read at the
+// roughness' mip, weighed by its LUT) against the traced lobe, on a glossy metal plane (F0 0.9, roughness 0.3):
+//   - "overhead": the camera 3 m up looking down (NoV 0.9-1, where the split sum's n = v = r holds and the lobe is
+//     nearly isotropic), under an equirect sky of radiance C with a patch of 21 C near the zenith (elevation
+//     60-80 degrees, 30 degrees either side of -Z: no sun, it stays below sky.hdri's 100 x median) whose edge the
+//     reflections cross. Bounds: the sum over the plane within 3 %, mean |block ratio - 1| below 6 %.
+//   - "sun": the same view under sky.procedural with its sun near the zenith and the disk in the cube map. The twin
+//     traces the same sky without the disk in its cube (the sun is the direct light's: lighting.deferred's sun and
+//     next-event estimation), so ibl.environment's mips 1 and up must leave the disk out: the same bounds.
+//   - "grazing": the camera 2 m up looking ahead (NoV 0.2-0.8) at the same patch lowered to elevation 20-40 degrees,
+//     where the true lobe is stretched and the split sum is not exact: measured and asserted only better than the
+//     sky node's own cube (one level, blurred towards its SH by roughness, Karis' fit) by a quarter at least, as in
+//     the overhead view.
+// Compared in 4 x 4-pixel blocks of the plane (the twin at 256 samples per pixel).
+TEST_F(Reference, TwinsMatchLightingDeferredUnderAPrefilteredSky) {
+    const int W = 64, H = 48, B = 4;
+    const double C = 100.0;
+    const double kDeg = kPi / 180.0;
+    for (const char* view : {"overhead", "sun", "grazing"}) {
+        const bool sun = std::string(view) == "sun", grazing = std::string(view) == "grazing";
+        SceneBuilder b(std::string("twin_vs_environment_") + view);
+        b.node("plane",
+               static_cast<int32_t>(b.mesh("plane", floorQuad(), b.material("glossy", glm::vec3(0.9f), 1.0f, 0.7f))));
+        if (grazing)
+            b.camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, -1.0f}, 0.9f);
+        else
+            b.camera({0.0f, 3.0f, 0.3f}, {0.0f, 0.0f, 0.0f}, 0.9f);
+        auto glb = b.write();
+        const double low = grazing ? 20.0 : 60.0, high = grazing ? 40.0 : 80.0;
+        auto proceduralSky = [](bool disk) {
+            return json{
+                {"type", "sky.procedural"},
+                {"params", {{"size", 32}, {"sun_elevation", 75.0}, {"sun_azimuth", 0.0}, {"sun_in_cubemap", disk}}}};
+        };
+        json sky = sun ? proceduralSky(true) : equirectSky(glb, C, 32, [&](glm::dvec3 d) {
+            const double elevation = std::asin(std::clamp(d.y, -1.0, 1.0));
+            const double azimuth = std::atan2(d.x, -d.z);
+            const bool patch = elevation > low * kDeg && elevation < high * kDeg && std::abs(azimuth) < 30.0 * kDeg;
+            return patch ? 21.0 : 1.0;
+        });
+        struct Result {
+            double sumRatio = 0.0, blockError = 0.0;
+        };
+        Result results[2];
+        for (const bool environment : {true, false}) {
+            if (sun && !environment) continue; // the sky node's cube with the disk has nothing to be compared for
+            SCOPED_TRACE(std::string(view) + (environment ? ", ibl.environment" : ", the sky node's cube"));
+            json nodes = {{"scene", {{"type", "scene.gltf"}, {"params", {{"path", glb.string()}}}}},
+                          {"sky", sky},
+                          {"env_cdf", {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}}}};
+            nodes["gbuffer"] = {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}};
+            nodes["lighting"] = lightingNode({{"sky_ambient", 1.0}}, false);
+            if (environment) {
+                nodes["environment"] = environmentNode();
+                useEnvironment(nodes["lighting"]);
+            }
+            nodes["reflections"] = twinNode("reference.reflections", {{"spp", 256}});
+            if (sun) {
+                nodes["traced_sky"] = proceduralSky(false);
+                nodes["env_cdf"]["in"]["sky"] = "traced_sky.cubemap";
+                nodes["reflections"]["in"]["sky"] = "traced_sky.cubemap";
+                nodes["reflections"]["in"]["sky_sh"] = "traced_sky.sh";
+            }
+            auto out = runGraph(
+                graph(nodes, {{"specular", "lighting.specular_indirect"}, {"traced", "reflections.color"}}, W, H));
+            Pinhole cam(b.s, W, H);
+            double sum = 0.0, sumTraced = 0.0, error = 0.0;
+            int blocks = 0;
+            for (int by = 0; by < H / B; ++by)
+                for (int bx = 0; bx < W / B; ++bx) {
+                    double s = 0.0, st = 0.0;
+                    bool plane = true;
+                    for (int y = by * B; y < (by + 1) * B; ++y)
+                        for (int x = bx * B; x < (bx + 1) * B; ++x) {
+                            plane = plane && cam.ray(x, y).y < -0.15;
+                            s += rgb(out.at("specular"), x, y).g;
+                            st += rgb(out.at("traced"), x, y).g;
+                        }
+                    if (!plane) continue;
+                    sum += s;
+                    sumTraced += st;
+                    error += std::abs(s / st - 1.0);
+                    ++blocks;
+                }
+            ASSERT_GT(blocks, 60);
+            Result& r = results[environment ? 0 : 1];
+            r.sumRatio = sum / sumTraced;
+            r.blockError = error / blocks;
+            std::printf("%s, %s: specular_indirect / reflections twin %.4f over the plane, mean |block ratio - 1| "
+                        "%.4f (%d blocks)\n",
+                        view, environment ? "ibl.environment" : "sky node's cube", r.sumRatio, r.blockError, blocks);
         }
+        SCOPED_TRACE(view);
+        if (!grazing) {
+            EXPECT_NEAR(results[0].sumRatio, 1.0, 0.03);
+            EXPECT_LT(results[0].blockError, 0.06);
+        }
+        if (!sun) EXPECT_LT(results[0].blockError, 0.75 * results[1].blockError);
     }
 }
 
