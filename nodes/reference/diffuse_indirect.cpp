@@ -68,7 +68,7 @@ protected:
 
     glm::vec3 sample(const CpuRays& rays, int x, int y, uint32_t& rng) const override {
         glm::vec3 o, d;
-        rays.cameraRay(x, y, glm::vec2(0.5f), o, d);
+        rays.cameraRay(x, y, primaryJitter(rng), o, d);
         CpuSurface s;
         if (!rays.intersect(o, d, std::numeric_limits<float>::infinity(), s)) return glm::vec3(0.0f);
         const glm::vec3 n = s.normal, ng = s.geometricNormal;

@@ -18,8 +18,8 @@ NodeSchema twinSchema(const TwinSchema& t) {
     s.doc = t.doc +
             " Traced on the CPU (Embree, every core) whatever the Vulkan device, with render.pathtrace's materials, "
             "BRDF (core/shading) and estimator of the light arriving along a ray; primary surfaces are the camera "
-            "rays through pixel centres (unjittered). With target_noise > 0 it converges, then caches, as "
-            "render.pathtrace does.";
+            "rays through pixel centres (unjittered; with antialias through random points of the pixel). With "
+            "target_noise > 0 it converges, then caches, as render.pathtrace does.";
     auto tex = [](const char* name, const char* doc, bool optional = false) {
         InputPort in{name, PortKind::Texture, {}, optional, Usage::Sampled, doc};
         in.readBack = true; // the CPU tracer reads the sky back once a frame
@@ -58,6 +58,15 @@ NodeSchema twinSchema(const TwinSchema& t) {
         {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of emissive surfaces"},
         {"report", ParamType::Bool, true, {}, {}, {}, "A progress bar and a summary line"},
         {"seed", ParamType::Int, 0, 0.0, 2147483647.0, {}, "Random sequence (independent estimates)"},
+        {"antialias",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
+         "Each sample's camera ray through a random point of the pixel (a box filter, as render.pathtrace's "
+         "antialias): textures and edges averaged over the pixel, as the path-traced reference's pixel sees them; "
+         "off: every ray through the pixel's centre"},
     };
     appendConvergeParams(s.params);
     return s;
@@ -103,6 +112,7 @@ void TwinNode::traceBatch(ExecuteContext& ctx, const CpuSky& sky, uint32_t spp, 
 }
 
 void TwinNode::execute(ExecuteContext& ctx) {
+    mAntialias = ctx.params().getBool("antialias");
     readParams(ctx.params());
     if (ctx.params().getFloat("target_noise") > 0.0f) {
         executeConverge(ctx);
@@ -158,6 +168,7 @@ void TwinNode::executeConverge(ExecuteContext& ctx) {
     for (const char* name : {"sun_scale", "sky_scale", "emissive_scale", "target_noise"})
         hasher.value(p.getFloat(name));
     hasher.value(ctx.hasInput("env_cdf"));
+    if (p.getBool("antialias")) hasher.string("antialias"); // off: the keys of before the param
     hashParams(hasher, p);
     const BakeKey key{"reference", hasher.result()};
     if (!mConvergedKey || *mConvergedKey != key.hash) {

@@ -6,7 +6,10 @@
 //
 // Primary surfaces: the camera ray through each pixel's centre (unjittered), intersected with the tracer's scene:
 // the same geometry and materials the G-buffer rasterises (PathTrace.TexturedSurfacesMatchTheRasterisersSamplers),
-// but without TAA's sub-pixel jitter, so edges may differ from the G-buffer by a pixel.
+// but without TAA's sub-pixel jitter, so edges may differ from the G-buffer by a pixel. With `antialias` each sample's
+// ray passes through a random point of the pixel instead (render.pathtrace's box filter): textures minified at grazing
+// views are then averaged over the pixel, as the G-buffer's mip maps and the reference's pixels average them, where
+// rays through the centre alias them.
 #include "nodes/render/converge.hpp"
 #include "nodes/render/pathtrace_cpu.hpp"
 
@@ -43,6 +46,8 @@ protected:
     virtual void hashParams(scene::Hasher& h, const Params& p) const { (void)h, (void)p; }
     // Called at the start of each frame with the node's params (the sample function reads what it stores).
     virtual void readParams(const Params& p) { (void)p; }
+    // Where in the pixel a sample's camera ray passes: its centre, or a random point with `antialias`.
+    glm::vec2 primaryJitter(uint32_t& rng) const { return mAntialias ? CpuRays::next2(rng) : glm::vec2(0.5f); }
 
 private:
     CpuTraceSettings settings(ExecuteContext& ctx, uint32_t spp, uint32_t seed) const;
@@ -59,6 +64,7 @@ private:
     CpuAccumulation mAccumulation;
     CpuResultUpload mUpload;
     std::optional<uint64_t> mConvergedKey;
+    bool mAntialias = false;
 };
 
 // GGX visible-normal sampling (Heitz 2018) and its pdf of the reflected direction: the path tracer's
