@@ -41,12 +41,14 @@ NodeSchema schema() {
     };
     OutputPort cube;
     cube.name = "cubemap";
-    cube.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    // Half floats: filtered linearly, between mips too, where lavapipe does not filter RGBA32F (the sky node's
+    // cube is read with the nearest texel there); clamped at the largest half, above what its readers keep.
+    cube.format = VK_FORMAT_R16G16B16A16_SFLOAT;
     cube.size = SizeRule::absolute(64, 64);
     cube.persistent = true;
     cube.readBack = true;
-    cube.doc = "Prefiltered sky radiance (cd/m², RGBA32F cube map): mip m is GGX roughness m / (mips - 1) "
-               "(shaders/ibl/ibl_common.glsl), mip 0 the sky as given";
+    cube.doc = "Prefiltered sky radiance (cd/m², RGBA16F cube map, clamped at 65504): mip m is GGX roughness "
+               "m / (mips - 1) (shaders/ibl/ibl_common.glsl), mip 0 the sky as given";
     OutputPort lut;
     lut.name = "brdf_lut";
     lut.format = VK_FORMAT_R32G32_SFLOAT;
@@ -92,7 +94,7 @@ public:
         mSamples = static_cast<uint32_t>(p.getInt("samples"));
         mLutSamples = static_cast<uint32_t>(p.getInt("lut_samples"));
         mLutPipeline = ctx.computePipeline("ibl/brdf_lut.comp");
-        mPrefilterPipeline = ctx.computePipeline("ibl/prefilter.comp", {{"PREFILTER_TARGET_FORMAT", "rgba32f"}}, 1);
+        mPrefilterPipeline = ctx.computePipeline("ibl/prefilter.comp", {{"PREFILTER_CLAMP_TO_HALF", "1"}}, 1);
     }
 
     void execute(ExecuteContext& ctx) override {

@@ -14,11 +14,7 @@
 // (gpu.IblCapture.PrefilteredMips: worst 3.4 % with it at 64 samples, 1.2 % without at 512).
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 1, binding = 0) uniform samplerCubeArray source;
-// ibl.capture's probes are RGBA16F; ibl.environment's sky is RGBA32F (a sky's radiance passes half float's range).
-#ifndef PREFILTER_TARGET_FORMAT
-#define PREFILTER_TARGET_FORMAT rgba16f
-#endif
-layout(set = 1, binding = 1, PREFILTER_TARGET_FORMAT) uniform writeonly image2DArray target;
+layout(set = 1, binding = 1, rgba16f) uniform writeonly image2DArray target;
 
 void main() {
     ivec2 g = ivec2(gl_GlobalInvocationID.xy);
@@ -54,5 +50,10 @@ void main() {
         }
         color = sum / max(weight, 1e-6);
     }
+#ifdef PREFILTER_CLAMP_TO_HALF
+    // ibl.environment: a sky's sun disk passes half float's range; its readers clamp radiance at 60000 anyway
+    // (shaders/lighting/ambient.glsl's kHalfMax), so the largest half keeps what they see and stays finite.
+    color = min(color, vec3(65504.0));
+#endif
     imageStore(target, ivec3(texel, layer), vec4(color, 1.0));
 }

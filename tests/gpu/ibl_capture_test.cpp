@@ -291,7 +291,7 @@ TEST_F(IblCapture, PrefilteredMipsMatchCpuIntegralOfTheCapture) {
 // over the sky node's own faces, and its LUT against the CPU quadrature. The sky is the lobe environment modulated
 // by a fine checker (15-degree cells, x1.6 / x0.4), the case filtered importance sampling is for: 512 samples over a
 // rough lobe miss most of its mip-0 texels, and each must stand for its share of the sphere (read at the mip of that
-// share). Mip 0 is the sky as given (within 1e-5: it is read at its texel centres).
+// share). Mip 0 is the sky as given, to half float's precision (within 2e-3; measured 9.6e-4).
 class IblEnvironment : public GpuTest {};
 
 fs::path checkeredLobeEnvironment() {
@@ -350,7 +350,7 @@ TEST_F(IblEnvironment, PrefilteredMipsMatchCpuIntegralOfTheSky) {
             }
     }
     std::printf("environment mip 0: largest relative difference from the sky %.2e\n", mip0Error);
-    EXPECT_LT(mip0Error, 1e-5) << "mip 0 is the sky itself (read at its texel centres)";
+    EXPECT_LT(mip0Error, 2e-3) << "mip 0 is the sky itself (read at its texel centres, stored as half floats)";
     for (uint32_t m = 1; m < cube.desc().mipLevels; ++m) {
         const int s = size >> m;
         const double roughness = double(m) / double(cube.desc().mipLevels - 1);
