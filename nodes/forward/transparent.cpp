@@ -73,6 +73,13 @@ NodeSchema schema() {
          "transmission framebuffer blurs (level log2(larger side) - 10 (1 - roughness x clamp(2 ior - 2, 0, 1))); "
          "transparent surfaces farther back are then not seen "
          "through glass. Without it, glass tints the pixel straight behind (dual-source blending), unblurred"},
+        {"brdf_lut",
+         PortKind::Texture,
+         {},
+         true,
+         Usage::Sampled,
+         "ibl.environment's (or ibl.capture's) split-sum BRDF LUT: the sky's and the volume's reflection are weighed "
+         "by it (f0 A + f90 B), as lighting.deferred's with its brdf_lut, instead of Karis' analytic fit"},
     };
     OutputPort color;
     color.name = "color";
@@ -114,8 +121,10 @@ bool linearFilterable(Context& ctx, VkFormat format) {
 
 // Set 0 of the pipelines (set 1 is the scene's): binding 0 the uniforms, 1-5 the sampled inputs. Without a
 // volume, binding 5 holds sky_sh instead (the shader never reads it when the volume's counts are zero); without a
-// background, binding 6 holds color (never read when the background flag is 0).
-constexpr std::array<const char*, 6> kSampled = {"shadow_map", "sky_sh", "sky", "color", "volume", "background"};
+// background, binding 6 holds color (never read when the background flag is 0); without a brdf_lut, binding 7 holds
+// sky_sh (never read when volumeCounts.w is 0).
+constexpr std::array<const char*, 7> kSampled = {"shadow_map", "sky_sh",     "sky",     "color",
+                                                 "volume",     "background", "brdf_lut"};
 // The samplers of the node's DescriptorSets.
 enum SamplerIndex : size_t { kLinear = 0, kNearest };
 
@@ -130,6 +139,7 @@ public:
             ctx.failParam("sky_ambient", "connect both volume and baked (bake.lightmap's volume and layout), or neither");
         if (ctx.hasInput("baked")) mBaked = ctx.objectAs<BakedLightingObject>("baked");
         mBackground = ctx.hasInput("background");
+        mLut = ctx.hasInput("brdf_lut");
         if (mBackground) {
             const ImageDesc& color = ctx.input("color");
             const ImageDesc& atlas = ctx.input("background");
@@ -226,6 +236,7 @@ private:
             u.volumeOrigin = glm::vec4(mBaked->volumeOrigin, mBaked->volumeSpacing);
             u.volumeCounts = glm::uvec4(mBaked->volumeCounts, 0u);
         }
+        u.volumeCounts.w = mLut ? 1u : 0u;
         if (mBackground) {
             const ImageDesc& color = ctx.input("color").desc();
             u.background = glm::uvec4(1u, color.width, color.height, mipAtlasLevels(color.width, color.height));
@@ -238,11 +249,13 @@ private:
             const std::string name = kSampled[i];
             const std::string port = name == "volume" && !mBaked            ? "sky_sh"
                                      : name == "background" && !mBackground ? "color"
+                                     : name == "brdf_lut" && !mLut          ? "sky_sh"
                                                                             : name;
             const GpuImage& image = ctx.input(port);
             // The background's levels are read bilinearly (shaders/common/mip_atlas.glsl).
-            const bool linear = (name == "sky" || (name == "background" && mBackground)) &&
-                                linearFilterable(ctx.gpu(), image.desc().format);
+            const bool linear =
+                (name == "sky" || (name == "background" && mBackground) || (name == "brdf_lut" && mLut)) &&
+                linearFilterable(ctx.gpu(), image.desc().format);
             w.image(
                 i + 1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                 {mSets.sampler(linear ? kLinear : kNearest), image.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
@@ -319,6 +332,7 @@ private:
     std::shared_ptr<BakedLightingObject> mBaked;
     bool mSort = true;
     bool mBackground = false;
+    bool mLut = false; // brdf_lut connected
     VkDevice mDevice = VK_NULL_HANDLE;
     DescriptorSets mSets;
     VkDescriptorSet mSet = VK_NULL_HANDLE;

@@ -34,6 +34,7 @@ layout(set = 0, binding = 2) uniform sampler2D in_sky_sh;
 layout(set = 0, binding = 3) uniform samplerCube in_sky;
 layout(set = 0, binding = 5) uniform sampler2D in_volume; // bound to another image, never read, without a volume
 layout(set = 0, binding = 6) uniform sampler2D in_background; // the same without a background
+layout(set = 0, binding = 7) uniform sampler2D in_brdf_lut; // the same without a LUT (volumeCounts.w 0)
 
 layout(location = 0) in vec3 vNormal;
 layout(location = 1) in vec4 vTangent;
@@ -100,8 +101,12 @@ void main() {
     bool baked = volumeSh(in_volume, u.volumeOrigin, u.volumeCounts.xyz, world, N, volume);
     float occlusion = baked ? vColor.a * cavity : u.params.x * vColor.a * cavity;
     vec3 diffuse = skyDiffuse(baked ? volume : sh, N, diffuseColor) * occlusion;
-    vec3 specular = (baked ? volumeSpecularF90(volume, N, v, f0, f90, roughness)
-                           : skySpecularF90(in_sky, sh, N, v, f0, f90, roughness)) *
+    // The split sum's BRDF factor: the LUT where connected (as lighting.deferred), else Karis' analytic fit.
+    bool brdfLut = u.volumeCounts.w != 0u;
+    float NoVc = clamp(dot(N, v), 1e-4, 1.0);
+    vec3 brdf = brdfLut ? environmentBrdfLut(in_brdf_lut, f0, f90, roughness, NoVc)
+                        : environmentBrdfF90(f0, f90, roughness, NoVc);
+    vec3 specular = (baked ? volumeSpecularWith(volume, N, v, brdf) : skySpecularWith(in_sky, sh, N, v, brdf, roughness)) *
                     occlusion;
     vec3 lit = direct + diffuse + specular + emissive * u.params.w;
 
@@ -151,8 +156,11 @@ void main() {
         vec3 nc = shadingNormal(vNormal, vTangent, materialClearcoatNormal(m, vUv0, vUv1, grads), gl_FrontFacing);
         vec3 coatLight = vec3(clearcoatSpecularCosine(nc, v, l, coat.y)) * sunE * visibility * cavity;
         coatLight += shadePunctualClearcoat(world, nc, v, coat.y) * cavity;
-        coatLight += (baked ? volumeSpecular(volume, nc, v, vec3(kClearcoatF0), coat.y)
-                            : skySpecular(in_sky, sh, nc, v, vec3(kClearcoatF0), coat.y)) *
+        float NcoVc = clamp(dot(nc, v), 1e-4, 1.0);
+        vec3 coatBrdf = brdfLut ? environmentBrdfLut(in_brdf_lut, vec3(kClearcoatF0), 1.0, coat.y, NcoVc)
+                                : environmentBrdf(vec3(kClearcoatF0), coat.y, NcoVc);
+        coatLight += (baked ? volumeSpecularWith(volume, nc, v, coatBrdf)
+                            : skySpecularWith(in_sky, sh, nc, v, coatBrdf, coat.y)) *
                      occlusion;
         float NcoV = dot(nc, v);
         lit = clearcoatLayer(lit, coat.x, NcoV, coatLight);

@@ -12,7 +12,7 @@ namespace vitrine::gpu_types {
 struct TransparentUniforms {
     vec4 params; // x: sky ambient scale, y: shadows on (1/0), z: sun intensity scale, w: emissive scale
     vec4 volumeOrigin;  // bake.lightmap's irradiance volume: xyz probe (0, 0, 0), w spacing (m)
-    uvec4 volumeCounts; // xyz probes per axis (0: no volume connected)
+    uvec4 volumeCounts; // xyz probes per axis (0: no volume connected); w: 1 with a brdf_lut
     uvec4 background;   // x: 1 with a background (color.pyramid), yz its level-0 size, w its levels
     ShadowCascades shadow;
     PunctualLights lights;
