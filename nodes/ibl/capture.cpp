@@ -295,30 +295,6 @@ private:
         return faces;
     }
 
-    // One descriptor set per output mip: the source (its cube-array view, or mip m's array view) and mip m of cubes.
-    VkDescriptorSet mipSet(ExecuteContext& ctx, VkImageView source, uint32_t mip) {
-        const VkDescriptorSet set = mSets.allocate();
-        DescriptorWrites(set)
-            .image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                   {mSets.sampler(0), source, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL})
-            .image(1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-                   {VK_NULL_HANDLE, ctx.output("cubes").mipView(mip), VK_IMAGE_LAYOUT_GENERAL})
-            .update(ctx.gpu().device());
-        return set;
-    }
-
-    // Frees the previous pass's sets, making the layout, a pool for 16 sets (one per mip) and the sampler first.
-    void resetSets(Context& gpu) {
-        if (!mSets) {
-            const VkDescriptorSetLayoutBinding bindings[] = {
-                {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-                {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
-            const SamplerDesc sampler[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR}};
-            mSets = DescriptorSets(gpu, bindings, 16, sampler, "ibl.capture.prefilter");
-        }
-        mSets.reset();
-    }
-
     void prefilter(ExecuteContext& ctx, std::vector<Image> faces) {
         const uint32_t sourceMips = std::bit_width(mSize);
         ImageDesc d;
@@ -331,10 +307,13 @@ private:
         d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
         mSource = GpuImage(ctx.gpu(), d, "ibl.capture.source");
         uploadCubeMips(ctx.gpu(), mSource, boxMips(std::move(faces), sourceMips));
-        resetSets(ctx.gpu());
+        resetPrefilterSets(ctx.gpu(), mSets, "ibl.capture.prefilter");
         const std::array<VkDescriptorSetLayout, 1> layouts = {mSets.layout()};
         for (uint32_t m = 0; m < mMips; ++m) {
-            const VkDescriptorSet set = mipSet(ctx, mSource.view(), m);
+            // One set per output mip: the source's cube-array view (a cached capture: mip m's array view), mip m of
+            // cubes.
+            const VkDescriptorSet set =
+                prefilterMipSet(ctx.gpu(), mSets, mSource.view(), ctx.output("cubes").mipView(m));
             gpu_types::IblPrefilterPush push{};
             push.size = mSize >> m;
             push.layers = mLayers;
@@ -368,10 +347,11 @@ private:
         d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
         mSource = GpuImage(ctx.gpu(), d, "ibl.capture.cached");
         uploadCubeMips(ctx.gpu(), mSource, mips);
-        resetSets(ctx.gpu());
+        resetPrefilterSets(ctx.gpu(), mSets, "ibl.capture.prefilter");
         const std::array<VkDescriptorSetLayout, 1> layouts = {mSets.layout()};
         for (uint32_t m = 0; m < mMips; ++m) {
-            const VkDescriptorSet set = mipSet(ctx, mSource.mipView(m), m);
+            const VkDescriptorSet set =
+                prefilterMipSet(ctx.gpu(), mSets, mSource.mipView(m), ctx.output("cubes").mipView(m));
             gpu_types::IblPrefilterPush push{};
             push.size = mSize >> m;
             push.layers = mLayers;

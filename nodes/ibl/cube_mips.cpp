@@ -74,4 +74,25 @@ void uploadCubeMips(Context& ctx, const GpuImage& image, const std::vector<std::
     });
 }
 
+void resetPrefilterSets(Context& gpu, DescriptorSets& sets, const std::string& name) {
+    if (!sets) {
+        const VkDescriptorSetLayoutBinding bindings[] = {
+            {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
+            {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
+        const SamplerDesc sampler[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR}};
+        sets = DescriptorSets(gpu, bindings, 16, sampler, name);
+    }
+    sets.reset();
+}
+
+VkDescriptorSet prefilterMipSet(Context& gpu, DescriptorSets& sets, VkImageView source, VkImageView target) {
+    const VkDescriptorSet set = sets.allocate();
+    DescriptorWrites(set)
+        .image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               {sets.sampler(0), source, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL})
+        .image(1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {VK_NULL_HANDLE, target, VK_IMAGE_LAYOUT_GENERAL})
+        .update(gpu.device());
+    return set;
+}
+
 } // namespace vitrine

@@ -124,18 +124,12 @@ public:
         removeSun(faces, sh);
         uploadCubeMips(ctx.gpu(), mSource, boxMips(std::move(faces), sourceMips));
 
-        resetSets(ctx.gpu());
+        resetPrefilterSets(ctx.gpu(), mSets, "ibl.environment.prefilter");
         const std::array<VkDescriptorSetLayout, 1> layouts = {mSets.layout()};
         for (uint32_t m = 0; m < mMips; ++m) {
             // Mip 0 is the mirror: the sky as given, its sun disk with it (what a mirror shows, as without mips).
-            const VkDescriptorSet set = mSets.allocate();
-            DescriptorWrites(set)
-                .image(
-                    0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                    {mSets.sampler(0), (m == 0 ? mWithSun : mSource).view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL})
-                .image(1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-                       {VK_NULL_HANDLE, ctx.output("cubemap").mipView(m), VK_IMAGE_LAYOUT_GENERAL})
-                .update(ctx.gpu().device());
+            const VkDescriptorSet set = prefilterMipSet(ctx.gpu(), mSets, (m == 0 ? mWithSun : mSource).view(),
+                                                        ctx.output("cubemap").mipView(m));
             gpu_types::IblPrefilterPush push{};
             push.size = mSize >> m;
             push.layers = 6;
@@ -179,17 +173,6 @@ private:
                     float* t = faces[f].at(x, y);
                     t[0] = float(l.x), t[1] = float(l.y), t[2] = float(l.z);
                 }
-    }
-
-    void resetSets(Context& gpu) {
-        if (!mSets) {
-            const VkDescriptorSetLayoutBinding bindings[] = {
-                {0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr},
-                {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr}};
-            const SamplerDesc sampler[] = {{VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR}};
-            mSets = DescriptorSets(gpu, bindings, 16, sampler, "ibl.environment.prefilter");
-        }
-        mSets.reset();
     }
 
     uint32_t mSize = 64, mMips = 7, mLutSize = 64, mSamples = 512, mLutSamples = 4096;

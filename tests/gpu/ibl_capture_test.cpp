@@ -214,6 +214,35 @@ TEST_F(IblCapture, BrdfLutMatchesCpuIntegration) {
     std::printf("BRDF LUT %dx%d: largest error against the CPU quadrature %.2e\n", n, n, worst);
 }
 
+// The prefilter's definition summed over every texel of a cube's mip 0 (no sampling, no mip filtering): the texel
+// direction n's sum of L D(h) (n.l) dOmega / sum of D(h) (n.l) dOmega, h = normalize(n + l).
+struct CubeTexel {
+    glm::dvec3 dir, L;
+    double omega;
+};
+std::vector<CubeTexel> cubeTexels(const std::vector<Image>& faces, int size) {
+    std::vector<CubeTexel> texels;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x)
+                texels.push_back({shading::cubeTexelDirection(f, x, y, size), rgb(faces[f], x, y),
+                                  shading::cubeTexelSolidAngle(x, y, size)});
+    return texels;
+}
+glm::dvec3 cpuPrefilter(const std::vector<CubeTexel>& texels, glm::dvec3 n, double alpha) {
+    glm::dvec3 sum(0.0);
+    double weight = 0.0;
+    for (const CubeTexel& t : texels) {
+        const double NoL = glm::dot(n, t.dir);
+        if (NoL <= 0.0) continue;
+        const double NoH = glm::dot(n, glm::normalize(n + t.dir));
+        const double w = shading::ggxD(static_cast<float>(NoH), static_cast<float>(alpha)) * NoL * t.omega;
+        sum += w * t.L;
+        weight += w;
+    }
+    return sum / weight;
+}
+
 // An environment smooth enough that its mip-0 texels are a fair quadrature of it: a wide coloured lobe over a
 // dim constant, as an equirectangular EXR for sky.hdri.
 fs::path lobeEnvironment() {
@@ -248,17 +277,7 @@ TEST_F(IblCapture, PrefilteredMipsMatchCpuIntegralOfTheCapture) {
     const Capture c = runCapture(captureGraph("open_sky", sky, {{"size", size}, {"cache", false}}));
     ASSERT_EQ(c.mips.size(), 6u);
     const std::vector<Image>& src = c.mips[0];
-    // Source texels: direction, solid angle, radiance.
-    struct Texel {
-        glm::dvec3 dir, L;
-        double omega;
-    };
-    std::vector<Texel> texels;
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < size; ++y)
-            for (int x = 0; x < size; ++x)
-                texels.push_back({shading::cubeTexelDirection(f, x, y, size), rgb(src[f], x, y),
-                                  shading::cubeTexelSolidAngle(x, y, size)});
+    const std::vector<CubeTexel> texels = cubeTexels(src, size);
     for (size_t m = 1; m < c.mips.size(); ++m) {
         const int s = size >> m;
         const double roughness = double(m) / double(c.mips.size() - 1);
@@ -267,18 +286,8 @@ TEST_F(IblCapture, PrefilteredMipsMatchCpuIntegralOfTheCapture) {
         for (int f = 0; f < 6; ++f)
             for (int y = 0; y < s; ++y)
                 for (int x = 0; x < s; ++x) {
-                    const glm::dvec3 n = shading::cubeTexelDirection(f, x, y, s);
-                    glm::dvec3 sum(0.0);
-                    double weight = 0.0;
-                    for (const Texel& t : texels) {
-                        const double NoL = glm::dot(n, t.dir);
-                        if (NoL <= 0.0) continue;
-                        const double NoH = glm::dot(n, glm::normalize(n + t.dir));
-                        const double w = shading::ggxD(static_cast<float>(NoH), static_cast<float>(alpha)) * NoL * t.omega;
-                        sum += w * t.L;
-                        weight += w;
-                    }
-                    const glm::dvec3 want = sum / weight, got = rgb(c.mips[m][f], x, y);
+                    const glm::dvec3 want = cpuPrefilter(texels, shading::cubeTexelDirection(f, x, y, s), alpha),
+                                     got = rgb(c.mips[m][f], x, y);
                     const double e = relErr(got, want);
                     worst = std::max(worst, e);
                     EXPECT_LT(e, 0.02) << "mip " << m << " face " << f << " texel " << x << "," << y;
@@ -333,22 +342,15 @@ TEST_F(IblEnvironment, PrefilteredMipsMatchCpuIntegralOfTheSky) {
     const GpuImage& cube = ex.image("environment.cubemap");
     ASSERT_EQ(cube.desc().mipLevels, 6u);
     std::vector<Image> sky;
-    struct Texel {
-        glm::dvec3 dir, L;
-        double omega;
-    };
-    std::vector<Texel> texels;
     double mip0Error = 0.0;
     for (int f = 0; f < 6; ++f) {
         sky.push_back(ex.read("sky.cubemap", 0, f));
         const Image mip0 = ex.read("environment.cubemap", 0, f);
         for (int y = 0; y < size; ++y)
-            for (int x = 0; x < size; ++x) {
+            for (int x = 0; x < size; ++x)
                 mip0Error = std::max(mip0Error, relErr(rgb(mip0, x, y), rgb(sky[f], x, y)));
-                texels.push_back({shading::cubeTexelDirection(f, x, y, size), rgb(sky[f], x, y),
-                                  shading::cubeTexelSolidAngle(x, y, size)});
-            }
     }
+    const std::vector<CubeTexel> texels = cubeTexels(sky, size);
     std::printf("environment mip 0: largest relative difference from the sky %.2e\n", mip0Error);
     EXPECT_LT(mip0Error, 2e-3) << "mip 0 is the sky itself (read at its texel centres, stored as half floats)";
     for (uint32_t m = 1; m < cube.desc().mipLevels; ++m) {
@@ -361,19 +363,8 @@ TEST_F(IblEnvironment, PrefilteredMipsMatchCpuIntegralOfTheSky) {
             const Image got = ex.read("environment.cubemap", m, f);
             for (int y = 0; y < s; ++y)
                 for (int x = 0; x < s; ++x) {
-                    const glm::dvec3 nrm = shading::cubeTexelDirection(f, x, y, s);
-                    glm::dvec3 sum(0.0);
-                    double weight = 0.0;
-                    for (const Texel& t : texels) {
-                        const double NoL = glm::dot(nrm, t.dir);
-                        if (NoL <= 0.0) continue;
-                        const double NoH = glm::dot(nrm, glm::normalize(nrm + t.dir));
-                        const double w =
-                            shading::ggxD(static_cast<float>(NoH), static_cast<float>(alpha)) * NoL * t.omega;
-                        sum += w * t.L;
-                        weight += w;
-                    }
-                    const double e = relErr(rgb(got, x, y), sum / weight);
+                    const double e =
+                        relErr(rgb(got, x, y), cpuPrefilter(texels, shading::cubeTexelDirection(f, x, y, s), alpha));
                     worst = std::max(worst, e);
                     mean += e;
                     ++n;
