@@ -1,4 +1,5 @@
 #include "core/shading/brdf.hpp"
+#include "shaders/common/ggx_albedo.h"
 #include "shaders/common/sheen_albedo.h"
 
 #include <algorithm>
@@ -61,8 +62,19 @@ glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic) {
     return baseColor * (1.0f - metallic);
 }
 
+float ggxAlbedo(float NoV, float alpha) {
+    float x = 2.0f * (std::sqrt(std::clamp(NoV, 0.01f, 1.0f)) - 0.1f) / 0.9f - 1.0f;
+    float y = 2.0f * std::clamp(std::sqrt(alpha), std::sqrt(kMinGgxAlpha), 1.0f) - 1.0f;
+    return std::clamp(VITRINE_GGX_ALBEDO(x, y), 0.05f, 1.0f);
+}
+
+glm::vec3 ggxMultiscatter(glm::vec3 f0, float NoV, float alpha) {
+    float e = ggxAlbedo(NoV, alpha);
+    return glm::vec3(1.0f) + f0 * ((1.0f - e) / e);
+}
+
 glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float f90,
-                          float roughness) {
+                          float roughness, bool multiscatter) {
     float NoL = glm::dot(n, l), NoV = glm::dot(n, v);
     if (NoL <= 0.0f || NoV <= 0.0f) return glm::vec3(0.0f);
     glm::vec3 h = glm::normalize(v + l);
@@ -70,6 +82,7 @@ glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffu
     float VoH = std::clamp(glm::dot(v, h), 0.0f, 1.0f);
     float alpha = ggxAlpha(roughness);
     glm::vec3 spec = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
+    if (multiscatter) spec *= ggxMultiscatter(f0, NoV, alpha);
     return (diffuseColor * lambertDiffuse() + spec) * NoL;
 }
 
@@ -85,10 +98,10 @@ glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseC
 }
 
 glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
-                             float roughness, glm::vec4 dielectric) {
+                             float roughness, glm::vec4 dielectric, bool multiscatter) {
     return brdfCosineF0F90(n, v, l, diffuseAlbedo(baseColor, metallic),
                            specularF0With(baseColor, metallic, 0.04f, dielectric), specularF90(metallic, dielectric),
-                           roughness);
+                           roughness, multiscatter);
 }
 
 glm::vec3 brdfCosine(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic, float roughness) {
@@ -121,8 +134,8 @@ glm::vec3 clearcoatLayer(glm::vec3 base, float clearcoat, float NcoV, glm::vec3 
 }
 
 glm::vec3 brdfCosineClearcoat(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
-                              float roughness, glm::vec4 dielectric, glm::vec2 coat) {
-    glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+                              float roughness, glm::vec4 dielectric, glm::vec2 coat, bool multiscatter) {
+    glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric, multiscatter);
     return clearcoatLayer(base, coat.x, glm::dot(nc, v), glm::vec3(clearcoatSpecularCosine(nc, v, l, coat.y)));
 }
 
@@ -184,8 +197,8 @@ glm::vec3 sheenLayer(glm::vec3 base, float scaling, glm::vec3 sheen) {
 }
 
 glm::vec3 brdfCosineSheen(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
-                          float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen) {
-    glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric);
+                          float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen, bool multiscatter) {
+    glm::vec3 base = brdfCosineSpecular(n, v, l, baseColor, metallic, roughness, dielectric, multiscatter);
     if (hasSheen(sheen)) {
         glm::vec3 c(sheen);
         base = sheenLayer(base, sheenScaling(c, glm::dot(n, v), sheen.a), sheenCosine(n, v, l, c, sheen.a));

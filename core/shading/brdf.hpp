@@ -27,10 +27,15 @@ glm::vec3 diffuseAlbedo(glm::vec3 baseColor, float metallic);
 glm::vec4 dielectricSpecular(float f0Ior, glm::vec4 specular);
 glm::vec3 specularF0With(glm::vec3 baseColor, float metallic, float f0Ior, glm::vec4 dielectric);
 float specularF90(float metallic, glm::vec4 dielectric);
+// The GGX lobe's directional albedo for F = 1 (common/ggx_albedo.h's fit) and the multiple-scattering compensation
+// 1 + F0 (1 - E) / E [Turquin19] (common/brdf.glsl). `multiscatter` below: the lobe times it (the shaders'
+// VITRINE_MULTISCATTER; the nodes' `multiscatter` param).
+float ggxAlbedo(float NoV, float alpha);
+glm::vec3 ggxMultiscatter(glm::vec3 f0, float NoV, float alpha);
 glm::vec3 brdfCosineF0F90(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float f90,
-                          float roughness);
+                          float roughness, bool multiscatter = false);
 glm::vec3 brdfCosineSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
-                             float roughness, glm::vec4 dielectric);
+                             float roughness, glm::vec4 dielectric, bool multiscatter = false);
 glm::vec3 shadeDirectionalSpecular(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
                                    float roughness, glm::vec4 dielectric, glm::vec3 intensity);
 // KHR_materials_clearcoat (shaders/common/brdf.glsl): the coat's Schlick Fresnel (F0 0.04), its GGX lobe times the
@@ -41,7 +46,7 @@ float clearcoatFresnel(float VoH);
 float clearcoatSpecularCosine(glm::vec3 nc, glm::vec3 v, glm::vec3 l, float roughness);
 glm::vec3 clearcoatLayer(glm::vec3 base, float clearcoat, float NcoV, glm::vec3 coat);
 glm::vec3 brdfCosineClearcoat(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
-                              float roughness, glm::vec4 dielectric, glm::vec2 coat);
+                              float roughness, glm::vec4 dielectric, glm::vec2 coat, bool multiscatter = false);
 // KHR_materials_sheen (shaders/common/brdf.glsl): the Charlie distribution and the spec's fitted Charlie visibility
 // of alpha = sheenAlpha(r), the lobe times the cosine (colour included), its directional albedo E from
 // common/sheen_albedo.h (tools/make_sheen_albedo.py), the base's scaling 1 - max(sc) E, the layering base * scaling +
@@ -59,7 +64,8 @@ inline bool hasSheen(glm::vec4 sheen) {
 }
 glm::vec3 sheenLayer(glm::vec3 base, float scaling, glm::vec3 sheen);
 glm::vec3 brdfCosineSheen(glm::vec3 n, glm::vec3 nc, glm::vec3 v, glm::vec3 l, glm::vec3 baseColor, float metallic,
-                          float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen);
+                          float roughness, glm::vec4 dielectric, glm::vec2 coat, glm::vec4 sheen,
+                          bool multiscatter = false);
 // brdfCosine with the diffuse colour and F0 given apart (shaders/common/brdf.glsl).
 glm::vec3 brdfCosineF0(glm::vec3 n, glm::vec3 v, glm::vec3 l, glm::vec3 diffuseColor, glm::vec3 f0, float roughness);
 // shaders/common/thin_transmission.glsl: light from behind a thin transmissive surface through its specular BTDF

@@ -10,6 +10,7 @@
 #include "core/scene/gpu_scene.hpp"
 #include "nodes/bake/baked_lighting.hpp"
 #include "nodes/depth/mip_atlas.hpp"
+#include "nodes/lighting/multiscatter.hpp"
 #include "nodes/lighting/punctual_lights.hpp"
 #include "nodes/shadow/cascades.hpp"
 
@@ -99,6 +100,14 @@ NodeSchema schema() {
         {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows (off: the sun reaches everything)"},
         {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
         {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of emission (and of unlit colours)"},
+        {"multiscatter",
+         ParamType::Enum,
+         "off",
+         {},
+         {},
+         {"off", "environment", "all"},
+         "As lighting.deferred's: the GGX lobe's multiple scattering for every light (all), the sky's and the "
+         "volume's alone (environment: the glTF Sample Viewer's model) or none (off)"},
         {"sort",
          ParamType::Enum,
          "back_to_front",
@@ -286,6 +295,8 @@ private:
         // The node's set is set 0 and the scene's set 1 (VITRINE_SCENE_SET), as in the ray tracers.
         ShaderDefines defines = {{"VITRINE_SCENE_TEXTURES", std::to_string(std::max(1u, gpu.textureCount()))},
                                  {"VITRINE_SCENE_SET", "1"}};
+        for (auto& define : multiscatterDefines(ctx.params()))
+            defines.push_back(define);
         RasterPipelineDesc d;
         d.setLayouts = {mSets.layout(), gpu.setLayout()};
         d.pushConstantSize = sizeof(SceneDrawPush);

@@ -1,10 +1,11 @@
 // lighting.deferred: sun (GGX + Lambert, cascaded shadows) and sky ambient over the G-buffer.
+#include "shaders/lighting/deferred.h"
 #include "core/graph/registry.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "nodes/bake/baked_lighting.hpp"
+#include "nodes/lighting/multiscatter.hpp"
 #include "nodes/lighting/punctual_lights.hpp"
 #include "nodes/shadow/cascades.hpp"
-#include "shaders/lighting/deferred.h"
 
 namespace vitrine {
 namespace {
@@ -71,12 +72,37 @@ NodeSchema schema() {
                   "diffuse, x vertex AO x cavity, x the ao tint; what reference.diffuse_indirect estimates by tracing";
     s.outputs = {color, spec, diffuse};
     s.params = {
-        {"sky_ambient", ParamType::Float, 0.15, 0.0, 1.0, {},
+        {"sky_ambient",
+         ParamType::Float,
+         0.15,
+         0.0,
+         1.0,
+         {},
          "Fraction of the open sky's ambient that reaches surfaces with neither a lightmap nor the irradiance volume "
          "(a stand-in for occlusion)"},
         {"shadows", ParamType::Bool, true, {}, {}, {}, "Sun shadows (off: the sun reaches everything)"},
         {"sun_scale", ParamType::Float, 1.0, 0.0, 100.0, {}, "Multiplier of the sky model's sun illuminance"},
-        {"emissive_scale", ParamType::Float, 1.0, 0.0, 1e6, {}, "Multiplier of the emissive channel where it is emission alone (lightmapped pixels carry emission and baked light together and are left as baked)"},
+        {"emissive_scale",
+         ParamType::Float,
+         1.0,
+         0.0,
+         1e6,
+         {},
+         "Multiplier of the emissive channel where it is emission alone (lightmapped pixels carry emission and baked "
+         "light together and are left as baked)"},
+        {"multiscatter",
+         ParamType::Enum,
+         "off",
+         {},
+         {},
+         {"off", "environment", "all"},
+         "Multiple scattering between the GGX lobe's microfacets [Turquin19]: the specular times 1 + F0 (1 - E(n.v)) / "
+         "E(n.v), E the single-scattering lobe's directional albedo (common/brdf.glsl ggxMultiscatter), which gives a "
+         "white metal back the light single scattering loses (up to 69 % at roughness 1). all: the sun's, the lights' "
+         "and the sky's specular (render.pathtrace's multiscatter traces the same lobe); environment: the sky's and "
+         "the irradiance volume's alone (the glTF Sample Viewer's model, image-based light only; graphs/gltf.json); "
+         "off: single scattering (the Museum's). ibl.localized's probe reflections, where connected, stay single "
+         "scattering"},
     };
     return s;
 }
@@ -95,7 +121,7 @@ public:
         if (ctx.hasInput("volume") != ctx.hasInput("baked"))
             ctx.failParam("sky_ambient", "connect both volume and baked (bake.lightmap's volume and layout), or neither");
         if (ctx.hasInput("baked")) mBaked = ctx.objectAs<BakedLightingObject>("baked");
-        mPipeline = ctx.computePipeline("lighting/deferred.comp");
+        mPipeline = ctx.computePipeline("lighting/deferred.comp", multiscatterDefines(ctx.params()));
     }
 
     void execute(ExecuteContext& ctx) override {

@@ -67,7 +67,7 @@ protected:
         if (glm::dot(n, l) <= 0.0f || glm::dot(ng, l) <= 0.0f) return glm::vec3(0.0f);
         const float pdf = cpu_sampling::ggxVndfPdf(NoV, glm::clamp(glm::dot(n, h), 0.0f, 1.0f), alpha);
         if (!(pdf > 0.0f)) return glm::vec3(0.0f);
-        const glm::vec3 weight = brdfCosineF0F90(n, v, l, glm::vec3(0.0f), f0, f90, s.roughness) / pdf;
+        const glm::vec3 weight = brdfCosineF0F90(n, v, l, glm::vec3(0.0f), f0, f90, s.roughness, multiscatter()) / pdf;
         return s.cavity * weight * rays.radiance(CpuRays::offset(s.position, ng, l), l, rng);
     }
 };

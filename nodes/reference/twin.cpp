@@ -67,6 +67,14 @@ NodeSchema twinSchema(const TwinSchema& t) {
          "Each sample's camera ray through a random point of the pixel (a box filter, as render.pathtrace's "
          "antialias): textures and edges averaged over the pixel, as the path-traced reference's pixel sees them; "
          "off: every ray through the pixel's centre"},
+        {"multiscatter",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
+         "The GGX lobe with its multiple-scattering compensation at every surface the paths meet (the twin of a "
+         "lighting.deferred or forward.transparent with multiscatter on; as render.pathtrace's multiscatter)"},
     };
     appendConvergeParams(s.params);
     return s;
@@ -95,6 +103,7 @@ CpuTraceSettings TwinNode::settings(ExecuteContext& ctx, uint32_t spp, uint32_t 
     s.emissiveScale = p.getFloat("emissive_scale");
     s.antialias = false;
     s.envSampling = ctx.hasInput("env_cdf");
+    s.multiscatter = mMultiscatter;
     return s;
 }
 
@@ -113,6 +122,7 @@ void TwinNode::traceBatch(ExecuteContext& ctx, const CpuSky& sky, uint32_t spp, 
 
 void TwinNode::execute(ExecuteContext& ctx) {
     mAntialias = ctx.params().getBool("antialias");
+    mMultiscatter = ctx.params().getBool("multiscatter");
     readParams(ctx.params());
     if (ctx.params().getFloat("target_noise") > 0.0f) {
         executeConverge(ctx);
@@ -169,6 +179,7 @@ void TwinNode::executeConverge(ExecuteContext& ctx) {
         hasher.value(p.getFloat(name));
     hasher.value(ctx.hasInput("env_cdf"));
     if (p.getBool("antialias")) hasher.string("antialias"); // off: the keys of before the param
+    if (p.getBool("multiscatter")) hasher.string("multiscatter");
     hashParams(hasher, p);
     const BakeKey key{"reference", hasher.result()};
     if (!mConvergedKey || *mConvergedKey != key.hash) {

@@ -48,6 +48,8 @@ protected:
     virtual void readParams(const Params& p) { (void)p; }
     // Where in the pixel a sample's camera ray passes: its centre, or a random point with `antialias`.
     glm::vec2 primaryJitter(uint32_t& rng) const { return mAntialias ? CpuRays::next2(rng) : glm::vec2(0.5f); }
+    // `multiscatter`: the GGX lobe with its multiple-scattering compensation (the primary surface's and the paths').
+    bool multiscatter() const { return mMultiscatter; }
 
 private:
     CpuTraceSettings settings(ExecuteContext& ctx, uint32_t spp, uint32_t seed) const;
@@ -65,6 +67,7 @@ private:
     CpuResultUpload mUpload;
     std::optional<uint64_t> mConvergedKey;
     bool mAntialias = false;
+    bool mMultiscatter = false;
 };
 
 // GGX visible-normal sampling (Heitz 2018) and its pdf of the reflected direction: the path tracer's

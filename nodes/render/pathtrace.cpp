@@ -145,6 +145,15 @@ NodeSchema schema() {
          "shadow rays stop at it (faces of such glass that close nothing, e.g. a single quad, are thin-walled glass "
          "tinted over the thickness, as forward.transparent draws them) (off: those surfaces are left out of the "
          "scene, as for the bake and the twins, and masks are opaque)"},
+        {"multiscatter",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
+         "The GGX lobe with its multiple-scattering compensation, 1 + F0 (1 - E) / E (common/brdf.glsl "
+         "ggxMultiscatter): rough metals reflect the energy single scattering loses, as lighting.deferred's and "
+         "forward.transparent's multiscatter (the truth of a graph that shades with it)"},
         {"backend",
          ParamType::Enum,
          "auto",
@@ -168,6 +177,13 @@ bool seesThroughAnything(const scene::Scene& scene) {
     return false;
 }
 
+// pathtrace.comp's defines: the scene's texture count, and the multiple-scattering lobe with `multiscatter`.
+ShaderDefines tracerDefines(size_t textures, const Params& p) {
+    ShaderDefines d = {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}};
+    if (p.getBool("multiscatter")) d.push_back({"VITRINE_MULTISCATTER", "1"});
+    return d;
+}
+
 class Pathtrace final : public Node {
 public:
     void setup(SetupContext& ctx) override {
@@ -177,8 +193,7 @@ public:
             ctx.failParam("spp",
                           "connect both history (this node's color@prev) and history_stats (stats@prev), or neither");
         size_t textures = std::max<size_t>(1, mScene->scene().textures.size());
-        mPipeline =
-            ctx.computePipeline("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 3);
+        mPipeline = ctx.computePipeline("render/pathtrace.comp", tracerDefines(textures, ctx.params()), 3);
         mStorePipeline = ctx.computePipeline("render/pathtrace_store.comp", {}, 1);
         mSceneSeesThrough = seesThroughAnything(mScene->scene());
     }
@@ -270,14 +285,14 @@ private:
         for (const char* name : {"sun_scale", "sky_scale", "emissive_scale", "target_noise"}) h.value(p.getFloat(name));
         h.value(p.getBool("antialias"));
         if (seeThrough(p)) h.string("see through v1"); // keys of scenes traced as before are unchanged
+        if (p.getBool("multiscatter")) h.string("multiscatter"); // the same
         if (cpu) {
             h.string("cpu");
             h.value(kCpuTracerVersion);
         } else {
             h.string("gpu");
             const size_t textures = std::max<size_t>(1, mScene->scene().textures.size());
-            const CompiledShader shader =
-                ctx.shaders().compile("render/pathtrace.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}});
+            const CompiledShader shader = ctx.shaders().compile("render/pathtrace.comp", tracerDefines(textures, p));
             h.bytes(shader.spirv.data(), shader.spirv.size() * sizeof(uint32_t));
             h.string(ctx.gpu().deviceInfo().name);
         }
@@ -359,6 +374,7 @@ private:
         s.skyScale = p.getFloat("sky_scale");
         s.emissiveScale = p.getFloat("emissive_scale");
         s.antialias = p.getBool("antialias");
+        s.multiscatter = p.getBool("multiscatter");
         s.envSampling = ctx.hasInput("env_cdf");
         s.seeThrough = mCpuSeesThrough;
         const CpuTraceCounters c = mCpu->trace(s, sky, mAccumulation);
@@ -407,6 +423,7 @@ private:
         s.skyScale = p.getFloat("sky_scale");
         s.emissiveScale = p.getFloat("emissive_scale");
         s.antialias = p.getBool("antialias");
+        s.multiscatter = p.getBool("multiscatter");
         s.envSampling = ctx.hasInput("env_cdf");
         s.seeThrough = mCpuSeesThrough;
 

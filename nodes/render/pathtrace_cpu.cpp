@@ -1116,7 +1116,7 @@ struct CpuPathTracer::Impl {
             const float roughness = regularizedRoughness(s.roughness, st.causticFootprint, s.t);
             const vec2 coat(s.coat.x, regularizedRoughness(s.coat.y, st.causticFootprint, s.t));
             vec3 f = brdfCosineSheen(n, s.coatNormal, v, lights.sunDir, s.baseColor, s.metallic, roughness,
-                                     s.dielectric, coat, s.sheen);
+                                     s.dielectric, coat, s.sheen, st.multiscatter);
             if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
                 p.radiance += weight * f * lights.sunE *
                               shadowTransmittance(offsetRay(s.position, ng, lights.sunDir), lights.sunDir,
@@ -1129,7 +1129,7 @@ struct CpuPathTracer::Impl {
             float pdf = env.pdf(l);
             if (glm::dot(ng, l) > 0.0f && pdf > 0.0f) {
                 vec3 f = brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
-                                         s.coat, s.sheen);
+                                         s.coat, s.sheen, st.multiscatter);
                 if (f.x > 0.0f || f.y > 0.0f || f.z > 0.0f)
                     p.radiance +=
                         weight * f * env.radiance(l) *
@@ -1146,7 +1146,7 @@ struct CpuPathTracer::Impl {
         if (pdf <= 0.0f) return false;
         p.throughput = weight *
                        brdfCosineSheen(n, s.coatNormal, v, l, s.baseColor, s.metallic, s.roughness, s.dielectric,
-                                       s.coat, s.sheen) /
+                                       s.coat, s.sheen, st.multiscatter) /
                        pdf;
         p.brdfPdfPrev = pdf;
         if (p.bounce >= 2u) {

@@ -43,6 +43,8 @@ struct CpuTraceSettings {
     // render.pathtrace's `transparent` on a tracer built with its transparent primitives: paths and shadow rays pass
     // alpha coverage and KHR_materials_transmission (pathtrace.comp's PATHTRACE_SEE_THROUGH).
     bool seeThrough = false;
+    // render.pathtrace's `multiscatter`: the GGX lobe with its multiple-scattering compensation (core/shading's).
+    bool multiscatter = false;
 };
 
 // Per-pixel accumulation, the layout of the node's outputs: color (mean rgb, 1) and stats (count, mean luminance,

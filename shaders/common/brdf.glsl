@@ -78,12 +78,41 @@ vec3 specularF0With(vec3 baseColor, float metallic, float f0Ior, vec4 dielectric
 // F90 = k + (1 - k) metallic: exactly 1 without the extension.
 float specularF90(float metallic, vec4 dielectric) { return dielectric.a + (1.0 - dielectric.a) * metallic; }
 
-// Specular lobe f_s(l, v) = D V F, without the cosine.
+// Multiple scattering between the microfacets [Turquin19]. The lobe D V F is single scattering: light that would
+// leave the surface after two or more bounces between facets is lost, 1 - E(NoV) of it for F = 1 (E the lobe's
+// directional albedo; 69 % lost at roughness 1 seen from above, nothing for a mirror), so rough metals come out
+// dark. The compensation scales the lobe by 1 + F0 (1 - E) / E: a white metal's lobe then reflects all the light it
+// gets at every roughness, a dielectric's (F0 0.04) a few per cent more. E is common/ggx_albedo.h's fit of the
+// quadrature (tools/make_ggx_albedo.py; within 1.9 %). The lobe is compensated where VITRINE_MULTISCATTER is defined
+// (every light: render.pathtrace's and the twins' `multiscatter`, lighting.deferred's and forward.transparent's
+// `multiscatter` "all"), the split sum's environment term where VITRINE_MULTISCATTER_ENVIRONMENT is (their
+// "environment" and "all"; "environment" alone is the glTF Sample Viewer's model [Fdez-Aguera19]), so that the shading
+// without them is the single-scattering lobe to the bit. The clear coat's lobe (F0 0.04) is left single scattering.
+#include "common/ggx_albedo.h"
+float ggxAlbedo(float NoV, float alpha) {
+    float x = 2.0 * (sqrt(clamp(NoV, 0.01, 1.0)) - 0.1) / 0.9 - 1.0;
+    float y = 2.0 * clamp(sqrt(alpha), sqrt(kMinGgxAlpha), 1.0) - 1.0;
+    return clamp(VITRINE_GGX_ALBEDO(x, y), 0.05, 1.0);
+}
+vec3 ggxMultiscatter(vec3 f0, float NoV, float alpha) {
+    float e = ggxAlbedo(NoV, alpha);
+    return 1.0 + f0 * ((1.0 - e) / e);
+}
+
+// Specular lobe f_s(l, v) = D V F, without the cosine (times ggxMultiscatter with VITRINE_MULTISCATTER).
 vec3 ggxSpecular(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0) {
-    return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+    vec3 s = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
+#ifdef VITRINE_MULTISCATTER
+    s *= ggxMultiscatter(f0, NoV, alpha);
+#endif
+    return s;
 }
 vec3 ggxSpecularF90(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0, float f90) {
-    return ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
+    vec3 s = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
+#ifdef VITRINE_MULTISCATTER
+    s *= ggxMultiscatter(f0, NoV, alpha);
+#endif
+    return s;
 }
 
 // The full BRDF times the cosine, f(l, v) NoL, for unit vectors n (surface), v (to the eye),

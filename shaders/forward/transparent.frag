@@ -106,6 +106,9 @@ void main() {
     float NoVc = clamp(dot(N, v), 1e-4, 1.0);
     vec3 brdf = brdfLut ? environmentBrdfLut(in_brdf_lut, f0, f90, roughness, NoVc)
                         : environmentBrdfF90(f0, f90, roughness, NoVc);
+#ifdef VITRINE_MULTISCATTER_ENVIRONMENT
+    brdf *= ggxMultiscatter(f0, NoVc, ggxAlpha(roughness)); // the lobe's multiple scattering (`multiscatter`)
+#endif
     vec3 specular = (baked ? volumeSpecularWith(volume, N, v, brdf) : skySpecularWith(in_sky, sh, N, v, brdf, roughness)) *
                     occlusion;
     vec3 lit = direct + diffuse + specular + emissive * u.params.w;

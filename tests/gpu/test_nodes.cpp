@@ -77,7 +77,10 @@ void main() {
             float cosL = sqrt(1.0 - u1);
             lambert += lambertDiffuse() * cosL / (cosL / kPi);
         }
-    imageStore(out_albedo, p, vec4(spec, lambert, 0.0, 0.0) / float(m * m));
+    // z: the fitted albedo (common/ggx_albedo.h); w: the lobe with its multiple-scattering compensation (F0 = 1).
+    spec /= float(m * m);
+    imageStore(out_albedo, p, vec4(spec, lambert / float(m * m), ggxAlbedo(NoV, alpha),
+                                   spec * ggxMultiscatter(vec3(1.0), NoV, alpha).r));
 }
 )";
 
