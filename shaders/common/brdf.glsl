@@ -99,20 +99,17 @@ vec3 ggxMultiscatter(vec3 f0, float NoV, float alpha) {
     return 1.0 + f0 * ((1.0 - e) / e);
 }
 
-// Specular lobe f_s(l, v) = D V F, without the cosine (times ggxMultiscatter with VITRINE_MULTISCATTER).
-vec3 ggxSpecular(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0) {
-    vec3 s = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnel(f0, VoH);
-#ifdef VITRINE_MULTISCATTER
-    s *= ggxMultiscatter(f0, NoV, alpha);
-#endif
-    return s;
-}
+// Specular lobe f_s(l, v) = D V F, without the cosine (times ggxMultiscatter with VITRINE_MULTISCATTER); the plain
+// one is the F90 one at f90 = 1 (the same value to the bit, see schlickFresnelF90), so the lobe is written once.
 vec3 ggxSpecularF90(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0, float f90) {
     vec3 s = ggxD(NoH, alpha) * smithGgxVisibility(NoV, NoL, alpha) * schlickFresnelF90(f0, f90, VoH);
 #ifdef VITRINE_MULTISCATTER
     s *= ggxMultiscatter(f0, NoV, alpha);
 #endif
     return s;
+}
+vec3 ggxSpecular(float NoV, float NoL, float NoH, float VoH, float alpha, vec3 f0) {
+    return ggxSpecularF90(NoV, NoL, NoH, VoH, alpha, f0, 1.0);
 }
 
 // The full BRDF times the cosine, f(l, v) NoL, for unit vectors n (surface), v (to the eye),
