@@ -119,6 +119,14 @@ NodeSchema schema() {
          {},
          "Scale of the sky's ambient where no probe applies (as lighting.deferred's sky_ambient: a stand-in for "
          "occlusion)"},
+        {"multiscatter",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
+         "The probes' reflection (and the sky's where no probe applies) compensated for the GGX lobe's multiple "
+         "scattering, as lighting.deferred's multiscatter environment / all (common/brdf.glsl ggxMultiscatter)"},
     };
     return s;
 }
@@ -389,7 +397,9 @@ private:
 
         d.name = "ibl.localized.resolve";
         d.vertex = ctx.shaders().compile("forward/fullscreen.vert");
-        d.fragment = ctx.shaders().compile("ibl/localized_resolve.frag");
+        ShaderDefines resolveDefines;
+        if (ctx.params().getBool("multiscatter")) resolveDefines.push_back({"VITRINE_MULTISCATTER_ENVIRONMENT", "1"});
+        d.fragment = ctx.shaders().compile("ibl/localized_resolve.frag", resolveDefines);
         d.colorFormats = {format("specular"), format("diffuse"), format("radiance")};
         d.depthFormat = VK_FORMAT_UNDEFINED;
         d.depthTest = false;

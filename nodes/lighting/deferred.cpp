@@ -101,8 +101,8 @@ NodeSchema schema() {
          "white metal back the light single scattering loses (up to 69 % at roughness 1). all: the sun's, the lights' "
          "and the sky's specular (render.pathtrace's multiscatter traces the same lobe); environment: the sky's and "
          "the irradiance volume's alone (the glTF Sample Viewer's model, image-based light only; graphs/gltf.json); "
-         "off: single scattering (the Museum's). ibl.localized's probe reflections, where connected, stay single "
-         "scattering"},
+         "off: single scattering (the Museum's). Where the reflection comes from ibl.localized and ssr.composite, "
+         "their own multiscatter compensates it"},
     };
     return s;
 }

@@ -49,6 +49,16 @@ NodeSchema schema() {
     specular.doc = "The indirect specular term now inside color, mix(I, E L_ssr vertexAO cavity, c) (0 where nothing "
                    "is drawn): what reference.reflections estimates by tracing";
     s.outputs = {color, specular};
+    s.params = {
+        {"multiscatter",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
+         "SSR's reflection weighed with the GGX lobe's multiple scattering, E (1 + f0 (1 - E_fit) / E_fit) (as "
+         "lighting.deferred's and ibl.localized's multiscatter; common/brdf.glsl ggxMultiscatter)"},
+    };
     return s;
 }
 
@@ -56,7 +66,9 @@ class SsrComposite final : public Node {
 public:
     void setup(SetupContext& ctx) override {
         mCamera = ctx.objectAs<CameraObject>("camera");
-        mPipeline = ctx.computePipeline("ssr/composite.comp");
+        ShaderDefines defines;
+        if (ctx.params().getBool("multiscatter")) defines.push_back({"VITRINE_MULTISCATTER_ENVIRONMENT", "1"});
+        mPipeline = ctx.computePipeline("ssr/composite.comp", defines);
         mLut = ctx.hasInput("brdf_lut");
     }
     void execute(ExecuteContext& ctx) override {

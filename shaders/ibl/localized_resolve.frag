@@ -47,13 +47,21 @@ void main() {
         vec3 l = rad.rgb / rad.a;
         float NoV = clamp(dot(n, v), 1e-4, 1.0);
         vec2 ab = texture(in_brdf_lut, iblLutUv(NoV, roughness, vec2(textureSize(in_brdf_lut, 0)))).rg;
-        outSpecular = vec4(min(l * (f0 * ab.x + ab.y), vec3(kHalfMax)), 1.0);
+        vec3 brdf = f0 * ab.x + ab.y;
+#ifdef VITRINE_MULTISCATTER_ENVIRONMENT
+        brdf *= ggxMultiscatter(f0, NoV, ggxAlpha(roughness)); // the lobe's multiple scattering (`multiscatter`)
+#endif
+        outSpecular = vec4(min(l * brdf, vec3(kHalfMax)), 1.0);
         outDiffuse = vec4(min(albedo * irr.rgb / irr.a, vec3(kHalfMax)), 1.0);
         outRadiance = vec4(min(l, vec3(kHalfMax)), 1.0);
     } else {
         vec3 sh[9];
         for (int i = 0; i < 9; ++i) sh[i] = texelFetch(in_sky_sh, ivec2(i, 0), 0).rgb;
-        outSpecular = vec4(skySpecular(in_sky, sh, n, v, f0, roughness) * u.params.z, 1.0);
+        vec3 sky = skySpecular(in_sky, sh, n, v, f0, roughness);
+#ifdef VITRINE_MULTISCATTER_ENVIRONMENT
+        sky *= ggxMultiscatter(f0, clamp(dot(n, v), 1e-4, 1.0), ggxAlpha(roughness));
+#endif
+        outSpecular = vec4(sky * u.params.z, 1.0);
         outDiffuse = vec4(skyDiffuse(sh, n, albedo) * u.params.z, 1.0);
         outRadiance = vec4(0.0);
     }

@@ -61,6 +61,9 @@ void main() {
     } else {
         brdf = environmentBrdfF90(f0, f90, roughness, NoV);
     }
+#ifdef VITRINE_MULTISCATTER_ENVIRONMENT
+    brdf *= ggxMultiscatter(f0, NoV, ggxAlpha(roughness)); // the lobe's multiple scattering (`multiscatter`)
+#endif
     vec3 indirect = texelFetch(in_specular_indirect, p, 0).rgb;
     float c = clamp(ssr.a, 0.0, 1.0);
     vec3 specular = indirect * (1.0 - c) + brdf * ssr.rgb * (g2.z * g2.w); // the term alone
