@@ -176,6 +176,7 @@ BakeKey lightmapCacheKey(const scene::Scene& scene, const LightmapBakeSettings& 
     h.value(s.emissiveScale);
     if (s.seed != 0) h.value(s.seed); // seed 0 keeps the key it had before the seed existed
     h.value(s.causticFootprint);
+    if (s.multiscatter) h.string("multiscatter"); // off keeps the keys of before the setting
     return {"lightmap", h.result()};
 }
 

@@ -47,6 +47,8 @@ struct LightmapBakeSettings {
     // ceiling) is spread: regularizedRoughness's footprint, 1 / atlas.texelsPerMeter metres per texel. 0: exact.
     float causticFootprint = 0.0f;
     float causticFootprintMeters() const { return causticFootprint / atlas.texelsPerMeter; }
+    // The GGX lobe with its multiple-scattering compensation (common/brdf.glsl ggxMultiscatter) along the paths.
+    bool multiscatter = false;
 };
 
 // A regular grid of probes: probe (x, y, z) sits at origin + spacing * (x, y, z).

@@ -114,6 +114,14 @@ NodeSchema schema() {
          "Texels over which a glossy surface's reflection of the sun is spread (path-space regularisation: the "
          "sun's caustic off the polished floor, found by one path in tens of thousands with 40x a texel's light, "
          "keeps its energy but is blurred to this size; 0: exact and spiky, see the README)"},
+        {"multiscatter",
+         ParamType::Bool,
+         false,
+         {},
+         {},
+         {},
+         "The paths reflect off the GGX lobe with its multiple-scattering compensation (as render.pathtrace's "
+         "multiscatter; common/brdf.glsl ggxMultiscatter), on both integrators"},
         {"backend",
          ParamType::Enum,
          "auto",
@@ -147,6 +155,7 @@ public:
         mSettings.emissiveScale = p.getFloat("emissive_scale");
         mSettings.seed = static_cast<uint32_t>(p.getInt("seed"));
         mSettings.causticFootprint = p.getFloat("caustic_footprint");
+        mSettings.multiscatter = p.getBool("multiscatter");
         mUseCache = p.getBool("cache");
         mBackend = p.getString("backend");
 
@@ -174,7 +183,9 @@ public:
         vol.height = std::max(1u, mVolume.counts.y * mVolume.counts.z);
 
         const size_t textures = std::max<size_t>(1, scene.textures.size());
-        mPipeline = ctx.computePipeline("bake/lightmap.comp", {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}}, 4);
+        ShaderDefines defines = {{"VITRINE_SCENE_TEXTURES", std::to_string(textures)}};
+        if (mSettings.multiscatter) defines.push_back({"VITRINE_MULTISCATTER", "1"});
+        mPipeline = ctx.computePipeline("bake/lightmap.comp", defines, 4);
     }
 
     void execute(ExecuteContext& ctx) override {
@@ -346,6 +357,7 @@ private:
         s.skyScale = mSettings.skyScale;
         s.emissiveScale = mSettings.emissiveScale;
         s.causticFootprint = mSettings.causticFootprintMeters();
+        s.multiscatter = mSettings.multiscatter;
         s.envSampling = false; // the bake has the sky's cube map, not its sampling table
         std::vector<std::atomic<uint32_t>> inside(jobCount);
         const size_t width = static_cast<size_t>(s.width);
