@@ -19,13 +19,13 @@ downloaded; rerun to regenerate (about a minute; needs numpy):
 """
 import math
 import sys
-import textwrap
 
 import numpy as np
 
+from horner_macro import horner_macro
+
 SIZE = 32
 MIN_ALPHA = 0.002  # common/brdf.glsl kMinGgxAlpha
-MIN_NOV = 0.0005
 MIN_R = math.sqrt(MIN_ALPHA)
 DEGREE = 10
 MIN_U = 0.1  # sqrt of the smallest NoV fitted
@@ -53,10 +53,6 @@ def albedo(nov, r, nu=512, nphi=256):
     return float(g.mean())
 
 
-def solve(a, b):
-    return list(np.linalg.solve(np.array(a), np.array(b)))
-
-
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "shaders/common/ggx_albedo.h"
     samples = []  # (x, y, E): x = 2 (sqrt(NoV) - MIN_U) / (1 - MIN_U) - 1, y = 2 max(r, MIN_R) - 1
@@ -77,15 +73,7 @@ def main():
     print("E from %.4f to %.4f; fit: worst |E_fit - E| %.4f, relative %.4f" % (e.min(), e.max(), worst, rel),
           file=sys.stderr)
 
-    def poly_y(a):
-        s = "%.9ef" % c[a, DEGREE - a]
-        for b in range(DEGREE - a - 1, -1, -1):
-            s = "(%s) * (y) + %.9ef" % (s, c[a, b])
-        return s
-    expr = poly_y(DEGREE)
-    for a in range(DEGREE - 1, -1, -1):
-        expr = "(%s) * (x) + %s" % (expr, poly_y(a))
-    expr = " \\\n    ".join(textwrap.wrap("(%s)" % expr, 112, break_long_words=False))
+    expr = horner_macro(c, DEGREE)
     with open(out, "w") as fh:
         fh.write("// Made by tools/make_ggx_albedo.py (read it for what this is); do not edit.\n")
         fh.write("// The GGX specular lobe's directional albedo for F = 1, E(NoV, r) = VITRINE_GGX_ALBEDO(x, y),\n"

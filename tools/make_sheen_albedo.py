@@ -17,7 +17,8 @@ rerun to regenerate (a few minutes):
 """
 import math
 import sys
-import textwrap
+
+from horner_macro import horner_macro
 
 SIZE = 32
 MIN_ALPHA = 0.01  # common/brdf.glsl kMinSheenAlpha
@@ -102,16 +103,7 @@ def main():
     worst = max(abs(fitted(x, y) - e) for x, y, e in samples)
     away = max(abs(fitted(x, y) - e) for x, y, e in samples if x >= -0.6)
     print("fit: worst |E_fit - E| %.4f; %.4f where NoV >= 0.04" % (worst, away), file=sys.stderr)
-    # Horner in x of Horner in y.
-    def poly_y(a):
-        s = "%.9ef" % c[a, DEGREE - a]
-        for b in range(DEGREE - a - 1, -1, -1):
-            s = "(%s) * (y) + %.9ef" % (s, c[a, b])
-        return s
-    expr = poly_y(DEGREE)
-    for a in range(DEGREE - 1, -1, -1):
-        expr = "(%s) * (x) + %s" % (expr, poly_y(a))
-    expr = " \\\n    ".join(textwrap.wrap("(%s)" % expr, 112, break_long_words=False))
+    expr = horner_macro(c, DEGREE)
     with open(out, "w") as f:
         f.write("// Made by tools/make_sheen_albedo.py (read it for what this is); do not edit.\n")
         f.write("// KHR_materials_sheen's directional albedo E(NoV, r) = exp(VITRINE_SHEEN_ALBEDO_LOG(x, y)),\n"

@@ -798,8 +798,10 @@ json compositeNode(const char* reflection) {
 }
 
 // What ssr.composite weighs SSR's radiance by at pixel (x, y), from the read-back G-buffer ("normal", "base",
-// "material"): Karis' environment BRDF E from core/shading times the vertex AO and the cavity.
-glm::dvec3 weightOfSsr(const std::map<std::string, Image>& out, const MirrorScene& m, int x, int y) {
+// "material"): Karis' environment BRDF E from core/shading times the vertex AO and the cavity; with `multiscatter`
+// (ssr.composite's) also times core/shading's ggxMultiscatter, whose factor goes to `compensation` when asked.
+glm::dvec3 weightOfSsr(const std::map<std::string, Image>& out, const MirrorScene& m, int x, int y,
+                       bool multiscatter = false, glm::dvec3* compensation = nullptr) {
     const float* g0 = out.at("normal").at(x, y);
     const float* g1 = out.at("base").at(x, y);
     const float* g2 = out.at("material").at(x, y);
@@ -807,8 +809,14 @@ glm::dvec3 weightOfSsr(const std::map<std::string, Image>& out, const MirrorScen
     const glm::dvec3 v = -m.cam->ray(x, y);
     const float NoV = std::clamp(float(glm::dot(glm::dvec3(n), v)), 1e-4f, 1.0f);
     const glm::vec2 ab = shading::envBrdfApprox(NoV, shading::roughnessFromShininess(g0[3]));
-    const glm::dvec3 e = glm::dvec3(shading::specularF0({g1[0], g1[1], g1[2]}, g1[3])) * double(ab.x) + double(ab.y);
-    return e * double(g2[2] * g2[3]);
+    const glm::vec3 f0 = shading::specularF0({g1[0], g1[1], g1[2]}, g1[3]);
+    const glm::dvec3 e = glm::dvec3(f0) * double(ab.x) + double(ab.y);
+    const glm::dvec3 k =
+        multiscatter
+            ? glm::dvec3(shading::ggxMultiscatter(f0, NoV, shading::ggxAlpha(shading::roughnessFromShininess(g0[3]))))
+            : glm::dvec3(1.0);
+    if (compensation) *compensation = k;
+    return e * k * double(g2[2] * g2[3]);
 }
 
 // ssr.composite on a lit glossy floor (roughness 0.15, cavity 0.8, vertex AO 0.5..1) with SSR at half
@@ -864,20 +872,12 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
                 int x0 = x / 2, y0 = y / 2, x1 = (x + 1) / 2, y1 = (y + 1) / 2;
                 glm::dvec4 r = 0.25 * (fetch(x0, y0) + fetch(x1, y0) + fetch(x0, y1) + fetch(x1, y1));
                 // r is premultiplied (c L_ssr, c): the bilinear mix of the four texels is c L_ssr of the mix.
-                glm::dvec3 reflectedTimesC = weightOfSsr(out, m, x, y) * glm::dvec3(r);
+                glm::dvec3 k;
+                glm::dvec3 reflectedTimesC = weightOfSsr(out, m, x, y, multiscatter, &k) * glm::dvec3(r);
                 double c = std::clamp(r.w, 0.0, 1.0);
-                if (multiscatter) {
-                    const float* g1 = out.at("base").at(x, y);
-                    const glm::vec3 n = shading::octDecode({g0[0], g0[1]});
-                    const float NoV = std::clamp(float(glm::dot(glm::dvec3(n), -m.cam->ray(x, y))), 1e-4f, 1.0f);
-                    const glm::dvec3 k(
-                        shading::ggxMultiscatter(shading::specularF0({g1[0], g1[1], g1[2]}, g1[3]), NoV,
-                                                 shading::ggxAlpha(shading::roughnessFromShininess(g0[3]))));
-                    reflectedTimesC *= k;
-                    if (c > 0.5) {
-                        compensation = std::max(compensation, k.r);
-                        ++seen;
-                    }
+                if (multiscatter && c > 0.5) {
+                    compensation = std::max(compensation, k.r);
+                    ++seen;
                 }
                 glm::dvec3 expected = glm::max(color - spec + spec * (1.0 - c) + reflectedTimesC, glm::dvec3(0.0));
                 // Its specular_indirect output: the blended term alone (what reference.reflections is compared with).
