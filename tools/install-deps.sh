@@ -11,6 +11,8 @@ packages=(
     libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers
     glslang-dev glslang-tools spirv-tools
     libglm-dev libtinygltf-dev libstb-dev nlohmann-json3-dev libembree-dev
+    libmeshoptimizer-dev  # glTF's EXT_meshopt_compression
+    gltfpack  # tests: an independent EXT_meshopt_compression / KHR_mesh_quantization encoder (tests/unit/scene)
     libopenexr-dev libimath-dev libopencolorio-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     python3-jsonschema

@@ -17,7 +17,8 @@
 // texture and the attenuation: material.hpp),
 // KHR_materials_pbrSpecularGlossiness (converted to metallic-roughness at load: factors, and
 // textures texel by texel into new textures; gltf_specgloss.cpp), KHR_materials_variants (one variant chosen by name at
-// load), KHR_mesh_quantization, VITRINE_material_layers (VITRINE_material_layers.md) and the scene's reflection probes
+// load), KHR_mesh_quantization, EXT_meshopt_compression (decoded by libmeshoptimizer before tinygltf reads the file:
+// gltf_meshopt.cpp), VITRINE_material_layers (VITRINE_material_layers.md) and the scene's reflection probes
 // in VITRINE_reflection_probes (VITRINE_reflection_probes.md), morph targets (POSITION, NORMAL, TANGENT displacements;
 // mesh or node `weights` make the rest pose, animated weights are an animation channel). Any other extension in
 // extensionsRequired is refused by name; any other in extensionsUsed is ignored with a warning

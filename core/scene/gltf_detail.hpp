@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -36,6 +37,7 @@ inline constexpr const char* kSheen = "KHR_materials_sheen";
 inline constexpr const char* kVolume = "KHR_materials_volume";
 inline constexpr const char* kSpecGloss = "KHR_materials_pbrSpecularGlossiness";
 inline constexpr const char* kVariants = "KHR_materials_variants";
+inline constexpr const char* kMeshopt = "EXT_meshopt_compression";
 
 // Material extensions vitrine reads no part of, and what of the material each one's absence leaves out: the loader
 // warns once per extension (naming the materials that use it) rather than with the generic extensionsUsed warning.
@@ -90,6 +92,11 @@ std::string jsonPointer(const std::string& element);
 // A data: URI (RFC 2397) decoded: base64 or percent-encoded payload. False with error set when malformed.
 bool decodeDataUri(const std::string& uri, std::vector<uint8_t>& out, std::string& mediaType, std::string& error);
 
+// Standard base64 with padding (RFC 4648), for data: URIs.
+std::string base64Encode(const std::vector<uint8_t>& data);
+// A relative URI's %XX escapes decoded (a file name beside the glTF).
+std::string urlDecode(const std::string& s);
+
 // `element.key`, or `key` at the top level (element empty).
 std::string path(const std::string& element, const char* key);
 // Typed reads of obj[key] that fail with `element.key` when the type is wrong; absent → def.
@@ -108,6 +115,15 @@ const Json* object(const LoadContext& ctx, const Json& obj, const char* key, con
 size_t topLevelCount(const LoadContext& ctx, const char* name);
 // Fails unless value is an integer index in [0, topLevelCount(target)).
 uint32_t checkIndex(const LoadContext& ctx, const Json& value, const std::string& element, const char* target);
+
+// EXT_meshopt_compression (gltf_meshopt.cpp): every compressed bufferView of ctx.doc decoded with libmeshoptimizer
+// into one new buffer of the document edit() returns (a copy of ctx.doc, made on first call; the new buffer a data:
+// URI), the views pointed at it and the extension dropped; fallback buffers that hold no data get a one-byte
+// placeholder, since no view reads them any more. Fails naming the view's field on a bad field, a range outside its
+// buffer or data that does not decode. Does nothing (and never calls edit) when no view is compressed.
+void decodeMeshoptCompression(const LoadContext& ctx, const std::function<Json&()>& edit);
+// True when the buffer is marked as EXT_meshopt_compression's fallback ({"fallback": true}), which may hold no data.
+bool isMeshoptFallback(const Json& buffer);
 
 // Step 1: read the file (UserError when it cannot be opened).
 std::vector<uint8_t> readGltfFile(const LoadContext& ctx, const std::filesystem::path& file);

@@ -139,8 +139,6 @@ bool decodeDataUri(const std::string& uri, std::vector<uint8_t>& out, std::strin
     return true;
 }
 
-namespace {
-
 std::string base64Encode(const std::vector<uint8_t>& data) {
     static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
@@ -156,8 +154,6 @@ std::string base64Encode(const std::vector<uint8_t>& data) {
     }
     return out;
 }
-
-} // namespace
 
 std::string path(const std::string& element, const char* key) {
     return element.empty() ? std::string(key) : element + "." + key;
@@ -235,12 +231,6 @@ uint32_t checkIndex(const LoadContext& ctx, const Json& value, const std::string
     return static_cast<uint32_t>(i);
 }
 
-namespace {
-
-uint32_t readU32(const std::vector<uint8_t>& b, size_t at) {
-    return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 | uint32_t(b[at + 3]) << 24;
-}
-
 std::string urlDecode(const std::string& s) {
     std::string out;
     for (size_t i = 0; i < s.size(); ++i) {
@@ -252,6 +242,12 @@ std::string urlDecode(const std::string& s) {
         }
     }
     return out;
+}
+
+namespace {
+
+uint32_t readU32(const std::vector<uint8_t>& b, size_t at) {
+    return uint32_t(b[at]) | uint32_t(b[at + 1]) << 8 | uint32_t(b[at + 2]) << 16 | uint32_t(b[at + 3]) << 24;
 }
 
 // A chunk type or magic number as text and hex, e.g. "'BIN\0' (0x004E4942)", for messages.
@@ -349,7 +345,7 @@ const std::set<std::string> kSupported = {kTextureTransform, kEmissiveStrength,
                                           kProbesExtension,  kSpecGloss,
                                           kVariants,         kSpecular,
                                           kClearcoat,        kSheen,
-                                          kVolume};
+                                          kVolume,           kMeshopt};
 
 // An extension the file uses but does not require may be ignored (glTF 2.0, 3.12): a warning per extension.
 void checkUsedExtensions(const LoadContext& ctx) {
@@ -551,7 +547,8 @@ void checkReferences(const LoadContext& ctx) {
     forEach(ctx, d, "buffers", "", [&](const std::string& e, const Json& b) {
         int64_t length = integer(ctx, b, "byteLength", -1, e);
         if (length < 1) ctx.fail(e + ".byteLength", "missing or < 1; expected the buffer's size in bytes");
-        if (!member(b, "uri")) {
+        // An EXT_meshopt_compression fallback may hold no data: what reads it is decoded from another buffer.
+        if (!member(b, "uri") && !isMeshoptFallback(b)) {
             if (!binary || !bufferLength.empty()) {
                 ctx.fail(e, "has no uri; expected a file name or data: URI (only a .glb's first buffer may omit it)");
             }
@@ -642,6 +639,8 @@ void prepareTinygltfInput(LoadContext& ctx) {
             edit()[name][i]["uri"] = header + base64Encode(data);
         }
     }
+    // EXT_meshopt_compression, which tinygltf does not know: its views decoded into a buffer of their own.
+    decodeMeshoptCompression(ctx, edit);
     // tinygltf refuses an index accessor without a bufferView (glTF: all zeros, plus sparse values).
     const Json* meshes = member(ctx.doc, "meshes");
     const Json* accessors = member(ctx.doc, "accessors");

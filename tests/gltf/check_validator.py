@@ -2,8 +2,8 @@
 """ctest gltf.validator: every glTF file vitrine writes passes the Khronos glTF-Validator with no cap on messages.
 
 Exports `vitrine export-scene museum` (64-texel textures: the JSON is the same at any size), the showcase model and the
-round trip (load, export) of every file in tests/data/gltf/corpus/ and tests/data/gltf/viewer/ and of quad.gltf and
-layered.gltf, then runs tools/gltf-validator/validate.mjs (npm gltf-validator, pinned by its package-lock.json,
+round trip (load, export) of every file in tests/data/gltf/corpus/ and tests/data/gltf/viewer/, of two of the latter
+compressed by gltfpack -cc (EXT_meshopt_compression, KHR_mesh_quantization) and of quad.gltf and layered.gltf, then runs tools/gltf-validator/validate.mjs (npm gltf-validator, pinned by its package-lock.json,
 installed by tools/install-deps.sh) on them and on those test files themselves with maxIssues 0. Fails on any error or
 warning, and when the validator is not installed (never skipped). Infos are printed and counted, not failed: the
 lightmap UVs (TEXCOORD_1) and the textures that only VITRINE_material_layers samples are used by vitrine, which the
@@ -33,6 +33,15 @@ def main():
     if not viewer_files:
         sys.exit("gltf.validator: no files in tests/data/gltf/viewer/")
     corpus += viewer_files
+    # EXT_meshopt_compression files made by an independent encoder (Debian's gltfpack, installed by
+    # tools/install-deps.sh), quantized and compressed with filters: validated, and loaded for the round trip.
+    for f in [os.path.join(src, "tests", "data", "gltf", "viewer", n) for n in ("white_sphere.gltf", "metal_spheres.gltf")]:
+        packed = os.path.join(out, "gltfpack_" + os.path.basename(f))
+        r = subprocess.run(["gltfpack", "-i", f, "-o", packed, "-cc"], capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit(f"gltf.validator: gltfpack on {f} failed ({r.returncode}; installed by tools/install-deps.sh):\n"
+                     f"{r.stdout}{r.stderr}")
+        corpus.append(packed)
     sources = [("museum", "museum"), (os.path.join(src, "data", "models", "showcase.gltf"), "showcase")]
     sources += [(os.path.join(src, "tests", "data", "gltf", n + ".gltf"), n) for n in ("quad", "layered")]
     sources += [(f, "corpus_" + os.path.splitext(os.path.basename(f))[0]) for f in corpus]
