@@ -223,6 +223,19 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
             mVertices = GpuBuffer(ctx, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                   true, scene.name + ".vertices");
             std::memcpy(mVertices.mapped(), scene.vertices.data(), vbytes);
+            mPrevPositions = GpuBuffer(ctx, scene.vertices.size() * sizeof(glm::vec4),
+                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, scene.name + ".prev_positions");
+            auto* prev = static_cast<glm::vec4*>(mPrevPositions.mapped());
+            for (size_t v = 0; v < scene.vertices.size(); ++v)
+                prev[v] = glm::vec4(scene.vertices[v].position, 1.0f);
+            mDeformedMesh.assign(scene.meshes.size(), false);
+            for (uint32_t n : mSkinnedNodes)
+                mDeformedMesh[scene.nodes[n].mesh] = true;
+            for (size_t m = 0; m < scene.meshes.size() && mMorphAnimated; ++m) {
+                const scene::Mesh& mesh = scene.meshes[m];
+                for (uint32_t k = 0; k < mesh.primitiveCount; ++k)
+                    mDeformedMesh[m] = mDeformedMesh[m] || scene.primitives[mesh.firstPrimitive + k].targetCount > 0;
+            }
             mMeshWeights.resize(scene.meshes.size());
             for (size_t m = 0; m < scene.meshes.size(); ++m)
                 mMeshWeights[m] = scene.meshes[m].weights;
@@ -242,6 +255,9 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, scene.name + ".materials");
         mLayers = uploadBuffer(ctx, layers.data(), layers.size() * sizeof(GpuLayer), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                scene.name + ".layers");
+        if (!mPrevPositions.buffer())
+            mPrevPositions = GpuBuffer(ctx, sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true,
+                                       scene.name + ".prev_positions"); // nothing deforms: never read
         mInstances = GpuBuffer(ctx, std::max<size_t>(1, scene.instances.size()) * sizeof(GpuInstance),
                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, scene.name + ".instances");
         mCamera = GpuBuffer(ctx, sizeof(GpuCamera), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true, scene.name + ".camera");
@@ -479,19 +495,20 @@ void GpuScene::createDescriptors() {
     VkDevice device = mCtx.device();
     const uint32_t textures = std::max<uint32_t>(1, textureCount());
     const VkShaderStageFlags stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT | VK_SHADER_STAGE_COMPUTE_BIT;
-    VkDescriptorSetLayoutBinding b[5] = {
+    VkDescriptorSetLayoutBinding b[6] = {
         {0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, nullptr},
         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
         {4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, textures, stages, nullptr},
+        {5, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr},
     };
     VkDescriptorSetLayoutCreateInfo li{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    li.bindingCount = 5;
+    li.bindingCount = 6;
     li.pBindings = b;
     VK_CHECK(vkCreateDescriptorSetLayout(device, &li, nullptr, &mSetLayout));
     VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3},
+                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4},
                                      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, textures}};
     VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pi.maxSets = 1;
@@ -504,22 +521,25 @@ void GpuScene::createDescriptors() {
     ai.pSetLayouts = &mSetLayout;
     VK_CHECK(vkAllocateDescriptorSets(device, &ai, &mSet));
 
-    VkDescriptorBufferInfo buffers[4] = {{mCamera.buffer(), 0, VK_WHOLE_SIZE},
+    VkDescriptorBufferInfo buffers[6] = {{mCamera.buffer(), 0, VK_WHOLE_SIZE},
                                          {mInstances.buffer(), 0, VK_WHOLE_SIZE},
                                          {mMaterials.buffer(), 0, VK_WHOLE_SIZE},
-                                         {mLayers.buffer(), 0, VK_WHOLE_SIZE}};
+                                         {mLayers.buffer(), 0, VK_WHOLE_SIZE},
+                                         {},
+                                         {mPrevPositions.buffer(), 0, VK_WHOLE_SIZE}};
     std::vector<VkDescriptorImageInfo> images;
     for (uint32_t t = 0; t < mTextures.size(); ++t)
         images.push_back({mSamplers[t], mTextures[t].view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
     if (images.empty()) images.push_back({mSamplers[0], mFallback.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
     std::vector<VkWriteDescriptorSet> writes;
-    for (uint32_t i = 0; i < 5; ++i) {
+    for (uint32_t i = 0; i < 6; ++i) {
         VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
         w.dstSet = mSet;
         w.dstBinding = i;
         w.descriptorType = b[i].descriptorType;
-        w.descriptorCount = i < 4 ? 1 : static_cast<uint32_t>(images.size());
-        if (i < 4) w.pBufferInfo = &buffers[i];
+        w.descriptorCount = i != 4 ? 1 : static_cast<uint32_t>(images.size());
+        if (i != 4)
+            w.pBufferInfo = &buffers[i];
         else w.pImageInfo = images.data();
         writes.push_back(w);
     }
@@ -534,6 +554,8 @@ void GpuScene::update(const scene::ScenePose& pose, const scene::ScenePose& prev
         out[i].world = world;
         out[i].prevWorld = prev;
         out[i].normalMatrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(world))));
+        const uint32_t mesh = mScene.instances[i].mesh;
+        out[i].flags = glm::vec4(mesh < mDeformedMesh.size() && mDeformedMesh[mesh] ? 1.0f : 0.0f, 0.0f, 0.0f, 0.0f);
     }
     GpuCamera c = camera.gpu();
     std::memcpy(mCamera.mapped(), &c, sizeof(c));
@@ -549,6 +571,49 @@ void GpuScene::update(const scene::ScenePose& pose, const scene::ScenePose& prev
                 if (p.skinned)
                     mScene.skinPrimitive(mesh.firstPrimitive + k, joints,
                                          std::span<scene::Vertex>(vertices + p.vertexOffset, p.vertexCount));
+            }
+        }
+    }
+    // Last frame's positions of what deforms: the same deformation with the previous pose (stateless, as prevWorld:
+    // the first frame rendered, or one after a jump in time, gets its true motion).
+    if (!mDeformedMesh.empty()) {
+        auto* prev = static_cast<glm::vec4*>(mPrevPositions.mapped());
+        const scene::ScenePose& before = previous.nodeWorld.size() == mScene.nodes.size() ? previous : pose;
+        std::vector<scene::Vertex> posed;
+        auto write = [&](const scene::Primitive& p) {
+            for (uint32_t v = 0; v < p.vertexCount; ++v)
+                prev[p.vertexOffset + v] = glm::vec4(posed[v].position, 1.0f);
+        };
+        std::vector<bool> done(mScene.meshes.size(), false);
+        if (pose.nodeWorld.size() == mScene.nodes.size()) {
+            for (uint32_t n : mSkinnedNodes) {
+                const uint32_t m = mScene.nodes[n].mesh;
+                if (done[m]) continue;
+                done[m] = true;
+                const std::vector<glm::mat4> joints = mScene.jointMatrices(n, before);
+                const scene::Mesh& mesh = mScene.meshes[m];
+                for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                    const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
+                    if (!p.skinned) continue;
+                    posed.assign(p.vertexCount, scene::Vertex{});
+                    mScene.skinPrimitive(mesh.firstPrimitive + k, joints, posed);
+                    write(p);
+                }
+            }
+        }
+        std::vector<bool> skinned(mScene.meshes.size(), false); // posed by their skin (a morph on it is not applied)
+        for (uint32_t n : mSkinnedNodes)
+            skinned[mScene.nodes[n].mesh] = true;
+        for (size_t m = 0; m < mScene.meshes.size() && mMorphAnimated; ++m) {
+            if (!mDeformedMesh[m] || done[m] || skinned[m]) continue;
+            const scene::Mesh& mesh = mScene.meshes[m];
+            const bool animated = m < before.meshWeights.size() && !before.meshWeights[m].empty();
+            const std::vector<float>& w = animated ? before.meshWeights[m] : mesh.weights;
+            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
+                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
+                posed.assign(p.vertexCount, scene::Vertex{});
+                mScene.morphVertices(mesh.firstPrimitive + k, w, posed);
+                write(p);
             }
         }
     }

@@ -94,7 +94,8 @@ public:
 
     // Writes this frame's instance transforms (with last frame's for velocity) and camera, re-skins the meshes of
     // nodes whose skin has animated joints and re-morphs those whose morph weights an animation changed
-    // (pose.meshWeights). The vertex buffer is then host-visible; velocity and the ray-tracing BVH do not follow. Safe while
+    // (pose.meshWeights). The vertex buffer is then host-visible, and the same deformation with `previous` writes
+    // those vertices' last-frame positions (binding 5) for velocity; the ray-tracing BVH does not follow. Safe while
     // recording: the render graph runs one frame in flight, so the GPU is done with the last frame.
     void update(const scene::ScenePose& pose, const scene::ScenePose& previous, const CameraFrame& camera);
 
@@ -136,6 +137,7 @@ private:
     Context& mCtx;
     const scene::Scene& mScene;
     GpuBuffer mVertices, mIndices, mMaterials, mLayers, mInstances, mCamera;
+    GpuBuffer mPrevPositions;       // vec4 per vertex when meshes deform (else one): last frame's positions, binding 5
     GpuBuffer mTexelTable, mTexels; // the texel pool (geometrySet() bindings 2 and 3), made with the set
     StorageBufferSet mGeometrySet;
     std::vector<GpuImage> mTextures;       // one per scene texture
@@ -151,6 +153,7 @@ private:
     bool mMorphAnimated = false;                  // an animation drives morph weights
     std::vector<std::vector<float>> mMeshWeights; // the weights the vertex buffer holds, per mesh
     std::vector<uint32_t> mSkinnedNodes;          // nodes whose skin moves: update() skins their mesh every frame
+    std::vector<bool> mDeformedMesh;              // per mesh: update() deforms it (skinned or morph-animated)
 };
 
 // What travels on a Scene port. CPU data from setup(); the GPU copy once a pass asks for it.

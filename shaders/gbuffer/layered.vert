@@ -22,7 +22,9 @@ layout(location = 7) out float vViewDepth;
 void main() {
     GpuInstance inst = instances[draw.instance];
     vec4 world = inst.world * vec4(inPosition, 1.0);
-    vec4 prevWorld = inst.prevWorld * vec4(inPosition, 1.0);
+    // A re-skinned or re-morphed vertex was elsewhere last frame (GpuScene::update()).
+    vec3 prevPosition = inst.flags.x != 0.0 ? scenePrevPositions[gl_VertexIndex].xyz : inPosition;
+    vec4 prevWorld = inst.prevWorld * vec4(prevPosition, 1.0);
     mat3 nm = mat3(inst.normalMatrix);
     vNormal = nm * inNormal;
     vTangent = vec4(mat3(inst.world) * inTangent.xyz, inTangent.w);

@@ -20,6 +20,8 @@ layout(set = VITRINE_SCENE_SET, binding = 1, std430) readonly buffer SceneInstan
 layout(set = VITRINE_SCENE_SET, binding = 2, std430) readonly buffer SceneMaterials { GpuMaterial materials[]; };
 layout(set = VITRINE_SCENE_SET, binding = 3, std430) readonly buffer SceneLayers { GpuLayer layers[]; };
 layout(set = VITRINE_SCENE_SET, binding = 4) uniform sampler2D sceneTextures[VITRINE_SCENE_TEXTURES];
+// Last frame's positions (object space, w = 1) of the vertices of deformed meshes, by vertex index (GpuInstance::flags.x).
+layout(set = VITRINE_SCENE_SET, binding = 5, std430) readonly buffer ScenePrevPositions { vec4 scenePrevPositions[]; };
 
 vec2 refUv(GpuTexRef r, vec2 uv0, vec2 uv1) {
     vec3 uv = vec3(r.info.y == 0 ? uv0 : uv1, 1.0);

@@ -81,6 +81,9 @@ struct GpuInstance {
     mat4 world;
     mat4 prevWorld;    // last frame's (equal to world on the first frame and for static instances)
     mat4 normalMatrix; // inverse transpose of world's upper 3x3
+    // x: 1 when the instance's mesh is deformed on the CPU every frame (animated joints or morph weights): its
+    // vertices' last-frame positions are scenePrevPositions[gl_VertexIndex] (velocity); 0: they are the vertex's own.
+    vec4 flags;
 };
 
 // One frame's camera. Jitter (sub-pixel, for temporal AA) is in `viewProj` only: velocity is computed from
@@ -116,7 +119,7 @@ VITRINE_PUSH_END(draw)
 static_assert(sizeof(GpuTexRef) == 48);
 static_assert(sizeof(GpuLayer) == 64 + 6 * 48);
 static_assert(sizeof(GpuMaterial) == 32 + 48 + 16 + 16 + 2 * 48 + 16 + 3 * 48 + 16 + 2 * 48 + 16 + 48);
-static_assert(sizeof(GpuInstance) == 192);
+static_assert(sizeof(GpuInstance) == 3 * 64 + 16);
 static_assert(sizeof(GpuCamera) == 6 * 64 + 4 * 16);
 static_assert(sizeof(SceneDrawPush) == 96);
 }

@@ -140,5 +140,64 @@ TEST_F(GltfCorpus, SkinnedTwoBoneBendDrawsWhereCpuSkinningPutsIt) {
     EXPECT_TRUE(covered(bent, 0.0, 0.5)); // the lower bone stays
 }
 
+// gbuffer.velocity (pixels, this frame minus last) of vertices the CPU deforms every frame (fps 1) against the motion
+// of the same surface point between the two frames worked out here:
+// - morph_animated.gltf at frame 2 (t = 2 s, the last at t = 1; the rest weight is 0, so last frame is not the rest
+//   pose): the front face spans x in [-0.5, 0.5 + w(t)], w = t / 2 (the orthographic camera shows 4 m across W pixels
+//   from x = -2); the point at fraction f of the face moves by f (w(2) - w(1)) = f / 2 m to the right;
+// - skin_bend.gltf at frame 1 (t = 1, the last at t = 0):
+//   the upper bone (rows 1.5-2, weight 1 on joint 1) turned 90° about Z round the joint at (0, 1), so
+//   the point p at t = 1 was at (0, 1) + R(-90°)(p - (0, 1)) = (p.y - 1, 1 - p.x) at t = 0.
+TEST_F(GltfCorpus, VelocityFollowsMorphedAndSkinnedVertices) {
+    const int w = 128, h = 128;
+    auto velocity = [&](const std::string& file, int frames) {
+        json graph = {
+            {"format", "vitrine-graph/1"},
+            {"frame", {{"width", w}, {"height", h}, {"frames", frames}}},
+            {"nodes",
+             {{"scene",
+               {{"type", "scene.gltf"},
+                {"params", {{"path", corpus(file).string()}, {"jitter", "off"}, {"start", 0.0}, {"fps", 1}}}}},
+              {"gbuffer", {{"type", "gbuffer.layered"}, {"in", {{"scene", "scene.scene"}}}}}}},
+            {"outputs", {{"velocity", "gbuffer.velocity"}, {"depth", "gbuffer.depth"}}}};
+        return runGraph(graph);
+    };
+    // Half-float velocities of up to 24 px: steps of 1/64 px.
+    const double tolerance = 0.05;
+    {
+        auto images = velocity("morph_animated.gltf", 3);
+        const Image& v = images.at("velocity");
+        int checked = 0;
+        for (int px = 0; px < w; px += 3) {
+            const double x1 = (px + 0.5) / w * 4.0 - 2.0;
+            if (x1 < -0.45 || x1 > 1.45) continue; // on the front face at t = 2, away from its edges
+            ASSERT_GT(images.at("depth").at(px, h / 2)[0], 0.0f) << px;
+            const double f = (x1 + 0.5) / 2.0, x0 = -0.5 + f * 1.5;
+            const double want = (x1 - x0) / 4.0 * w;
+            EXPECT_NEAR(v.at(px, h / 2)[0], want, tolerance) << "morph: pixel " << px;
+            EXPECT_NEAR(v.at(px, h / 2)[1], 0.0, tolerance) << "morph: pixel " << px;
+            ++checked;
+        }
+        EXPECT_GE(checked, 10);
+    }
+    {
+        auto images = velocity("skin_bend.gltf", 2);
+        const Image& v = images.at("velocity");
+        int checked = 0;
+        for (int px = 0; px < w; ++px) {
+            for (int py = 0; py < h; ++py) {
+                const double x1 = (px + 0.5) / w * 4.0 - 2.0, y1 = 3.0 - (py + 0.5) / h * 4.0;
+                if (x1 < -0.95 || x1 > -0.55 || std::abs(y1 - 1.0) > 0.08) continue; // the upper bone's outer half
+                ASSERT_GT(images.at("depth").at(px, py)[0], 0.0f) << px << ", " << py;
+                const double x0 = y1 - 1.0, y0 = 1.0 - x1;
+                EXPECT_NEAR(v.at(px, py)[0], (x1 - x0) / 4.0 * w, tolerance) << "skin: pixel " << px << ", " << py;
+                EXPECT_NEAR(v.at(px, py)[1], (y0 - y1) / 4.0 * h, tolerance) << "skin: pixel " << px << ", " << py;
+                ++checked;
+            }
+        }
+        EXPECT_GE(checked, 20);
+    }
+}
+
 } // namespace
 } // namespace vitrine::test
