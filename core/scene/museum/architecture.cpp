@@ -155,8 +155,12 @@ void buildHall(Museum& m) {
     openings[2].push_back(walls[2].opening({0, 0, kHallZ}, 2 * kDoorHalf, 0.0f, kDoorH));
     openings[3].push_back(walls[3].opening({-kHallX, 0, 0}, 2 * kDoorHalf, 0.0f, kDoorH));
     shell.material(m.mat.hallStone);
+    // Walls 1-3 open into a gallery whose lining stands kLiningGap in front of them (buildGallery): their doorways'
+    // reveals reach it. (Without, the camera saw the hall's wall down that 1-cm slot, whose texels the bake finds
+    // inside geometry, as a black line beside every doorway.)
     for (int i = 0; i < 4; ++i)
-        slab(shell, walls[i].frame(), walls[i].w, kHallH + 0.6f, t, openings[i], glm::vec2(1.0f));
+        slab(shell, walls[i].frame(), walls[i].w, kHallH + 0.6f, t, openings[i], glm::vec2(1.0f), true, true,
+             i == 0 ? 0.0f : kLiningGap);
 
     // Ceiling and roof, with four skylight wells.
     shell.material(m.mat.ceiling);
@@ -212,7 +216,7 @@ void buildGallery(Museum& m, const GallerySpec& g) {
             // In front of the hall's wall, which has the reveals already: a face with a doorway only.
             Wall lining = walls[i];
             glm::vec3 n = glm::cross(lining.u, kY);
-            lining.a += lining.u * t + n * 0.01f;
+            lining.a += lining.u * t + n * kLiningGap;
             lining.w -= 2 * t;
             openings.push_back(lining.opening(lining.facing(center), 2 * kDoorHalf, 0.0f, kDoorH));
             slab(shell, lining.frame(), lining.w, kRoomH + 0.01f, t, openings, glm::vec2(1.0f), false, false);

@@ -13,6 +13,9 @@ namespace vitrine::scene::museum {
 
 namespace plan {
 constexpr float kWall = 0.4f; // wall thickness
+// A gallery's lining stands this far in front of the hall's wall (no shared plane to fight over); the hall's
+// doorways' jambs and heads reach across the gap to it.
+constexpr float kLiningGap = 0.01f;
 // Interior of the hall: x ∈ [-kHallX, kHallX], z ∈ [-kHallZ, kHallZ], y ∈ [0, kHallH].
 constexpr float kHallX = 16.0f, kHallZ = 7.0f, kHallH = 9.0f;
 constexpr float kRoomH = 5.5f;   // side galleries' ceiling

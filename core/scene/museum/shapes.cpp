@@ -69,7 +69,7 @@ void faceWithHoles(MeshBuilder& b, const Frame& f, float w, float h, std::span<c
 } // namespace
 
 void slab(MeshBuilder& b, const Frame& f, float w, float h, float t, std::span<const Opening> openings,
-          glm::vec2 uvScale, bool back, bool reveals) {
+          glm::vec2 uvScale, bool back, bool reveals, float revealBeyond) {
     glm::vec3 n = f.normal();
     faceWithHoles(b, f, w, h, openings, uvScale);
     if (back) {
@@ -81,11 +81,12 @@ void slab(MeshBuilder& b, const Frame& f, float w, float h, float t, std::span<c
     }
     for (const Opening& o : reveals ? openings : std::span<const Opening>()) {
         float ow = o.x1 - o.x0, oh = o.y1 - o.y0;
-        rect(b, Frame{f.at(o.x0, o.y0), -n, f.v}, t, oh, uvScale);                      // left jamb, facing +u
-        rect(b, Frame{f.at(o.x1, o.y0) - n * t, n, f.v}, t, oh, uvScale);               // right jamb, facing -u
+        const float deep = t + revealBeyond;
+        rect(b, Frame{f.at(o.x0, o.y0), -n, f.v}, deep, oh, uvScale);           // left jamb, facing +u
+        rect(b, Frame{f.at(o.x1, o.y0) - n * deep, n, f.v}, deep, oh, uvScale); // right jamb, facing -u
         // Sill facing +v; at y0 = 0 it is a doorway's threshold, closing the floor across the wall.
         rect(b, Frame{f.at(o.x0, o.y0), f.u, -n}, ow, t, uvScale);
-        if (o.y1 < h) rect(b, Frame{f.at(o.x0, o.y1) - n * t, f.u, n}, ow, t, uvScale); // head, facing -v
+        if (o.y1 < h) rect(b, Frame{f.at(o.x0, o.y1) - n * deep, f.u, n}, ow, deep, uvScale); // head, facing -v
     }
 }
 

@@ -36,9 +36,11 @@ void rect(MeshBuilder& b, const Frame& f, float w, float h, glm::vec2 uvScale, i
 
 // A wall or ceiling slab: the front face in the frame's plane, a back face thickness behind it, and
 // openings cut through both with their reveals (jambs, sill, head). back = false leaves out the back,
-// reveals = false the reveals (a lining in front of a wall that has them already).
+// reveals = false the reveals (a lining in front of a wall that has them already). The jambs and the head
+// reach revealBeyond past the back face: to a lining standing that far in front of it, so that no slot
+// between the two shows in the opening (the sill does not: the floor beyond carries on under the lining).
 void slab(MeshBuilder& b, const Frame& f, float w, float h, float thickness, std::span<const Opening> openings,
-          glm::vec2 uvScale, bool back = true, bool reveals = true);
+          glm::vec2 uvScale, bool back = true, bool reveals = true, float revealBeyond = 0.0f);
 
 void box(MeshBuilder& b, const glm::vec3& min, const glm::vec3& max, float uvScale);
 
