@@ -228,9 +228,10 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
             auto* prev = static_cast<glm::vec4*>(mPrevPositions.mapped());
             for (size_t v = 0; v < scene.vertices.size(); ++v)
                 prev[v] = glm::vec4(scene.vertices[v].position, 1.0f);
-            mDeformedMesh.assign(scene.meshes.size(), false);
+            mSkinnedMesh.assign(scene.meshes.size(), false);
             for (uint32_t n : mSkinnedNodes)
-                mDeformedMesh[scene.nodes[n].mesh] = true;
+                mSkinnedMesh[scene.nodes[n].mesh] = true;
+            mDeformedMesh = mSkinnedMesh;
             for (size_t m = 0; m < scene.meshes.size() && mMorphAnimated; ++m) {
                 const scene::Mesh& mesh = scene.meshes[m];
                 for (uint32_t k = 0; k < mesh.primitiveCount; ++k)
@@ -601,11 +602,8 @@ void GpuScene::update(const scene::ScenePose& pose, const scene::ScenePose& prev
                 }
             }
         }
-        std::vector<bool> skinned(mScene.meshes.size(), false); // posed by their skin (a morph on it is not applied)
-        for (uint32_t n : mSkinnedNodes)
-            skinned[mScene.nodes[n].mesh] = true;
         for (size_t m = 0; m < mScene.meshes.size() && mMorphAnimated; ++m) {
-            if (!mDeformedMesh[m] || done[m] || skinned[m]) continue;
+            if (!mDeformedMesh[m] || mSkinnedMesh[m]) continue; // a skinned mesh is posed by its skin (above)
             const scene::Mesh& mesh = mScene.meshes[m];
             const bool animated = m < before.meshWeights.size() && !before.meshWeights[m].empty();
             const std::vector<float>& w = animated ? before.meshWeights[m] : mesh.weights;

@@ -153,6 +153,7 @@ private:
     bool mMorphAnimated = false;                  // an animation drives morph weights
     std::vector<std::vector<float>> mMeshWeights; // the weights the vertex buffer holds, per mesh
     std::vector<uint32_t> mSkinnedNodes;          // nodes whose skin moves: update() skins their mesh every frame
+    std::vector<bool> mSkinnedMesh;               // per mesh: posed by a moving skin (a morph on it is not applied)
     std::vector<bool> mDeformedMesh;              // per mesh: update() deforms it (skinned or morph-animated)
 };
 

@@ -314,13 +314,10 @@ TEST_F(Ssr, ColorPyramidTexelsAreTheMeanOfTheirFootprint) {
     }
 }
 
-// The SSR chain over a scene's G-buffer with a test image (each pixel's coordinates by default) as the colour the
-// reflections read: scene, G-buffer, Hi-Z, colour pyramid and ssr.hiz with `params`.
-json ssrNodes(const std::filesystem::path& glb, json params, const char* source = "test.ssr_coords") {
-    json n = baseNodes(glb);
-    n["coords"] = {{"type", source}};
+// Hi-Z, the colour pyramid of `color` and ssr.hiz with `params`, added to nodes that have the G-buffer.
+void addSsrChain(json& n, const char* color, json params = json::object()) {
     n["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-    n["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "coords.result"}}}};
+    n["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", color}}}};
     n["ssr"] = {{"type", "ssr.hiz"},
                 {"in",
                  {{"normal", "gbuffer.normal"},
@@ -328,7 +325,15 @@ json ssrNodes(const std::filesystem::path& glb, json params, const char* source 
                   {"hiz", "hiz.hiz"},
                   {"color", "pyramid.pyramid"},
                   {"camera", "scene.camera"}}},
-                {"params", params}};
+                {"params", std::move(params)}};
+}
+
+// The SSR chain over a scene's G-buffer with a test image (each pixel's coordinates by default) as the colour the
+// reflections read: scene, G-buffer, Hi-Z, colour pyramid and ssr.hiz with `params`.
+json ssrNodes(const std::filesystem::path& glb, json params, const char* source = "test.ssr_coords") {
+    json n = baseNodes(glb);
+    n["coords"] = {{"type", source}};
+    addSsrChain(n, "coords.result", std::move(params));
     return n;
 }
 
@@ -832,15 +837,7 @@ TEST_F(Ssr, CompositeMatchesTheCpuBlend) {
         const int W = MirrorScene::W, H = MirrorScene::H;
         json nodes = baseNodes(m.glb);
         nodes["lighting"] = lightingNode(json::object(), false);
-        nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-        nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "lighting.color"}}}};
-        nodes["ssr"] = {{"type", "ssr.hiz"},
-                        {"in",
-                         {{"normal", "gbuffer.normal"},
-                          {"depth", "gbuffer.depth"},
-                          {"hiz", "hiz.hiz"},
-                          {"color", "pyramid.pyramid"},
-                          {"camera", "scene.camera"}}}};
+        addSsrChain(nodes, "lighting.color");
         nodes["composite"] = compositeNode("ssr.reflection");
         nodes["composite"]["params"] = {{"multiscatter", multiscatter}};
         auto out = runGraph(graph(nodes,
@@ -1182,15 +1179,7 @@ TEST_F(Ssr, ReducesTheFlipErrorAgainstThePathTracedReference) {
     const int W = MirrorScene::W, H = MirrorScene::H;
     json nodes = baseNodes(m.glb);
     nodes["lighting"] = lightingNode({{"sky_ambient", 1.0}}, false);
-    nodes["hiz"] = {{"type", "depth.hiz"}, {"in", {{"depth", "gbuffer.depth"}}}};
-    nodes["pyramid"] = {{"type", "color.pyramid"}, {"in", {{"color", "lighting.color"}}}};
-    nodes["ssr"] = {{"type", "ssr.hiz"},
-                    {"in",
-                     {{"normal", "gbuffer.normal"},
-                      {"depth", "gbuffer.depth"},
-                      {"hiz", "hiz.hiz"},
-                      {"color", "pyramid.pyramid"},
-                      {"camera", "scene.camera"}}}};
+    addSsrChain(nodes, "lighting.color");
     nodes["composite"] = compositeNode("ssr.reflection");
     nodes["env_cdf"] = {{"type", "sky.env_cdf"}, {"in", {{"sky", "sky.cubemap"}}}};
     nodes["pt"] = {{"type", "render.pathtrace"},

@@ -324,11 +324,6 @@ float rayTriangleT(const glm::vec3& o, const glm::vec3& d, const glm::vec3& a, c
     return along > 1e-4f ? along : -1.0f;
 }
 
-bool rayHitsTriangle(const glm::vec3& o, const glm::vec3& d, const glm::vec3& a, const glm::vec3& b,
-                     const glm::vec3& c) {
-    return rayTriangleT(o, d, a, b, c) > 0.0f;
-}
-
 bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, const Aabb& box) {
     glm::vec3 t0 = (box.min - o) / d, t1 = (box.max - o) / d;
     glm::vec3 lo = glm::min(t0, t1), hi = glm::max(t0, t1);
@@ -336,10 +331,10 @@ bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, const Aabb& box) {
            std::min(std::min(hi.x, hi.y), hi.z) > 0.0f;
 }
 
-// The nearest surface along a ray from origin in the unit direction dir, brute force over every triangle at the
-// pose of time 0; infinity if none.
-float nearestSurface(const Scene& s, const glm::vec3& origin, const glm::vec3& dir) {
-    const ScenePose pose = s.evaluate(0.0);
+// The nearest surface along a ray from origin in direction dir (t in units of |dir|), brute force over every triangle
+// at `pose`; infinity if none. anyHit: the first one found instead (a shadow ray's question).
+float nearestSurface(const Scene& s, const ScenePose& pose, const glm::vec3& origin, const glm::vec3& dir,
+                     bool anyHit = false) {
     float nearest = std::numeric_limits<float>::infinity();
     for (size_t i = 0; i < s.instances.size(); ++i) {
         const Mesh& mesh = s.meshes[s.instances[i].mesh];
@@ -354,6 +349,7 @@ float nearestSurface(const Scene& s, const glm::vec3& origin, const glm::vec3& d
                         w *
                         glm::vec4(s.vertices[prim.vertexOffset + s.indices[prim.firstIndex + k + j]].position, 1.0f));
                 const float t = rayTriangleT(origin, dir, v[0], v[1], v[2]);
+                if (t > 0.0f && anyHit) return t;
                 if (t > 0.0f) nearest = std::min(nearest, t);
             }
         }
@@ -368,6 +364,7 @@ float nearestSurface(const Scene& s, const glm::vec3& origin, const glm::vec3& d
 TEST_F(Museum, DoorwaysAreClosedUpToTheGalleriesLinings) {
     using namespace museum::plan;
     const Scene& s = museum();
+    const ScenePose pose = s.evaluate(0.0);
     struct Doorway {
         glm::vec3 inner;   // centre of the doorway's floor line on the hall's inner face
         glm::vec3 outward; // into the gallery
@@ -381,7 +378,7 @@ TEST_F(Museum, DoorwaysAreClosedUpToTheGalleriesLinings) {
     int rays = 0;
     auto expectClosedAt = [&](const glm::vec3& origin, const glm::vec3& aim, const char* where) {
         const float distance = glm::length(aim - origin);
-        const float hit = nearestSurface(s, origin, (aim - origin) / distance);
+        const float hit = nearestSurface(s, pose, origin, (aim - origin) / distance);
         EXPECT_NEAR(hit, distance, 2e-3f) << where << ": aimed at (" << aim.x << ", " << aim.y << ", " << aim.z
                                           << "), a surface " << hit << " m away instead of " << distance;
         ++rays;
@@ -409,24 +406,7 @@ TEST_F(Museum, SunlightFallsInPatches) {
     glm::vec3 toSun = glm::normalize(s.sun.toSun);
     ScenePose pose = s.evaluate(0.0);
     auto lit = [&](const glm::vec3& origin) {
-        for (size_t i = 0; i < s.instances.size(); ++i) {
-            const Mesh& mesh = s.meshes[s.instances[i].mesh];
-            const glm::mat4& w = pose.instanceWorld[i];
-            for (uint32_t p = 0; p < mesh.primitiveCount; ++p) {
-                const Primitive& prim = s.primitives[mesh.firstPrimitive + p];
-                if (!rayHitsBox(origin, toSun, prim.bounds.transformed(w))) continue;
-                for (uint32_t k = 0; k < prim.indexCount; k += 3) {
-                    glm::vec3 v[3];
-                    for (int j = 0; j < 3; ++j) {
-                        v[j] = glm::vec3(
-                            w * glm::vec4(s.vertices[prim.vertexOffset + s.indices[prim.firstIndex + k + j]].position,
-                                          1.0f));
-                    }
-                    if (rayHitsTriangle(origin, toSun, v[0], v[1], v[2])) return false;
-                }
-            }
-        }
-        return true;
+        return nearestSurface(s, pose, origin, toSun, true) == std::numeric_limits<float>::infinity();
     };
     int litCount = 0, total = 0;
     for (float x = -15.0f; x <= 15.0f; x += 0.5f) {
