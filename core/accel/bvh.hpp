@@ -10,6 +10,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -110,5 +111,12 @@ struct BvhArrays {
 // Depth stays within options.maxDepth: deep subtrees switch to object-median splits.
 BvhBottomLevel buildBottomLevel(std::span<const BvhBuildTriangle> triangles, const BvhBuildOptions& options,
                                 BvhArrays& out);
+
+// Moves the triangles of a bottom level that `arrays` holds to new corners (corners(ref, v) writes the three of the
+// triangle whose GpuBvhTriangleRef is ref) and recomputes every box of its nodes bottom up, and level.bounds. The tree
+// stays as it was built: a refit is one pass over the level, and it stays exact (every box holds its triangles) while
+// traversal slows as far as the triangles moved from where the SAH split them.
+void refitBottomLevel(BvhBottomLevel& level, BvhArrays& arrays,
+                      const std::function<void(const GpuBvhTriangleRef&, glm::vec3 (&)[3])>& corners);
 
 } // namespace vitrine::accel

@@ -229,4 +229,42 @@ BvhBottomLevel buildBottomLevel(std::span<const BvhBuildTriangle> triangles, con
     return Builder(triangles, options, out).run();
 }
 
+namespace {
+
+// The box of node's subtree, after writing its children's boxes from their triangles (leaves) or subtrees.
+BvhBox refitNode(BvhArrays& arrays, uint32_t node) {
+    BvhBox box;
+    for (int which = 0; which < 2; ++which) {
+        BvhChild child = childOf(arrays.nodes[node], which);
+        if (child.absent()) continue;
+        BvhBox b;
+        if (child.leaf()) {
+            for (uint32_t t = child.link; t < child.link + child.count; ++t) {
+                const GpuBvhTriangle& tri = arrays.triangles[t];
+                b.expand(glm::vec3(tri.v0));
+                b.expand(glm::vec3(tri.v1));
+                b.expand(glm::vec3(tri.v2));
+            }
+        } else {
+            b = refitNode(arrays, child.link);
+        }
+        child.box = b;
+        setChild(arrays.nodes[node], which, child);
+        box.expand(b);
+    }
+    return box;
+}
+
+} // namespace
+
+void refitBottomLevel(BvhBottomLevel& level, BvhArrays& arrays,
+                      const std::function<void(const GpuBvhTriangleRef&, glm::vec3 (&)[3])>& corners) {
+    for (uint32_t t = level.firstTriangle; t < level.firstTriangle + level.triangleCount; ++t) {
+        glm::vec3 v[3];
+        corners(arrays.refs[t], v);
+        arrays.triangles[t] = {glm::vec4(v[0], 0.0f), glm::vec4(v[1], 0.0f), glm::vec4(v[2], 0.0f)};
+    }
+    level.bounds = refitNode(arrays, level.root);
+}
+
 } // namespace vitrine::accel

@@ -1,7 +1,10 @@
 #include "core/accel/scene_bvh.hpp"
 
+#include "core/base/error.hpp"
 #include "core/scene/closed_mesh.hpp"
+#include "core/scene/deformation.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -45,6 +48,19 @@ std::vector<GpuBvhPrimitive> SceneBvh::primitivesOf(const scene::Scene& scene) {
     return out;
 }
 
+std::vector<uint32_t> SceneBvh::deformedLevelsOf(const scene::Scene& scene,
+                                                 const std::vector<BvhDynamicInstance>& dynamic) {
+    const scene::Deformation deformation(scene);
+    std::vector<uint32_t> levels;
+    for (const BvhDynamicInstance& d : dynamic) {
+        if (d.instance < scene.instances.size() && deformation.meshDeforms(scene.instances[d.instance].mesh))
+            levels.push_back(d.level);
+    }
+    std::sort(levels.begin(), levels.end());
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    return levels;
+}
+
 SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     SceneBvh bvh;
@@ -52,17 +68,20 @@ SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& optio
     bvh.mOptions = options;
     bvh.mPrimitives = primitivesOf(scene);
 
+    // An instance whose mesh deforms gets a level of its own, as an animated one does, for refit() to move.
+    const scene::Deformation deformation(scene);
+    auto ownLevel = [&](const scene::MeshInstance& inst) { return inst.dynamic || deformation.meshDeforms(inst.mesh); };
     std::vector<BvhBuildTriangle> triangles;
     for (uint32_t i = 0; i < scene.instances.size(); ++i) {
         const scene::MeshInstance& inst = scene.instances[i];
-        if (!inst.dynamic) gather(scene, inst.mesh, inst.world, true, i, options.transparent, triangles);
+        if (!ownLevel(inst)) gather(scene, inst.mesh, inst.world, true, i, options.transparent, triangles);
     }
     bvh.mLevels.push_back(buildBottomLevel(triangles, options, bvh.mArrays));
 
     std::map<uint32_t, uint32_t> levelOfMesh;
     for (uint32_t i = 0; i < scene.instances.size(); ++i) {
         const scene::MeshInstance& inst = scene.instances[i];
-        if (!inst.dynamic) continue;
+        if (!ownLevel(inst)) continue;
         auto [it, added] = levelOfMesh.try_emplace(inst.mesh, static_cast<uint32_t>(bvh.mLevels.size()));
         if (added) {
             triangles.clear();
@@ -71,8 +90,22 @@ SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& optio
         }
         bvh.mDynamic.push_back({i, it->second, inst.world});
     }
+    bvh.mDeformedLevels = deformedLevelsOf(scene, bvh.mDynamic);
     bvh.mBuildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return bvh;
+}
+
+void SceneBvh::refit(const scene::Scene& scene, std::span<const scene::Vertex> vertices) {
+    if (vertices.size() != scene.vertices.size())
+        throw InternalError("SceneBvh::refit: " + std::to_string(vertices.size()) + " vertices for a scene of " +
+                            std::to_string(scene.vertices.size()));
+    for (uint32_t l : mDeformedLevels) {
+        refitBottomLevel(mLevels[l], mArrays, [&](const GpuBvhTriangleRef& ref, glm::vec3(&v)[3]) {
+            const scene::Primitive& p = scene.primitives[ref.primitive];
+            for (uint32_t k = 0; k < 3; ++k)
+                v[k] = vertices[p.vertexOffset + scene.indices[p.firstIndex + 3 * ref.triangle + k]].position;
+        });
+    }
 }
 
 std::vector<GpuBvhInstance> SceneBvh::topLevel(const scene::ScenePose& pose) const {

@@ -2,9 +2,10 @@
 
 // A scene's ray-tracing BVH in two levels, built on the CPU, cached with the bakes and uploaded by
 // core/accel/gpu_bvh.hpp. Static instances are pre-transformed into one world-space bottom level; every
-// mesh that a dynamic (animated) instance uses gets an object-space bottom level, and the top level —
-// entry 0 the static level, then one entry per dynamic instance with this frame's world-to-object
-// transform — is rewritten every frame from the pose, which is all an animated rigid part costs.
+// mesh that a dynamic (animated) or deforming (scene::Deformation: skinned, morphed) instance uses gets an
+// object-space bottom level, and the top level — entry 0 the static level, then one entry per such instance
+// with this frame's world-to-object transform — is rewritten every frame from the pose, which is all an
+// animated rigid part costs. A deforming mesh's level is refit to its posed vertices every frame (refit()).
 // Layouts: shaders/accel/bvh.h.
 
 #include "core/accel/bvh.hpp"
@@ -17,7 +18,7 @@ namespace vitrine::accel {
 
 using gpu_types::GpuBvhInstance;
 
-// A dynamic instance and the bottom level of its mesh.
+// An instance with a bottom level of its own (animated or deforming) and that level, its mesh's.
 struct BvhDynamicInstance {
     uint32_t instance = 0; // Scene::instances
     uint32_t level = 0;    // SceneBvh::levels()
@@ -33,8 +34,8 @@ inline glm::vec3 transformPoint(const glm::mat4& m, const glm::vec3& p) {
 class SceneBvh {
 public:
     // Bumped whenever the builder or the byte format changes, so caches of older builds are not used.
-    static constexpr uint32_t kVersion = 4; // 2: transparent primitives left out; 3: unless options.transparent;
-                                            // 4: GpuBvhPrimitive::flags
+    static constexpr uint32_t kVersion = 5; // 2: transparent primitives left out; 3: unless options.transparent;
+                                            // 4: GpuBvhPrimitive::flags; 5: deforming meshes' own levels
 
     static SceneBvh build(const scene::Scene& scene, const BvhBuildOptions& options = {});
 
@@ -51,6 +52,13 @@ public:
     std::vector<uint8_t> serialize() const;
     // nullopt when the bytes are not a SceneBvh of this version or are inconsistent.
     static std::optional<SceneBvh> deserialize(std::span<const uint8_t> bytes);
+
+    // Refits the levels of the deforming meshes (deformedLevels()) to vertices: Scene::vertices with those meshes
+    // posed (scene::Deformation::pose). Call it before topLevel() and the upload of the frame: it moves the levels'
+    // bounds too.
+    void refit(const scene::Scene& scene, std::span<const scene::Vertex> vertices);
+    // The bottom levels (levels() indices) of deforming meshes, in ascending order; empty when nothing deforms.
+    const std::vector<uint32_t>& deformedLevels() const { return mDeformedLevels; }
 
     // The top level at a pose (Scene::evaluate; instances the pose lacks are at rest): entry 0 the static
     // level, then one per dynamic instance, in dynamicInstances() order. Called once per frame.
@@ -72,11 +80,16 @@ private:
     // One GpuBvhPrimitive per scene primitive. Its flags come from core/scene/closed_mesh.hpp, whose rules are not part
     // of the cache key: loadOrBuild() takes them from here, not from the cache.
     static std::vector<GpuBvhPrimitive> primitivesOf(const scene::Scene& scene);
+    // The levels of mDynamic's instances whose mesh deforms (not stored in the cache either: the rule is
+    // scene::Deformation's).
+    static std::vector<uint32_t> deformedLevelsOf(const scene::Scene& scene,
+                                                  const std::vector<BvhDynamicInstance>& dynamic);
 
     BvhArrays mArrays;
     std::vector<GpuBvhPrimitive> mPrimitives;
     std::vector<BvhBottomLevel> mLevels;
     std::vector<BvhDynamicInstance> mDynamic;
+    std::vector<uint32_t> mDeformedLevels;
     uint64_t mSceneHash = 0;
     BvhBuildOptions mOptions;
     double mBuildMs = 0.0;

@@ -124,6 +124,7 @@ SceneBvh SceneBvh::loadOrBuild(const scene::Scene& scene, const BakeCache& cache
             bvh && bvh->mSceneHash == scene.contentHash() && bvh->mOptions == options) {
             st.fromCache = true;
             bvh->mPrimitives = primitivesOf(scene);
+            bvh->mDeformedLevels = deformedLevelsOf(scene, bvh->mDynamic);
             return std::move(*bvh);
         }
     }

@@ -65,15 +65,28 @@ GpuBvh& SceneObject::bvh(Context& ctx, bool transparent) {
                 logWarning("scene '" + mScene->name + "': could not write the BVH to the bake cache under " +
                            defaultCacheDir().string());
         }
+        if (!mBvh[i]->deformedLevels().empty()) mBvh[i]->refit(*mScene, deformation().posedVertices(pose));
         mGpuBvh[i] = std::make_unique<GpuBvh>(ctx, *mBvh[i], mScene->name);
         mGpuBvh[i]->update(pose);
     }
     return *mGpuBvh[i];
 }
 
+const scene::Deformation& SceneObject::deformation() const {
+    if (!mDeformation) mDeformation = std::make_unique<scene::Deformation>(*mScene);
+    return *mDeformation;
+}
+
 void SceneObject::reposeBvh(const scene::ScenePose& p) {
-    for (auto& b : mGpuBvh)
-        if (b) b->update(p);
+    std::vector<scene::Vertex> posed; // posed once for both BVHs
+    for (int i = 0; i < 2; ++i) {
+        if (!mGpuBvh[i]) continue;
+        if (!mBvh[i]->deformedLevels().empty()) {
+            if (posed.empty()) posed = deformation().posedVertices(p);
+            mBvh[i]->refit(*mScene, posed);
+        }
+        mGpuBvh[i]->update(p);
+    }
 }
 
 const StorageBufferSet& GpuScene::geometrySet() {
@@ -198,27 +211,12 @@ TexelPool packTexelPool(const scene::Scene& scene) {
 }
 
 GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& scene, float anisotropy)
-    : mCtx(ctx), mScene(scene), mAnisotropy(anisotropy) {
+    : mCtx(ctx), mScene(scene), mAnisotropy(anisotropy), mDeformation(scene) {
     auto start = Clock::now();
     try {
         const size_t vbytes = scene.vertices.size() * sizeof(scene::Vertex);
         const size_t ibytes = scene.indices.size() * sizeof(uint32_t);
-        for (const scene::Animation& a : scene.animations) {
-            for (const scene::AnimationChannel& c : a.channels)
-                mMorphAnimated = mMorphAnimated || c.path == scene::AnimationPath::Weights;
-        }
-        for (const scene::MeshInstance& instance : scene.instances) {
-            const scene::Node& node = scene.nodes[instance.node];
-            if (node.skin < 0 || !instance.dynamic) continue; // a still skin stays in its rest pose
-            const scene::Mesh& mesh = scene.meshes[instance.mesh];
-            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
-                if (scene.primitives[mesh.firstPrimitive + k].skinned) {
-                    mSkinnedNodes.push_back(instance.node);
-                    break;
-                }
-            }
-        }
-        if ((mMorphAnimated || !mSkinnedNodes.empty()) && vbytes > 0) {
+        if (mDeformation.any() && vbytes > 0) {
             // Animated morph weights or joints: update() re-poses the vertices in place, in host-visible memory.
             mVertices = GpuBuffer(ctx, vbytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                   true, scene.name + ".vertices");
@@ -228,18 +226,7 @@ GpuScene::GpuScene(Context& ctx, ShaderCompiler& shaders, const scene::Scene& sc
             auto* prev = static_cast<glm::vec4*>(mPrevPositions.mapped());
             for (size_t v = 0; v < scene.vertices.size(); ++v)
                 prev[v] = glm::vec4(scene.vertices[v].position, 1.0f);
-            mSkinnedMesh.assign(scene.meshes.size(), false);
-            for (uint32_t n : mSkinnedNodes)
-                mSkinnedMesh[scene.nodes[n].mesh] = true;
-            mDeformedMesh = mSkinnedMesh;
-            for (size_t m = 0; m < scene.meshes.size() && mMorphAnimated; ++m) {
-                const scene::Mesh& mesh = scene.meshes[m];
-                for (uint32_t k = 0; k < mesh.primitiveCount; ++k)
-                    mDeformedMesh[m] = mDeformedMesh[m] || scene.primitives[mesh.firstPrimitive + k].targetCount > 0;
-            }
-            mMeshWeights.resize(scene.meshes.size());
-            for (size_t m = 0; m < scene.meshes.size(); ++m)
-                mMeshWeights[m] = scene.meshes[m].weights;
+            mPosed = scene.vertices;
         } else {
             mVertices = uploadBuffer(ctx, scene.vertices.data(), vbytes,
                                      VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
@@ -556,80 +543,25 @@ void GpuScene::update(const scene::ScenePose& pose, const scene::ScenePose& prev
         out[i].prevWorld = prev;
         out[i].normalMatrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(world))));
         const uint32_t mesh = mScene.instances[i].mesh;
-        out[i].flags = glm::vec4(mesh < mDeformedMesh.size() && mDeformedMesh[mesh] ? 1.0f : 0.0f, 0.0f, 0.0f, 0.0f);
+        out[i].flags = glm::vec4(mDeformation.meshDeforms(mesh) ? 1.0f : 0.0f, 0.0f, 0.0f, 0.0f);
     }
     GpuCamera c = camera.gpu();
     std::memcpy(mCamera.mapped(), &c, sizeof(c));
-    std::vector<int32_t> skinnedMesh(mSkinnedNodes.empty() ? 0 : mScene.meshes.size(), 0);
-    if (!mSkinnedNodes.empty() && pose.nodeWorld.size() == mScene.nodes.size()) {
-        auto* vertices = static_cast<scene::Vertex*>(mVertices.mapped());
-        for (uint32_t n : mSkinnedNodes) {
-            const scene::Mesh& mesh = mScene.meshes[mScene.nodes[n].mesh];
-            if (skinnedMesh[mScene.nodes[n].mesh]++) continue; // a mesh is posed once, by its first skinned node
-            std::vector<glm::mat4> joints = mScene.jointMatrices(n, pose);
-            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
-                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
-                if (p.skinned)
-                    mScene.skinPrimitive(mesh.firstPrimitive + k, joints,
-                                         std::span<scene::Vertex>(vertices + p.vertexOffset, p.vertexCount));
-            }
-        }
-    }
+    if (!mDeformation.any() || !mVertices.mapped()) return;
     // Last frame's positions of what deforms: the same deformation with the previous pose (stateless, as prevWorld:
     // the first frame rendered, or one after a jump in time, gets its true motion).
-    if (!mDeformedMesh.empty()) {
-        auto* prev = static_cast<glm::vec4*>(mPrevPositions.mapped());
-        const scene::ScenePose& before = previous.nodeWorld.size() == mScene.nodes.size() ? previous : pose;
-        std::vector<scene::Vertex> posed;
-        auto write = [&](const scene::Primitive& p) {
-            for (uint32_t v = 0; v < p.vertexCount; ++v)
-                prev[p.vertexOffset + v] = glm::vec4(posed[v].position, 1.0f);
-        };
-        std::vector<bool> done(mScene.meshes.size(), false);
-        if (pose.nodeWorld.size() == mScene.nodes.size()) {
-            for (uint32_t n : mSkinnedNodes) {
-                const uint32_t m = mScene.nodes[n].mesh;
-                if (done[m]) continue;
-                done[m] = true;
-                const std::vector<glm::mat4> joints = mScene.jointMatrices(n, before);
-                const scene::Mesh& mesh = mScene.meshes[m];
-                for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
-                    const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
-                    if (!p.skinned) continue;
-                    posed.assign(p.vertexCount, scene::Vertex{});
-                    mScene.skinPrimitive(mesh.firstPrimitive + k, joints, posed);
-                    write(p);
-                }
-            }
-        }
-        for (size_t m = 0; m < mScene.meshes.size() && mMorphAnimated; ++m) {
-            if (!mDeformedMesh[m] || mSkinnedMesh[m]) continue; // a skinned mesh is posed by its skin (above)
-            const scene::Mesh& mesh = mScene.meshes[m];
-            const bool animated = m < before.meshWeights.size() && !before.meshWeights[m].empty();
-            const std::vector<float>& w = animated ? before.meshWeights[m] : mesh.weights;
-            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
-                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
-                posed.assign(p.vertexCount, scene::Vertex{});
-                mScene.morphVertices(mesh.firstPrimitive + k, w, posed);
-                write(p);
-            }
-        }
+    const scene::ScenePose& before = previous.nodeWorld.size() == mScene.nodes.size() ? previous : pose;
+    mDeformation.pose(before, mPosed);
+    auto* prev = static_cast<glm::vec4*>(mPrevPositions.mapped());
+    for (const scene::Deformation::Range& r : mDeformation.ranges()) {
+        for (uint32_t v = r.first; v < r.first + r.count; ++v)
+            prev[v] = glm::vec4(mPosed[v].position, 1.0f);
     }
-    if (mMorphAnimated) {
-        auto* vertices = static_cast<scene::Vertex*>(mVertices.mapped());
-        for (size_t m = 0; m < pose.meshWeights.size() && m < mScene.meshes.size(); ++m) {
-            const std::vector<float>& w = pose.meshWeights[m];
-            if (w.empty() || w == mMeshWeights[m]) continue;
-            const scene::Mesh& mesh = mScene.meshes[m];
-            for (uint32_t k = 0; k < mesh.primitiveCount; ++k) {
-                const scene::Primitive& p = mScene.primitives[mesh.firstPrimitive + k];
-                if (p.skinned && m < skinnedMesh.size() && skinnedMesh[m]) continue; // the skin poses it (bind pose)
-                mScene.morphVertices(mesh.firstPrimitive + k, w,
-                                     std::span<scene::Vertex>(vertices + p.vertexOffset, p.vertexCount));
-            }
-            mMeshWeights[m] = w;
-        }
-    }
+    // This frame's vertices, posed on the CPU and copied to the host-visible vertex buffer.
+    mDeformation.pose(pose, mPosed);
+    auto* vertices = static_cast<scene::Vertex*>(mVertices.mapped());
+    for (const scene::Deformation::Range& r : mDeformation.ranges())
+        std::memcpy(vertices + r.first, mPosed.data() + r.first, r.count * sizeof(scene::Vertex));
 }
 
 std::vector<VkVertexInputBindingDescription> GpuScene::vertexBindings() {

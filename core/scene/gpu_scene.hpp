@@ -9,6 +9,7 @@
 #include "core/gpu/buffer_set.hpp"
 #include "core/gpu/resources.hpp"
 #include "core/graph/node.hpp"
+#include "core/scene/deformation.hpp"
 #include "core/scene/jitter.hpp"
 #include "core/scene/scene.hpp"
 #include "shaders/scene/scene.h"
@@ -92,11 +93,11 @@ public:
     GpuScene(const GpuScene&) = delete;
     GpuScene& operator=(const GpuScene&) = delete;
 
-    // Writes this frame's instance transforms (with last frame's for velocity) and camera, re-skins the meshes of
-    // nodes whose skin has animated joints and re-morphs those whose morph weights an animation changed
-    // (pose.meshWeights). The vertex buffer is then host-visible, and the same deformation with `previous` writes
-    // those vertices' last-frame positions (binding 5) for velocity; the ray-tracing BVH does not follow. Safe while
-    // recording: the render graph runs one frame in flight, so the GPU is done with the last frame.
+    // Writes this frame's instance transforms (with last frame's for velocity) and camera, and poses the meshes that
+    // deform (scene::Deformation: moving skins, animated morph weights). The vertex buffer is then host-visible, and
+    // the same deformation with `previous` writes those vertices' last-frame positions (binding 5) for velocity; the
+    // ray-tracing BVH follows through SceneObject::reposeBvh(). Safe while recording: the render graph runs one frame
+    // in flight, so the GPU is done with the last frame.
     void update(const scene::ScenePose& pose, const scene::ScenePose& previous, const CameraFrame& camera);
 
     VkDescriptorSetLayout setLayout() const { return mSetLayout; }
@@ -150,11 +151,8 @@ private:
     std::vector<GpuDraw> mTransparentDraws;
     GpuSceneStats mStats;
     float mAnisotropy = -1.0f;
-    bool mMorphAnimated = false;                  // an animation drives morph weights
-    std::vector<std::vector<float>> mMeshWeights; // the weights the vertex buffer holds, per mesh
-    std::vector<uint32_t> mSkinnedNodes;          // nodes whose skin moves: update() skins their mesh every frame
-    std::vector<bool> mSkinnedMesh;               // per mesh: posed by a moving skin (a morph on it is not applied)
-    std::vector<bool> mDeformedMesh;              // per mesh: update() deforms it (skinned or morph-animated)
+    scene::Deformation mDeformation;
+    std::vector<scene::Vertex> mPosed; // scratch of update(): Scene::vertices with the deformed meshes posed
 };
 
 // What travels on a Scene port. CPU data from setup(); the GPU copy once a pass asks for it.
@@ -172,14 +170,17 @@ public:
     GpuScene& gpu() const; // InternalError before the producer uploaded it
 
     // The scene's ray-tracing BVH on the GPU (core/accel/gpu_bvh.hpp), for passes that trace rays. The
-    // first call loads it from the bake cache ($VITRINE_CACHE_DIR/bake/bvh), or builds and stores it, and
-    // uploads it posed at `pose`; the scene node re-poses it every frame after that (repose()). `transparent`: the BVH
-    // that also holds the transparent primitives (accel::BvhBuildOptions::transparent), a second one.
+    // first call loads it from the bake cache ($VITRINE_CACHE_DIR/bake/bvh), or builds and stores it (at rest), and
+    // uploads it posed at `pose`, deforming meshes refit; the scene node re-poses it every frame after that (repose()).
+    // `transparent`: the BVH that also holds the transparent primitives (accel::BvhBuildOptions::transparent), a second
+    // one.
     GpuBvh& bvh(Context& ctx, bool transparent = false);
     bool hasBvh() const { return mGpuBvh[0] != nullptr || mGpuBvh[1] != nullptr; }
     bool bvhFromCache() const { return mBvhFromCache; }
-    // Every uploaded BVH's top level at `pose`.
+    // Every uploaded BVH at `pose`: its top level, and its deforming meshes' levels refit (accel::SceneBvh::refit).
     void reposeBvh(const scene::ScenePose& pose);
+    // What of the scene deforms (made on the first call).
+    const scene::Deformation& deformation() const;
     void releaseGpu() override;
 
     // The pose of this frame and the last one (set by the scene node every frame).
@@ -193,6 +194,7 @@ private:
     // [0] without, [1] with the transparent primitives.
     std::unique_ptr<accel::SceneBvh> mBvh[2]; // CPU copy, kept across releaseGpu()
     std::unique_ptr<GpuBvh> mGpuBvh[2];
+    mutable std::unique_ptr<scene::Deformation> mDeformation;
     bool mBvhFromCache = false;
 };
 

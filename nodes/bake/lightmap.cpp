@@ -346,7 +346,7 @@ private:
     std::vector<glm::vec4> traceOnCpu(const std::vector<glm::vec4>& jobs, size_t jobCount, size_t texelJobs,
                                       const CpuSky& sky) const {
         const scene::Scene& scene = mScene->scene();
-        CpuPathTracer tracer(scene, mScene->pose.instanceWorld);
+        CpuPathTracer tracer(scene, mScene->pose);
         CpuTraceSettings s;
         s.width = static_cast<int>(std::min<size_t>(kJobsPerRow, jobCount));
         s.height = static_cast<int>((jobCount + kJobsPerRow - 1) / kJobsPerRow);

@@ -93,6 +93,7 @@ CpuTraceSettings TwinNode::settings(ExecuteContext& ctx, uint32_t spp, uint32_t 
     CpuTraceSettings s;
     s.invViewProj = glm::inverse(cam.viewProjNoJitter);
     s.cameraPos = cam.state.position;
+    s.orthographic = cam.state.lens.projection == scene::Projection::Orthographic;
     s.width = static_cast<int>(out.width);
     s.height = static_cast<int>(out.height);
     s.spp = spp;
@@ -109,10 +110,7 @@ CpuTraceSettings TwinNode::settings(ExecuteContext& ctx, uint32_t spp, uint32_t 
 
 void TwinNode::traceBatch(ExecuteContext& ctx, const CpuSky& sky, uint32_t spp, uint32_t seed,
                           const std::function<void(double)>& progress) {
-    if (!mCpu || mScene->pose.instanceWorld != mCpuPose) {
-        mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld);
-        mCpuPose = mScene->pose.instanceWorld;
-    }
+    if (!mCpu || mCpu->outdated(mScene->pose)) mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose);
     const CpuTraceSettings s = settings(ctx, spp, seed);
     const CpuTraceCounters c = mCpu->estimate(
         s, sky, mAccumulation, [this](const CpuRays& rays, int x, int y, uint32_t& rng) { return sample(rays, x, y, rng); },

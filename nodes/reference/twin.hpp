@@ -62,7 +62,6 @@ private:
     std::shared_ptr<CameraObject> mCamera;
     PipelineId mStorePipeline = 0;
     std::unique_ptr<CpuPathTracer> mCpu;
-    std::vector<glm::mat4> mCpuPose;
     CpuAccumulation mAccumulation;
     CpuResultUpload mUpload;
     std::optional<uint64_t> mConvergedKey;

@@ -34,10 +34,7 @@ void appendTwinParams(std::vector<ParamSpec>& params, int sppDefault) {
 }
 
 CpuPathTracer& TwinTracer::tracer(const SceneObject& scene) {
-    if (!mCpu || scene.pose.instanceWorld != mPose) {
-        mCpu = std::make_unique<CpuPathTracer>(scene.scene(), scene.pose.instanceWorld);
-        mPose = scene.pose.instanceWorld;
-    }
+    if (!mCpu || mCpu->outdated(scene.pose)) mCpu = std::make_unique<CpuPathTracer>(scene.scene(), scene.pose);
     return *mCpu;
 }
 
@@ -45,6 +42,7 @@ CpuTraceSettings TwinTracer::settings(const CameraFrame& cam, int width, int hei
     CpuTraceSettings s;
     s.invViewProj = glm::inverse(cam.viewProjNoJitter);
     s.cameraPos = cam.state.position;
+    s.orthographic = cam.state.lens.projection == scene::Projection::Orthographic;
     s.width = width;
     s.height = height;
     s.antialias = false; // primary surfaces through pixel centres

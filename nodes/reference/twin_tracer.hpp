@@ -34,7 +34,6 @@ public:
 
 private:
     std::unique_ptr<CpuPathTracer> mCpu;
-    std::vector<glm::mat4> mPose;
     CpuAccumulation mAccumulation;
     std::optional<uint64_t> mConvergedKey;
 };

@@ -246,6 +246,12 @@ void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFra
                      int height) {
     h.value(scene.scene().lightTransportHash());
     h.array(scene.pose.instanceWorld);
+    if (scene.deformation().any()) { // the posed vertices follow the joints (nodes) and the morph weights
+        h.string("deformed");
+        h.array(scene.pose.nodeWorld);
+        for (const std::vector<float>& w : scene.pose.meshWeights)
+            h.array(w);
+    }
     h.value(cam.viewProjNoJitter);
     h.value(cam.state.position);
     for (const Image& face : sky.faces) h.array(face.pixels);

@@ -77,8 +77,9 @@ bool convergeCached(const BakeKey& key, const ConvergeRun& run, CpuAccumulation&
 BakeKey partialKey(const BakeKey& key);
 
 // What every traced estimate of the camera's view depends on, into a cache key: the scene's light-transport content
-// and pose, the camera (unjittered view-projection and position), the sky's pixels and sun, the frame size. The
-// caller adds its node's name and version and every param that changes the estimate.
+// and pose (where a mesh deforms, every node and morph weight too), the camera (unjittered view-projection and
+// position), the sky's pixels and sun, the frame size. The caller adds its node's name and version and every param that
+// changes the estimate.
 void hashTraceInputs(scene::Hasher& h, const SceneObject& scene, const CameraFrame& camera, const CpuSky& sky,
                      int width, int height);
 

@@ -240,7 +240,8 @@ private:
         push.cameraPos = glm::vec4(cam.state.position, 0.0f);
         push.scales = {p.getFloat("sun_scale"), p.getFloat("sky_scale"), p.getFloat("emissive_scale"), 0.0f};
         uint32_t flags = (reset ? PATHTRACE_RESET : 0u) | (ctx.hasInput("env_cdf") ? PATHTRACE_ENV_CDF : 0u) |
-                         (p.getBool("antialias") ? PATHTRACE_ANTIALIAS : 0u) | (through ? PATHTRACE_SEE_THROUGH : 0u);
+                         (p.getBool("antialias") ? PATHTRACE_ANTIALIAS : 0u) | (through ? PATHTRACE_SEE_THROUGH : 0u) |
+                         (cam.state.lens.projection == scene::Projection::Orthographic ? PATHTRACE_ORTHOGRAPHIC : 0u);
         const ImageDesc& out = ctx.output("color").desc();
         const uint32_t chunks = (spp + PATHTRACE_SAMPLES_PER_DISPATCH - 1) / PATHTRACE_SAMPLES_PER_DISPATCH;
         const uint32_t every = std::max(1u, chunks / 10);
@@ -357,14 +358,14 @@ private:
     void traceCpuBatch(ExecuteContext& ctx, const CpuSky& sky, const ImageDesc& out, uint32_t spp, uint32_t seed) {
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
-        if (!mCpu || mScene->pose.instanceWorld != mCpuPose || mCpuSeesThrough != seeThrough(p)) {
+        if (!mCpu || mCpu->outdated(mScene->pose) || mCpuSeesThrough != seeThrough(p)) {
             mCpuSeesThrough = seeThrough(p);
-            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld, mCpuSeesThrough);
-            mCpuPose = mScene->pose.instanceWorld;
+            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose, mCpuSeesThrough);
         }
         CpuTraceSettings s;
         s.invViewProj = glm::inverse(cam.viewProjNoJitter);
         s.cameraPos = cam.state.position;
+        s.orthographic = cam.state.lens.projection == scene::Projection::Orthographic;
         s.width = static_cast<int>(out.width);
         s.height = static_cast<int>(out.height);
         s.spp = spp;
@@ -393,7 +394,7 @@ private:
     void executeCpu(ExecuteContext& ctx) {
         const Params& p = ctx.params();
         const CameraFrame& cam = mCamera->current;
-        const bool posed = mCpu && mScene->pose.instanceWorld == mCpuPose && mCpuSeesThrough == seeThrough(p);
+        const bool posed = mCpu && !mCpu->outdated(mScene->pose) && mCpuSeesThrough == seeThrough(p);
         bool moved = cam.viewProjNoJitter != mLastViewProj || !posed;
         bool reset = !ctx.hasInput("history") || !ctx.inputValid("history") || moved;
         mLastViewProj = cam.viewProjNoJitter;
@@ -403,8 +404,7 @@ private:
         const CpuSky sky = readCpuSky(ctx);
         if (!posed) {
             mCpuSeesThrough = seeThrough(p);
-            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose.instanceWorld, mCpuSeesThrough);
-            mCpuPose = mScene->pose.instanceWorld;
+            mCpu = std::make_unique<CpuPathTracer>(mScene->scene(), mScene->pose, mCpuSeesThrough);
         }
         const ImageDesc& out = ctx.output("color").desc();
         if (reset || mAccumulation.width != static_cast<int>(out.width) ||
@@ -414,6 +414,7 @@ private:
         CpuTraceSettings s;
         s.invViewProj = glm::inverse(cam.viewProjNoJitter);
         s.cameraPos = cam.state.position;
+        s.orthographic = cam.state.lens.projection == scene::Projection::Orthographic;
         s.width = static_cast<int>(out.width);
         s.height = static_cast<int>(out.height);
         s.spp = static_cast<uint32_t>(p.getInt("spp"));
@@ -514,7 +515,6 @@ private:
     glm::mat4 mLastViewProj{0.0f};
     // The CPU tracer: its Embree scene (of the pose it was built at), its accumulation and the result buffer.
     std::unique_ptr<CpuPathTracer> mCpu;
-    std::vector<glm::mat4> mCpuPose;
     CpuAccumulation mAccumulation;
     CpuResultUpload mUpload;
     double mLastPathsPerSecond = 0.0, mLastRaysPerSecond = 0.0, mLastPathsPerCpuSecond = 0.0;

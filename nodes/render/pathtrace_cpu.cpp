@@ -5,6 +5,7 @@
 
 #include "core/base/error.hpp"
 #include "core/scene/closed_mesh.hpp"
+#include "core/scene/deformation.hpp"
 #include "core/scene/gpu_scene.hpp"
 #include "core/shading/brdf.hpp"
 #include "shaders/render/pathtrace.h"
@@ -637,6 +638,10 @@ vec3 offsetRay(vec3 p, vec3 ng, vec3 dir) {
 
 struct CpuPathTracer::Impl {
     const scene::Scene& scene;
+    scene::ScenePose pose;            // as given
+    bool deforms = false;             // scene::Deformation::any()
+    std::vector<scene::Vertex> posed; // Scene::vertices with the deforming meshes posed (empty when none deforms)
+    std::span<const scene::Vertex> vertices; // what the triangles and their shading read: posed or Scene::vertices
     std::vector<glm::mat4> world;
     std::vector<glm::mat3> normalMatrix;
     Materials materials;
@@ -647,8 +652,12 @@ struct CpuPathTracer::Impl {
     RTCScene rtc = nullptr;
     RTCScene rtcOpaque = nullptr; // with `transparent`: the triangles no light passes
 
-    Impl(const scene::Scene& s, const std::vector<glm::mat4>& instanceWorld, bool transparent)
-        : scene(s), world(instanceWorld) {
+    Impl(const scene::Scene& s, const scene::ScenePose& p, bool transparent)
+        : scene(s), pose(p), world(p.instanceWorld) {
+        const scene::Deformation deformation(s);
+        deforms = deformation.any();
+        if (deforms) posed = deformation.posedVertices(p);
+        vertices = deforms ? std::span<const scene::Vertex>(posed) : std::span<const scene::Vertex>(s.vertices);
         packMaterials(s, materials.materials, materials.layers);
         materials.pool = packTexelPool(s);
         openVolume = scene::openVolumePrimitives(s);
@@ -665,7 +674,7 @@ struct CpuPathTracer::Impl {
                 if (!transparent && s.materials[prim.material].transparent()) continue;
                 for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
                     for (uint32_t k = 0; k < 3; ++k) {
-                        const scene::Vertex& v = s.vertices[s.indices[prim.firstIndex + 3 * t + k] + prim.vertexOffset];
+                        const scene::Vertex& v = vertices[s.indices[prim.firstIndex + 3 * t + k] + prim.vertexOffset];
                         worldPositions.push_back(glm::vec3(w * glm::vec4(v.position, 1.0f)));
                     }
                     refs.push_back({static_cast<uint32_t>(i), p, t, prim.material});
@@ -892,7 +901,7 @@ struct CpuPathTracer::Impl {
     std::array<const scene::Vertex*, 3> triangleVertices(const Hit& hit) const {
         const uint32_t* idx = triangleIndices(hit);
         const uint32_t offset = scene.primitives[refs[hit.triangle].primitive].vertexOffset;
-        return {&scene.vertices[idx[0] + offset], &scene.vertices[idx[1] + offset], &scene.vertices[idx[2] + offset]};
+        return {&vertices[idx[0] + offset], &vertices[idx[1] + offset], &vertices[idx[2] + offset]};
     }
     void prefetchIndices(const Hit& hit) const { __builtin_prefetch(triangleIndices(hit)); }
     void prefetchVertices(const Hit& hit) const {
@@ -1236,13 +1245,15 @@ struct CpuPathTracer::Impl {
         }
     }
 
-    static vec3 cameraDirection(const CpuTraceSettings& st, int x, int y, vec2 jitter) {
+    // The primary ray through (x, y) + jitter: from the camera (perspective) or the near plane (orthographic).
+    static void cameraRay(const CpuTraceSettings& st, int x, int y, vec2 jitter, vec3& origin, vec3& dir) {
         vec2 ndc = (vec2(static_cast<float>(x), static_cast<float>(y)) + jitter) /
                        vec2(static_cast<float>(st.width), static_cast<float>(st.height)) * 2.0f -
                    1.0f;
         vec4 nearH = st.invViewProj * vec4(ndc, 1.0f, 1.0f);
         vec4 farH = st.invViewProj * vec4(ndc, 0.5f, 1.0f);
-        return glm::normalize(vec3(farH) / farH.w - vec3(nearH) / nearH.w);
+        dir = glm::normalize(vec3(farH) / farH.w - vec3(nearH) / nearH.w);
+        origin = st.orthographic ? vec3(nearH) / nearH.w : st.cameraPos;
     }
 
     // pathtrace.comp's main for one row: this batch's samples, merged into the accumulation (Chan et al.). The row's
@@ -1261,8 +1272,7 @@ struct CpuPathTracer::Impl {
                 p = PathState{};
                 p.rng = rngSeed(glm::uvec2(x, y), st.seed, i);
                 vec2 jitter = st.antialias ? rngNext2(p.rng) : vec2(0.5f);
-                p.origin = st.cameraPos;
-                p.dir = cameraDirection(st, x, y, jitter);
+                cameraRay(st, x, y, jitter, p.origin, p.dir);
             }
             tracePaths(std::span<PathState>(batch.data(), count), st, env, rays);
             for (size_t k = 0; k < count; ++k) radiance[begin + k] = batch[k].radiance;
@@ -1310,8 +1320,15 @@ struct CpuPathTracer::Impl {
     }
 };
 
-CpuPathTracer::CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld, bool transparent)
-    : mImpl(std::make_unique<Impl>(scene, instanceWorld, transparent)) {}
+CpuPathTracer::CpuPathTracer(const scene::Scene& scene, const scene::ScenePose& pose, bool transparent)
+    : mImpl(std::make_unique<Impl>(scene, pose, transparent)) {}
+
+bool CpuPathTracer::outdated(const scene::ScenePose& pose) const {
+    const Impl& m = *mImpl;
+    if (pose.instanceWorld != m.pose.instanceWorld) return true;
+    // Joints are nodes: a deforming scene is outdated when any node moved or a morph weight changed.
+    return m.deforms && (pose.nodeWorld != m.pose.nodeWorld || pose.meshWeights != m.pose.meshWeights);
+}
 
 CpuPathTracer::~CpuPathTracer() = default;
 
@@ -1422,8 +1439,7 @@ vec3 CpuRays::sunIlluminance() const { return envOf(mEnv).sky->sunIlluminance * 
 vec3 CpuRays::sunDirection() const { return glm::normalize(envOf(mEnv).sky->sunDirection); }
 
 void CpuRays::cameraRay(int x, int y, vec2 jitter, vec3& origin, vec3& direction) const {
-    origin = mSettings->cameraPos;
-    direction = CpuPathTracer::Impl::cameraDirection(*mSettings, x, y, jitter);
+    CpuPathTracer::Impl::cameraRay(*mSettings, x, y, jitter, origin, direction);
 }
 
 vec3 CpuRays::offset(vec3 p, vec3 geometricNormal, vec3 dir) { return offsetRay(p, geometricNormal, dir); }

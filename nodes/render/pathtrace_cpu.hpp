@@ -30,6 +30,8 @@ struct CpuSky {
 struct CpuTraceSettings {
     glm::mat4 invViewProj{1.0f};
     glm::vec3 cameraPos{0.0f};
+    // An orthographic camera: primary rays start on the near plane, parallel (a perspective one's start at cameraPos).
+    bool orthographic = false;
     int width = 0, height = 0;
     uint32_t spp = 1;
     uint32_t maxBounces = 8;
@@ -153,9 +155,13 @@ struct CpuTraceCounters {
 
 class CpuPathTracer {
 public:
-    // Builds the Embree scene of every instance at `instanceWorld` (the pose of the frame); with `transparent` it holds
-    // the transparent primitives too (alpha blend, transmission), for CpuTraceSettings::seeThrough.
-    CpuPathTracer(const scene::Scene& scene, const std::vector<glm::mat4>& instanceWorld, bool transparent = false);
+    // Builds the Embree scene of every instance at `pose` (the frame's: instance transforms, and the vertices of
+    // deforming meshes, scene::Deformation, which shading reads too; a pose without instances is the rest pose); with
+    // `transparent` it holds the transparent primitives too (alpha blend, transmission), for
+    // CpuTraceSettings::seeThrough.
+    CpuPathTracer(const scene::Scene& scene, const scene::ScenePose& pose, bool transparent = false);
+    // Whether the tracer of `pose` would differ from this one (instances moved, meshes deformed differently).
+    bool outdated(const scene::ScenePose& pose) const;
     ~CpuPathTracer();
     CpuPathTracer(const CpuPathTracer&) = delete;
     CpuPathTracer& operator=(const CpuPathTracer&) = delete;

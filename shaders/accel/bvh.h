@@ -3,8 +3,9 @@
 // made of 16-byte members or of four 32-bit scalars, so std430 and C++ agree without padding rules.
 //
 // Two levels: entry 0 of the top level is the static level, every static instance pre-transformed into
-// one world-space bottom level; each further entry is a dynamic (animated) instance: an object-space
-// bottom level of its mesh and this frame's world-to-object transform. Traversal: shaders/accel/bvh.glsl.
+// one world-space bottom level; each further entry is a dynamic (animated) or deforming instance: an object-space
+// bottom level of its mesh (a deforming mesh's refit to this frame's vertices) and this frame's world-to-object
+// transform. Traversal: shaders/accel/bvh.glsl.
 #ifndef ACCEL_BVH_H
 #define ACCEL_BVH_H
 #include "../common/shared.h"

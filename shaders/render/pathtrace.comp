@@ -286,7 +286,8 @@ void main() {
         vec4 nearH = push.invViewProj * vec4(ndc, 1.0, 1.0);
         vec4 farH = push.invViewProj * vec4(ndc, 0.5, 1.0);
         vec3 dir = normalize(farH.xyz / farH.w - nearH.xyz / nearH.w);
-        vec3 L = tracePath(push.cameraPos.xyz, dir, rng);
+        vec3 origin = (push.counts.w & PATHTRACE_ORTHOGRAPHIC) != 0u ? nearH.xyz / nearH.w : push.cameraPos.xyz;
+        vec3 L = tracePath(origin, dir, rng);
         if (any(isnan(L)) || any(isinf(L))) L = vec3(0.0); // counted as a black sample, never propagated
         sum += L;
         float y = luminance(L), delta = y - mean;

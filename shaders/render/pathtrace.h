@@ -19,6 +19,7 @@ VITRINE_PUSH_END(push)
 #define PATHTRACE_ANTIALIAS 4u  // jitter the primary rays over the pixel (off: through the pixel centre)
 #define PATHTRACE_CONTINUE 8u   // a later dispatch of the frame: add to the outputs (not to the history)
 #define PATHTRACE_SEE_THROUGH 16u // `transparent` and the BVH holds surfaces that let light pass (mask, blend, transmission)
+#define PATHTRACE_ORTHOGRAPHIC 32u // an orthographic camera: primary rays start on the near plane (else at cameraPos)
 
 // Surfaces a path or a shadow ray passes through at most (alpha-cut, uncovered or transmitting), counted apart from
 // the bounces; a shadow ray with more is taken as blocked, a path with more ends.

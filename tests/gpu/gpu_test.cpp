@@ -135,11 +135,11 @@ double maxAbsDiff(const Image& a, const Image& b) {
     return m;
 }
 
-namespace {
-
 std::filesystem::path scratchDir() {
     return std::filesystem::temp_directory_path() / ("vitrine_gpu_test_" + std::to_string(::getpid()));
 }
+
+namespace {
 
 class ScratchCleanup : public ::testing::Environment {
 public:

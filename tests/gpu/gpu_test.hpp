@@ -40,6 +40,8 @@ std::map<std::string, Image> runGraphFile(const std::string& path, const std::ve
 // Finalizes and validates a scene built in a test and writes it as <name>.glb into a scratch folder of
 // this test process (removed when the program ends), for scene.gltf.
 std::filesystem::path writeSceneGlb(scene::Scene& s, const std::string& name);
+// This process's scratch directory (removed when the tests end); writeSceneGlb() writes there.
+std::filesystem::path scratchDir();
 
 // A camera orientation looking from eye at target, +Y up (cameras look down their local -Z).
 glm::quat lookRotation(glm::vec3 eye, glm::vec3 target);

@@ -547,7 +547,9 @@ TEST_F(LightmapBake, MultiscatterWhiteMetalBoxKeepsEveryBounce) {
             std::printf("\n");
             EXPECT_NEAR(means[0], 1.0, 0.03);
             EXPECT_LT(worst, 0.15);
-            if (bounces == 3) EXPECT_LT(means[1], 0.8);
+            if (bounces == 3) {
+                EXPECT_LT(means[1], 0.8);
+            }
         }
     // A bake with it is not one without it (the cache key; the bakes above do not use the cache).
     bake::LightmapBakeSettings single, compensated;

@@ -636,8 +636,9 @@ PATHTRACE_TEST(MultiscatterFurnaceSphereReturnsTheEnvironment) {
                 EXPECT_LT(worst, 0.5);
             }
         }
-        if (shininess < 0.3f)
+        if (shininess < 0.3f) {
             EXPECT_LT(means[1], 0.9) << "single scattering must lose what the compensation gives back";
+        }
     }
 }
 
@@ -2200,6 +2201,50 @@ PATHTRACE_TEST(SunBehindAnOpenVolumePaneShinesThroughItsTintedLobe) {
     std::printf("%s tracer, sun behind an open volume's rough pane: %d pixels, worst relative error %.5f\n", gBackend,
                 checked, worst);
     EXPECT_GE(checked, 300);
+}
+
+// Meshes that deform are traced where they are posed, by both tracers: the BVH refits the levels of deforming meshes
+// every frame (accel::SceneBvh::refit) and the CPU tracer builds its Embree scene from the posed vertices
+// (scene::Deformation). The corpus's white unlit meshes (they emit 1) under a uniform sky of 100, through their
+// orthographic cameras (xmag = ymag = 2: 4 m across the frame, centred on the camera's x and y; both tracers start
+// such a camera's rays on its near plane, parallel):
+// - skin_bend.gltf at frame 1 (t = 1, fps 1; camera at y = 1): the upper bone turned 90° about the joint at (0, 1) and
+//   lies along y = 1 from x = 0 to -1, 0.2 thick; at rest it stood along x = 0 from y = 1 to 2;
+// - morph_animated.gltf at frame 2 (t = 2; camera at y = 0; a static node, so only the morph moves it): the front face
+//   spans x from -0.5 to 1.5 (weight 1), where it reached 0.5 at rest (weight 0), over y from -0.5 to 0.5.
+PATHTRACE_TEST(DeformedMeshesAreTracedWherePosed) {
+    const int W = 64, H = 64;
+    const double C = 100.0;
+    struct Case {
+        const char* file;
+        int frame;
+        double cameraY;
+        std::vector<glm::dvec2> surface, sky; // world (x, y)
+    };
+    const Case cases[] = {
+        {"skin_bend.gltf", 1, 1.0, {{-0.73, 0.98}, {-0.45, 1.04}, {0.0, 0.5}}, {{0.0, 1.73}, {0.0, 1.4}, {-1.5, 1.0}}},
+        {"morph_animated.gltf", 2, 0.0, {{1.2, 0.0}, {0.9, 0.3}, {-0.3, 0.0}}, {{1.75, 0.0}, {-0.8, 0.0}}},
+    };
+    const auto skyFile = scratchDir() / "pt_deformed.glb";
+    std::filesystem::create_directories(skyFile.parent_path());
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        const auto file = std::filesystem::path(VITRINE_SOURCE_DIR) / "tests" / "data" / "gltf" / "corpus" / c.file;
+        json g = traceGraph(file, uniformSky(skyFile, C), {{"spp", 4}, {"antialias", false}}, W, H, c.frame + 1);
+        g["nodes"]["scene"]["params"]["fps"] = 1;
+        g["nodes"]["scene"]["params"]["start"] = 0.0;
+        const Image img = runGraph(g).at("color");
+        auto radiance = [&](glm::dvec2 p) {
+            const int x = static_cast<int>((p.x + 2.0) / 4.0 * W),
+                      y = static_cast<int>((c.cameraY + 2.0 - p.y) / 4.0 * H);
+            return static_cast<double>(img.at(x, y)[1]);
+        };
+        for (glm::dvec2 p : c.surface)
+            EXPECT_NEAR(radiance(p), 1.0, 0.01)
+                << gBackend << " tracer: the posed mesh at (" << p.x << ", " << p.y << ")";
+        for (glm::dvec2 p : c.sky)
+            EXPECT_NEAR(radiance(p), C, 0.01 * C) << gBackend << " tracer: the sky at (" << p.x << ", " << p.y << ")";
+    }
 }
 
 } // namespace

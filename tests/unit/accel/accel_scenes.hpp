@@ -15,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <span>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -186,7 +187,11 @@ struct WorldTriangles {
     std::vector<GpuBvhTriangleRef> refs;
 };
 
-inline WorldTriangles worldTriangles(const scene::Scene& s, const scene::ScenePose& pose = {}) {
+// Every BVH triangle of s at pose in world space; vertices: Scene::vertices with the deforming meshes posed (empty:
+// Scene::vertices).
+inline WorldTriangles worldTriangles(const scene::Scene& s, const scene::ScenePose& pose = {},
+                                     std::span<const scene::Vertex> vertices = {}) {
+    if (vertices.empty()) vertices = s.vertices;
     WorldTriangles w;
     for (uint32_t i = 0; i < s.instances.size(); ++i) {
         const scene::MeshInstance& inst = s.instances[i];
@@ -198,7 +203,7 @@ inline WorldTriangles worldTriangles(const scene::Scene& s, const scene::ScenePo
             for (uint32_t t = 0; t < prim.indexCount / 3; ++t) {
                 for (uint32_t k = 0; k < 3; ++k)
                     w.v.push_back(transformPoint(
-                        world, s.vertices[prim.vertexOffset + s.indices[prim.firstIndex + 3 * t + k]].position));
+                        world, vertices[prim.vertexOffset + s.indices[prim.firstIndex + 3 * t + k]].position));
                 w.refs.push_back({i, p, t, prim.material});
             }
         }
@@ -230,6 +235,23 @@ inline BruteHit bruteForce(const WorldTriangles& w, const Ray& ray) {
 
 inline bool sameSource(const GpuBvhTriangleRef& a, const GpuBvhTriangleRef& b) {
     return a.instance == b.instance && a.primitive == b.primitive && a.triangle == b.triangle;
+}
+
+// A refit test's motion of a static-level triangle (ref names its instance): its world corners twisted about +Y by
+// 0.8 rad per unit of height, then the whole triangle shifted by up to 0.4 per axis, drawn from its ref; far from
+// where the build split it.
+inline void movedTriangle(const scene::Scene& s, const GpuBvhTriangleRef& ref, glm::vec3 (&v)[3]) {
+    std::mt19937 rng(ref.primitive * 7919u + ref.triangle * 31u + ref.instance);
+    std::uniform_real_distribution<float> u(-0.4f, 0.4f);
+    const glm::vec3 shift(u(rng), u(rng), u(rng));
+    const scene::Primitive& p = s.primitives[ref.primitive];
+    for (uint32_t k = 0; k < 3; ++k) {
+        const glm::vec3 q =
+            transformPoint(s.instances[ref.instance].world,
+                           s.vertices[p.vertexOffset + s.indices[p.firstIndex + 3 * ref.triangle + k]].position);
+        const float a = 0.8f * q.y, c = std::cos(a), sn = std::sin(a);
+        v[k] = glm::vec3(c * q.x + sn * q.z, q.y, -sn * q.x + c * q.z) + shift;
+    }
 }
 
 inline glm::vec3 randomUnit(std::mt19937& rng) {

@@ -2,10 +2,12 @@
 // soup, the museum (static level and the robot's parts) and inputs that defeat SAH.
 #include "tests/unit/accel/accel_scenes.hpp"
 
+#include "core/scene/deformation.hpp"
 #include "core/scene/museum.hpp"
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <set>
 
 namespace vitrine::accel {
@@ -67,8 +69,11 @@ void checkLevel(const BvhArrays& a, const BvhBottomLevel& level) {
 }
 
 // Every level's invariants, and the refs: each scene triangle exactly once, in the static level (static
-// instances, world space) or in its mesh's level (object space), with the vertices it names.
+// instances, world space) or in its mesh's level (object space: animated or deforming instances), with the vertices
+// it names (the BVH as built, before a refit).
 void checkSceneBvh(const scene::Scene& s, const SceneBvh& bvh) {
+    const scene::Deformation deformation(s);
+    auto ownLevel = [&](const scene::MeshInstance& inst) { return inst.dynamic || deformation.meshDeforms(inst.mesh); };
     const BvhArrays& a = bvh.arrays();
     ASSERT_EQ(a.triangles.size(), a.refs.size());
     uint32_t nodes = 0, triangles = 0;
@@ -87,7 +92,7 @@ void checkSceneBvh(const scene::Scene& s, const SceneBvh& bvh) {
     for (uint32_t t = 0; t < bvh.levels()[0].triangleCount; ++t) {
         const GpuBvhTriangleRef& r = a.refs[t];
         ASSERT_LT(r.instance, s.instances.size());
-        EXPECT_FALSE(s.instances[r.instance].dynamic);
+        EXPECT_FALSE(ownLevel(s.instances[r.instance]));
         EXPECT_TRUE(seen.insert({r.instance, r.primitive, r.triangle}).second) << "twice: triangle " << t;
         const scene::Primitive& p = s.primitives[r.primitive];
         ASSERT_LT(r.triangle, p.indexCount / 3);
@@ -102,7 +107,7 @@ void checkSceneBvh(const scene::Scene& s, const SceneBvh& bvh) {
     }
     size_t staticTriangles = 0;
     for (const scene::MeshInstance& inst : s.instances) {
-        if (inst.dynamic) continue;
+        if (ownLevel(inst)) continue;
         const scene::Mesh& m = s.meshes[inst.mesh];
         for (uint32_t p = m.firstPrimitive; p < m.firstPrimitive + m.primitiveCount; ++p)
             if (!s.materials[s.primitives[p].material].transparent()) staticTriangles += s.primitives[p].indexCount / 3;
@@ -111,7 +116,7 @@ void checkSceneBvh(const scene::Scene& s, const SceneBvh& bvh) {
 
     for (const BvhDynamicInstance& d : bvh.dynamicInstances()) {
         ASSERT_LT(d.instance, s.instances.size());
-        EXPECT_TRUE(s.instances[d.instance].dynamic);
+        EXPECT_TRUE(ownLevel(s.instances[d.instance]));
         const BvhBottomLevel& level = bvh.levels()[d.level];
         const scene::Mesh& m = s.meshes[s.instances[d.instance].mesh];
         std::set<std::pair<uint32_t, uint32_t>> mine;
@@ -200,6 +205,61 @@ TEST(BvhBuild, DepthLimitSwitchesToMedianSplits) {
     checkSceneBvh(s, bvh);
     EXPECT_LE(bvh.levels()[0].depth, 9u);
     EXPECT_GT(SceneBvh::build(s).levels()[0].depth, 9u);
+}
+
+// A refit (what a deforming mesh's level gets every frame) keeps the tree and moves its boxes. After every triangle of
+// the soup moved (movedTriangle: a twist and a shift of up to 0.4 per axis), the level keeps its invariants
+// (checkLevel) and its links, its triangles are the moved ones, and every box is tight: the union of the corners
+// below it, no larger than a fresh build's box over the same triangles would be.
+TEST(BvhBuild, RefitMovesEveryBoxToTheCornersBelowIt) {
+    scene::Scene s = randomSoup(3000, 5);
+    SceneBvh bvh = SceneBvh::build(s);
+    const BvhArrays& built = bvh.arrays();
+    BvhArrays a = built;
+    BvhBottomLevel level = bvh.levels()[0];
+    refitBottomLevel(level, a, [&](const GpuBvhTriangleRef& r, glm::vec3(&v)[3]) { movedTriangle(s, r, v); });
+    checkLevel(a, level);
+    ASSERT_EQ(a.triangles.size(), built.triangles.size());
+    size_t moved = 0;
+    for (size_t t = 0; t < a.triangles.size(); ++t) {
+        glm::vec3 v[3];
+        movedTriangle(s, a.refs[t], v);
+        EXPECT_EQ(glm::vec3(a.triangles[t].v0), v[0]) << "triangle " << t;
+        EXPECT_EQ(glm::vec3(a.triangles[t].v1), v[1]) << "triangle " << t;
+        EXPECT_EQ(glm::vec3(a.triangles[t].v2), v[2]) << "triangle " << t;
+        moved += glm::vec3(built.triangles[t].v2) != v[2];
+    }
+    EXPECT_GT(moved, a.triangles.size() * 9 / 10);
+    // The corners below a child, walked from the links alone.
+    std::function<BvhBox(const BvhChild&)> below = [&](const BvhChild& c) {
+        BvhBox box;
+        if (c.leaf()) {
+            for (uint32_t t = c.link; t < c.link + c.count; ++t)
+                for (const glm::vec4& v : {a.triangles[t].v0, a.triangles[t].v1, a.triangles[t].v2})
+                    box.expand(glm::vec3(v));
+        } else {
+            for (int k = 0; k < 2; ++k)
+                if (BvhChild g = childOf(a.nodes[c.link], k); !g.absent()) box.expand(below(g));
+        }
+        return box;
+    };
+    BvhBox all;
+    for (uint32_t n = level.firstNode; n < level.firstNode + level.nodeCount; ++n) {
+        for (int k = 0; k < 2; ++k) {
+            const BvhChild c = childOf(a.nodes[n], k), b = childOf(built.nodes[n], k);
+            EXPECT_EQ(c.link, b.link) << "node " << n;
+            EXPECT_EQ(c.count, b.count) << "node " << n;
+            if (c.absent()) continue;
+            const BvhBox want = below(c);
+            EXPECT_EQ(c.box.min, want.min) << "node " << n << " child " << k;
+            EXPECT_EQ(c.box.max, want.max) << "node " << n << " child " << k;
+        }
+    }
+    for (const GpuBvhTriangle& t : a.triangles)
+        for (const glm::vec4& v : {t.v0, t.v1, t.v2})
+            all.expand(glm::vec3(v));
+    EXPECT_EQ(level.bounds.min, all.min);
+    EXPECT_EQ(level.bounds.max, all.max);
 }
 
 TEST(BvhBuild, TinyInputs) {

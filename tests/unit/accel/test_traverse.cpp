@@ -4,6 +4,8 @@
 #include "tests/unit/accel/accel_scenes.hpp"
 #include "tests/unit/accel/compare_hits.hpp"
 
+#include "core/scene/deformation.hpp"
+#include "core/scene/gltf.hpp"
 #include "core/scene/museum.hpp"
 
 #include <gtest/gtest.h>
@@ -36,6 +38,102 @@ TEST(BvhTraversal, ClosestHitMatchesBruteForceOnRandomSoup) {
     expectSameHits(bvh, w, rays, traceAll(bvh, bvh.topLevel({}), rays), hits, ties);
     EXPECT_GT(hits, rays.size() / 2);
     std::printf("soup: %zu rays, %zu hits, %zu ties\n", rays.size(), hits, ties);
+}
+
+// After a refit moved every triangle of the soup (movedTriangle: a twist and shifts of up to 0.4 per axis), traversal
+// finds what brute force over the moved triangles finds.
+TEST(BvhTraversal, ClosestHitMatchesBruteForceAfterARefit) {
+    scene::Scene s = randomSoup(3000, 5);
+    SceneBvh bvh = SceneBvh::build(s);
+    BvhArrays a = bvh.arrays();
+    BvhBottomLevel level = bvh.levels()[0];
+    refitBottomLevel(level, a, [&](const GpuBvhTriangleRef& r, glm::vec3(&v)[3]) { movedTriangle(s, r, v); });
+    WorldTriangles w = worldTriangles(s);
+    scene::Aabb box;
+    for (size_t t = 0; t < w.refs.size(); ++t) {
+        glm::vec3 v[3];
+        movedTriangle(s, w.refs[t], v);
+        for (int k = 0; k < 3; ++k)
+            box.expand(w.v[3 * t + k] = v[k]);
+    }
+    std::vector<GpuBvhInstance> top = bvh.topLevel({});
+    top[0].boundsMin = glm::vec4(level.bounds.min, 0.0f);
+    top[0].boundsMax = glm::vec4(level.bounds.max, 0.0f);
+    box.expand(box.min - 0.5f);
+    box.expand(box.max + 0.5f);
+    std::vector<Ray> rays = randomRays(w, box, 20000, 6);
+    std::vector<Hit> found;
+    for (const Ray& r : rays)
+        found.push_back(traceClosest(a, top, r));
+    size_t hits, ties;
+    expectSameHits(bvh, w, rays, found, hits, ties);
+    EXPECT_GT(hits, rays.size() / 2);
+    std::printf("refit soup: %zu rays, %zu hits, %zu ties\n", rays.size(), hits, ties);
+}
+
+// Deforming meshes (scene::Deformation: a moving skin, animated morph weights) get bottom levels of their own, refit
+// to the posed vertices (SceneBvh::refit): the corpus's two-bone bend (a dynamic node) and morphing cube (a static
+// node whose weights are animated), at rest and posed, are hit where brute force over their posed triangles hits
+// them. Three quarters of the rays aim at posed triangles, which a BVH left at rest would miss.
+TEST(BvhDeforming, SkinnedAndMorphedMeshesAreHitWhereTheyArePosed) {
+    for (const char* file : {"skin_bend.gltf", "morph_animated.gltf"}) {
+        SCOPED_TRACE(file);
+        const scene::Scene s = scene::loadGltf(std::filesystem::path(VITRINE_CORPUS_DIR) / file);
+        const scene::Deformation deformation(s);
+        ASSERT_TRUE(deformation.any());
+        SceneBvh bvh = SceneBvh::build(s);
+        ASSERT_EQ(bvh.deformedLevels().size(), 1u);
+        EXPECT_EQ(bvh.levels()[0].triangleCount, 0u); // nothing static: the one mesh deforms
+        float largestMove = 0.0f;
+        for (double t : {0.0, 0.4, 1.0, 2.0}) {
+            const scene::ScenePose pose = s.evaluate(t);
+            const std::vector<scene::Vertex> posed = deformation.posedVertices(pose);
+            for (size_t v = 0; v < posed.size(); ++v)
+                largestMove = std::max(largestMove, glm::length(posed[v].position - s.vertices[v].position));
+            bvh.refit(s, posed);
+            WorldTriangles w = worldTriangles(s, pose, posed);
+            scene::Aabb box;
+            for (const glm::vec3& v : w.v)
+                box.expand(v);
+            box.expand(box.min - 1.0f);
+            box.expand(box.max + 1.0f);
+            // From random points of the box: at the inside of random posed triangles (edges would tie between the few
+            // triangles), and every fourth in a random direction.
+            std::mt19937 rng(8 + static_cast<uint32_t>(4 * t));
+            std::uniform_real_distribution<float> u(0.0f, 1.0f);
+            std::vector<Ray> rays(3000);
+            for (size_t i = 0; i < rays.size(); ++i) {
+                Ray& r = rays[i];
+                r.origin = box.min + glm::vec3(u(rng), u(rng), u(rng)) * (box.max - box.min);
+                const size_t k = rng() % w.refs.size();
+                const float a = 0.05f + 0.6f * u(rng), b = 0.05f + 0.3f * u(rng);
+                const glm::vec3 target =
+                    w.v[3 * k] + a * (w.v[3 * k + 1] - w.v[3 * k]) + b * (w.v[3 * k + 2] - w.v[3 * k]);
+                r.direction = i % 4 == 0 ? randomUnit(rng) : target - r.origin;
+            }
+            size_t hits, ties;
+            expectSameHits(bvh, w, rays, traceAll(bvh, bvh.topLevel(pose), rays), hits, ties);
+            EXPECT_GT(hits, rays.size() / 2) << "t = " << t;
+        }
+        EXPECT_GT(largestMove, 0.9f); // the tip of the bend moves by 1.4, the cube's face by 1
+    }
+}
+
+// A BVH from the bake cache knows its deforming levels as a built one does (they are derived, not stored).
+TEST(BvhDeforming, TheCachedBvhRefitsToo) {
+    namespace fs = std::filesystem;
+    const fs::path root = fs::temp_directory_path() / ("vitrine_bvh_deform_test_" + std::to_string(::getpid()));
+    fs::remove_all(root);
+    BakeCache cache(root);
+    const scene::Scene s = scene::loadGltf(fs::path(VITRINE_CORPUS_DIR) / "skin_bend.gltf");
+    SceneBvh::CacheStatus status;
+    const SceneBvh built = SceneBvh::loadOrBuild(s, cache, {}, &status);
+    ASSERT_TRUE(status.stored);
+    const SceneBvh loaded = SceneBvh::loadOrBuild(s, cache, {}, &status);
+    EXPECT_TRUE(status.fromCache);
+    EXPECT_EQ(loaded.deformedLevels(), built.deformedLevels());
+    EXPECT_FALSE(loaded.deformedLevels().empty());
+    fs::remove_all(root);
 }
 
 class MuseumBvh : public ::testing::Test {
