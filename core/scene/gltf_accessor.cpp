@@ -133,6 +133,10 @@ const tinygltf::Accessor& accessorAt(const LoadContext& ctx, int index, const st
     if (index < 0 || static_cast<size_t>(index) >= ctx.model->accessors.size()) {
         ctx.fail(element, "accessor index " + std::to_string(index) + " out of range");
     }
+    if (auto it = ctx.unknownAccessorTypes.find(index); it != ctx.unknownAccessorTypes.end()) {
+        ctx.fail(element, "reads accessors[" + std::to_string(index) + "], whose type '" + it->second +
+                              "' is not SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4");
+    }
     return ctx.model->accessors[index];
 }
 

@@ -66,8 +66,16 @@ struct LoadContext {
     // `indices` of primitives whose index accessor has no bufferView are dropped (tinygltf refuses them; the
     // meshes step reads them from doc).
     std::vector<uint8_t> tinygltfInput;
+    // Whether preflight() made integral floats of integer properties (1.0 for 1) integers in doc: tinygltf then reads
+    // the rewritten doc too.
+    bool integersRewritten = false;
+    // Accessors whose `type` glTF does not define (index -> the type as written): accessorAt() refuses to read them.
+    std::map<int, std::string> unknownAccessorTypes;
     // Scene texture made for glTF texture i with usage u, or -1 (see resolveTexture()).
     std::vector<std::array<int32_t, 3>> textureByUsage;
+    // Scene texture loaded for glTF texture i, or -1 when it has no image vitrine could read (no source, or one that
+    // did not decode): materials are drawn without it.
+    std::vector<int32_t> sceneTexture;
     int32_t defaultMaterial = -1;
     // The KHR_materials_variants variant the caller asked for ("" = the primitives' default materials), and its index
     // into the file's variants once loadMaterials() has found it (-1: none asked for).

@@ -75,7 +75,11 @@ Camera readCamera(const LoadContext& ctx, const tinygltf::Camera& c, const Json&
         cam.znear = static_cast<float>(c.perspective.znear);
         cam.zfar = static_cast<float>(c.perspective.zfar);
         cam.aspectRatio = static_cast<float>(c.perspective.aspectRatio);
-        if (!(cam.yfov > 0.0f) || cam.yfov >= 3.14159f) ctx.fail(e + ".perspective.yfov", "expected 0 < yfov < π");
+        if (!(cam.yfov > 0.0f)) ctx.fail(e + ".perspective.yfov", "expected a field of view > 0 (radians)");
+        if (cam.yfov >= 3.14f) { // legal (glTF: it SHOULD be below π), but no projection reaches it
+            ctx.warn(e + ".perspective.yfov", std::to_string(cam.yfov) + " rad is not below π; drawn at 3.14 rad");
+            cam.yfov = 3.14f;
+        }
         if (!(cam.znear > 0.0f)) ctx.fail(e + ".perspective.znear", "expected > 0");
         if (cam.zfar != 0.0f && cam.zfar <= cam.znear) ctx.fail(e + ".perspective.zfar", "expected > znear");
     } else if (c.type == "orthographic") {
@@ -585,6 +589,18 @@ void loadNodesAndScene(LoadContext& ctx) {
     }
 }
 
+// tinygltf's image decoder (stb_image), except that an image it cannot decode (WebP, KTX2, damaged data) is left empty
+// instead of failing the whole file: loadImagesAndTextures() warns and draws the textures using it without it.
+bool decodeOrLeaveEmpty(tinygltf::Image* image, int index, std::string* err, std::string* warn, int width, int height,
+                        const unsigned char* bytes, int size, void*) {
+    std::string ignored;
+    if (tinygltf::LoadImageData(image, index, &ignored, warn, width, height, bytes, size, nullptr)) return true;
+    (void)err;
+    image->image.clear();
+    image->width = image->height = 0;
+    return true;
+}
+
 } // namespace vitrine::scene::gltf
 
 namespace vitrine::scene {
@@ -601,6 +617,7 @@ Scene loadGltfFromMemory(const std::vector<uint8_t>& bytes, const std::filesyste
 
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(decodeOrLeaveEmpty, nullptr);
     std::string err, warn;
     const std::vector<uint8_t>& input = ctx.tinygltfInput.empty() ? bytes : ctx.tinygltfInput;
     bool ok = ctx.glb ? loader.LoadBinaryFromMemory(&model, &err, &warn, input.data(),

@@ -96,15 +96,17 @@ TextureImage toImage(const LoadContext& ctx, const tinygltf::Image& src, size_t 
 }
 
 int32_t resolveTexture(LoadContext& ctx, uint32_t gltfIndex, TextureUsage usage) {
+    const int32_t loaded = ctx.sceneTexture[gltfIndex];
+    if (loaded < 0) return -1; // no image vitrine could read (loadImagesAndTextures warned): drawn without it
     std::array<int32_t, 3>& byUsage = ctx.textureByUsage[gltfIndex];
     int32_t& slot = byUsage[static_cast<int>(usage)];
     if (slot >= 0) return slot;
     bool unassigned = byUsage[0] < 0 && byUsage[1] < 0 && byUsage[2] < 0;
     if (unassigned) {
-        ctx.scene->textures[gltfIndex].usage = usage;
-        slot = static_cast<int32_t>(gltfIndex);
+        ctx.scene->textures[loaded].usage = usage;
+        slot = loaded;
     } else {
-        Texture copy = ctx.scene->textures[gltfIndex];
+        Texture copy = ctx.scene->textures[loaded];
         copy.usage = usage;
         slot = static_cast<int32_t>(ctx.scene->textures.size());
         ctx.scene->textures.push_back(copy);
@@ -425,9 +427,11 @@ TextureRef readTextureInfo(LoadContext& ctx, const Json& info, TextureUsage usag
             uvSet = integer(ctx, *tt, "texCoord", uvSet, te); // the extension overrides textureInfo.texCoord
         }
     }
-    if (uvSet < 0 || uvSet > 1) {
-        ctx.fail(e + ".texCoord",
-                 std::to_string(uvSet) + "; expected 0 or 1 (vitrine keeps TEXCOORD_0 and TEXCOORD_1)");
+    if (uvSet < 0) ctx.fail(e + ".texCoord", std::to_string(uvSet) + "; expected a TEXCOORD_n set, n >= 0");
+    if (uvSet > 1) { // legal; a third UV set is rare enough that vitrine's vertices keep two
+        ctx.warn(e + ".texCoord",
+                 std::to_string(uvSet) + ": vitrine keeps TEXCOORD_0 and TEXCOORD_1; drawn without this texture");
+        return ref;
     }
     ref.uvSet = static_cast<uint32_t>(uvSet);
     ref.texture = resolveTexture(ctx, gltfIndex, usage);
@@ -448,8 +452,22 @@ Json writeTextureInfo(const TextureRef& ref, int textureIndex) {
 void loadImagesAndTextures(LoadContext& ctx) {
     const tinygltf::Model& model = *ctx.model;
     Scene& scene = *ctx.scene;
-    for (size_t i = 0; i < model.images.size(); ++i)
-        scene.images.push_back(toImage(ctx, model.images[i], i));
+    // Images tinygltf could not decode (decodeOrLeaveEmpty: WebP, KTX2, damaged data) are left out, with a warning;
+    // textures of theirs, and textures without a source, are drawn as if absent.
+    std::vector<int32_t> sceneImage(model.images.size(), -1);
+    for (size_t i = 0; i < model.images.size(); ++i) {
+        const tinygltf::Image& image = model.images[i];
+        if (image.image.empty() && image.width <= 0) {
+            ctx.warn("images[" + std::to_string(i) + "]",
+                     "could not be decoded" + (image.uri.empty() ? std::string() : " ('" + image.uri + "')") +
+                         (image.mimeType.empty() ? std::string() : " (" + image.mimeType + ")") +
+                         ": vitrine reads PNG and JPEG (not WebP, KTX2 or damaged data); textures using it are drawn "
+                         "without it");
+            continue;
+        }
+        sceneImage[i] = static_cast<int32_t>(scene.images.size());
+        scene.images.push_back(toImage(ctx, image, i));
+    }
 
     std::vector<Sampler> samplers;
     for (const tinygltf::Sampler& s : model.samplers)
@@ -457,16 +475,20 @@ void loadImagesAndTextures(LoadContext& ctx) {
 
     const Json* docTextures = member(ctx.doc, "textures");
     ctx.textureByUsage.assign(model.textures.size(), {-1, -1, -1});
+    ctx.sceneTexture.assign(model.textures.size(), -1);
     for (size_t i = 0; i < model.textures.size(); ++i) {
         const tinygltf::Texture& t = model.textures[i];
         std::string e = "textures[" + std::to_string(i) + "]";
-        if (t.source < 0) {
-            ctx.fail(e + ".source", "missing; expected an image index (texture-source extensions such as "
-                                    "KHR_texture_basisu are not supported)");
+        if (t.source < 0) { // legal: a texture-source extension may supply the image
+            ctx.warn(e + ".source",
+                     "missing (texture-source extensions such as KHR_texture_basisu and EXT_texture_webp "
+                     "are not read); materials using this texture are drawn without it");
+            continue;
         }
+        if (sceneImage[t.source] < 0) continue; // its image was left out, with a warning
         Texture texture;
         texture.name = t.name;
-        texture.image = static_cast<uint32_t>(t.source);
+        texture.image = static_cast<uint32_t>(sceneImage[t.source]);
         if (t.sampler >= 0) texture.sampler = samplers[t.sampler];
         // exportGlb() records the usage so that a texture no material uses still comes back the same.
         if (const Json* extras = object(ctx, (*docTextures)[i], "extras", e)) {
@@ -475,11 +497,12 @@ void loadImagesAndTextures(LoadContext& ctx) {
                 for (TextureUsage u : {TextureUsage::Color, TextureUsage::Normal, TextureUsage::Data}) {
                     if (usage == usageName(u)) {
                         texture.usage = u;
-                        ctx.textureByUsage[i][static_cast<int>(u)] = static_cast<int32_t>(i);
+                        ctx.textureByUsage[i][static_cast<int>(u)] = static_cast<int32_t>(scene.textures.size());
                     }
                 }
             }
         }
+        ctx.sceneTexture[i] = static_cast<int32_t>(scene.textures.size());
         scene.textures.push_back(texture);
     }
 }
@@ -496,7 +519,7 @@ void loadMaterials(LoadContext& ctx) {
     warnIgnoredMaterialExtensions(ctx, materials);
     for (size_t i = 0; i < ctx.textureByUsage.size(); ++i) {
         const auto& u = ctx.textureByUsage[i];
-        if (u[0] < 0 && u[1] < 0 && u[2] < 0) {
+        if (u[0] < 0 && u[1] < 0 && u[2] < 0 && ctx.sceneTexture[i] >= 0) {
             ctx.warn("textures[" + std::to_string(i) + "]", "no material uses it; kept as linear data");
         }
     }

@@ -33,9 +33,10 @@ uint32_t defaultMaterial(LoadContext& ctx) {
 // Triangle strips and fans as lists (glTF's winding rules).
 std::vector<uint32_t> toTriangleList(const LoadContext& ctx, std::vector<uint32_t> in, int mode, const std::string& e) {
     if (mode == TINYGLTF_MODE_TRIANGLES) {
-        if (in.size() % 3 != 0) {
-            ctx.fail(e + ".indices",
-                     "count " + std::to_string(in.size()) + " is not a multiple of 3; expected whole triangles");
+        if (in.size() % 3 != 0) { // legal (the Khronos validator warns): the trailing vertices make no triangle
+            ctx.warn(e, std::to_string(in.size()) + " vertices or indices are not a multiple of 3; the last " +
+                            std::to_string(in.size() % 3) + " are not drawn");
+            in.resize(in.size() - in.size() % 3);
         }
         return in;
     }
@@ -68,7 +69,10 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
         return it == p.attributes.end() ? -1 : it->second;
     };
     int positionAccessor = find("POSITION");
-    if (positionAccessor < 0) ctx.fail(e + ".attributes", "no POSITION; expected vertex positions");
+    if (positionAccessor < 0) { // legal: an extension may supply positions; vitrine reads none that does
+        ctx.warn(e + ".attributes", "no POSITION; primitive skipped");
+        return;
+    }
     AccessorValues positions = readAccessor(ctx, positionAccessor, e + ".attributes.POSITION", {3});
     size_t n = positions.count;
     auto read = [&](const char* name, std::initializer_list<int> comps) {
@@ -233,15 +237,23 @@ void loadPrimitive(LoadContext& ctx, const tinygltf::Primitive& p, int indexAcce
     prim.vertexCount = static_cast<uint32_t>(vertices.size());
     prim.material = material >= 0 ? static_cast<uint32_t>(material) : defaultMaterial(ctx);
     prim.lightmapUvs = uv1.count > 0;
-    if (joints.count) {
+    size_t unweighted = 0; // vertices whose weights do not add up to anything
+    for (size_t i = 0; joints.count && i < vertices.size(); ++i) {
+        const glm::vec4 w = jointWeights.get(i);
+        unweighted += !(w.x + w.y + w.z + w.w > 0.0f);
+    }
+    if (unweighted) { // the Khronos validator does not check the sums; skinning would collapse such vertices
+        ctx.warn(e + ".attributes.WEIGHTS_0", std::to_string(unweighted) + " of " + std::to_string(vertices.size()) +
+                                                  " vertices have weights summing to 0 (glTF: they sum to 1); the "
+                                                  "primitive is drawn unskinned, with its node");
+    }
+    if (joints.count && !unweighted) {
         // Bind space as loaded (rest morph weights applied); the loader skins the rest pose once the nodes are known.
         prim.skinned = true;
         prim.firstSkinVertex = static_cast<uint32_t>(scene.skinVertices.size());
         for (size_t i = 0; i < vertices.size(); ++i) {
             glm::vec4 w = jointWeights.get(i);
             float sum = w.x + w.y + w.z + w.w;
-            if (!(sum > 0.0f)) ctx.fail(e + ".attributes.WEIGHTS_0", "vertex " + std::to_string(i) +
-                                                                      " has weights summing to 0; expected 1");
             scene.skinVertices.push_back({vertices[i].position, vertices[i].normal, vertices[i].tangent,
                                           joints.get(i), w / sum}); // glTF: weights sum to 1 (normalised here)
         }

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -271,6 +272,8 @@ std::string fourCC(uint32_t v) {
 constexpr uint32_t kGlbMagic = 0x46546C67u; // "glTF"
 constexpr uint32_t kChunkJson = 0x4E4F534Au;
 constexpr uint32_t kChunkBin = 0x004E4942u;
+// The largest buffer without readable data that stands in as zeros (readsAsZeros); a larger one is refused.
+constexpr uint64_t kMaxZeroBuffer = 64ull << 20;
 
 // Splits a GLB into its JSON text and binary chunk, checking the header (magic, version, length) and each chunk's
 // type and length against the file, with messages that say which field is wrong.
@@ -409,6 +412,21 @@ void checkOptionalIndex(const LoadContext& ctx, const Json& obj, const char* key
     if (const Json* v = member(obj, key)) checkIndex(ctx, *v, path(element, key), target);
 }
 
+// A buffer vitrine reads as byteLength zeros, with a warning: one without a uri that is not a .glb's first buffer (its
+// binary chunk) nor an EXT_meshopt_compression fallback, or one whose uri names a remote resource (a scheme such as
+// http://). index: the buffer's.
+bool readsAsZeros(const LoadContext& ctx, const Json& buffer, size_t index) {
+    const Json* uri = member(buffer, "uri");
+    if (!uri) return !(!ctx.glbBin.empty() && index == 0) && !isMeshoptFallback(buffer);
+    if (!uri->is_string()) return false;
+    const std::string& s = uri->get_ref<const std::string&>();
+    const size_t scheme = s.find("://");
+    return scheme != std::string::npos && scheme > 0 && s.rfind("data:", 0) != 0 &&
+           std::all_of(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(scheme), [](char c) {
+               return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '-' || c == '.';
+           });
+}
+
 void checkExternalFile(const LoadContext& ctx, const Json& obj, const std::string& element, uint64_t minBytes) {
     const Json* uri = member(obj, "uri");
     if (!uri) return;
@@ -460,8 +478,17 @@ void checkReferences(const LoadContext& ctx) {
     if (const Json* ext = member(d, "extensions")) {
         if (const Json* lights = member(*ext, kLightsPunctual)) {
             if (const Json* list = member(*lights, "lights"); list && list->is_array()) lightCount = list->size();
+            const std::string le = std::string("extensions.") + kLightsPunctual;
+            forEach(ctx, *lights, "lights", le, [&](const std::string& e, const Json& light) {
+                require(ctx, light, e, {{"type", "directional, point or spot"}});
+                if (light["type"] == "spot") require(ctx, light, e, {{"spot", "{innerConeAngle, outerConeAngle}"}});
+            });
         }
     }
+    // Every element of glTF's top-level arrays is an object (forEach says which is not).
+    for (const char* name : {"accessors", "animations", "buffers", "bufferViews", "cameras", "images", "materials",
+                             "meshes", "nodes", "samplers", "scenes", "skins", "textures"})
+        forEach(ctx, d, name, "", [](const std::string&, const Json&) {});
     forEach(ctx, d, "nodes", "", [&](const std::string& e, const Json& n) {
         if (const Json* children = member(n, "children")) {
             if (!children->is_array()) ctx.fail(e + ".children", "expected an array of node indices");
@@ -503,6 +530,7 @@ void checkReferences(const LoadContext& ctx) {
                 {{"componentType", "the component type (5120..5126)"},
                  {"count", "the number of elements"},
                  {"type", "SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4"}});
+        if (integer(ctx, a, "count", 1, e) < 1) ctx.fail(e + ".count", "expected at least 1 element");
         checkOptionalIndex(ctx, a, "bufferView", e, "bufferViews");
         if (const Json* sparse = object(ctx, a, "sparse", e)) {
             std::string se = e + ".sparse";
@@ -547,17 +575,24 @@ void checkReferences(const LoadContext& ctx) {
     forEach(ctx, d, "buffers", "", [&](const std::string& e, const Json& b) {
         int64_t length = integer(ctx, b, "byteLength", -1, e);
         if (length < 1) ctx.fail(e + ".byteLength", "missing or < 1; expected the buffer's size in bytes");
-        // An EXT_meshopt_compression fallback may hold no data: what reads it is decoded from another buffer.
-        if (!member(b, "uri") && !isMeshoptFallback(b)) {
-            if (!binary || !bufferLength.empty()) {
-                ctx.fail(e, "has no uri; expected a file name or data: URI (only a .glb's first buffer may omit it)");
+        if (readsAsZeros(ctx, b, bufferLength.size())) {
+            // Legal (the data may come from elsewhere, or nothing may read it), but vitrine has nothing to read.
+            if (static_cast<uint64_t>(length) > kMaxZeroBuffer) {
+                ctx.fail(e, "has no data vitrine can read (" + std::to_string(length) +
+                                " bytes: no uri, or one that is not a local file); expected a file name or data: URI");
             }
+            const Json* uri = member(b, "uri");
+            ctx.warn(e, (uri ? "uri '" + uri->get<std::string>() + "' is not a local file (vitrine reads no network)"
+                             : std::string("has no uri (only a .glb's first buffer is its binary chunk)")) +
+                            "; its bytes (" + std::to_string(length) + ") read as zeros");
+        } else if (!member(b, "uri") && !isMeshoptFallback(b)) {
             if (static_cast<uint64_t>(length) > ctx.glbBin.size()) {
                 ctx.fail(e + ".byteLength", std::to_string(length) + " bytes, but the GLB binary chunk has " +
                                                 std::to_string(ctx.glbBin.size()));
             }
+        } else {
+            checkExternalFile(ctx, b, e, static_cast<uint64_t>(length));
         }
-        checkExternalFile(ctx, b, e, static_cast<uint64_t>(length));
         bufferLength.push_back(static_cast<uint64_t>(length));
     });
     forEach(ctx, d, "bufferViews", "", [&](const std::string& e, const Json& v) {
@@ -639,6 +674,29 @@ void prepareTinygltfInput(LoadContext& ctx) {
             edit()[name][i]["uri"] = header + base64Encode(data);
         }
     }
+    // An accessor type glTF does not define: the Khronos validator warns, legal while nothing reads the accessor
+    // (accessorAt() refuses it then). tinygltf, which refuses the file, is told SCALAR.
+    if (const Json* accessors = member(ctx.doc, "accessors")) {
+        static const std::set<std::string> types = {"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"};
+        for (size_t i = 0; i < accessors->size(); ++i) {
+            const Json& type = (*accessors)[i]["type"];
+            if (type.is_string() && types.count(type.get<std::string>())) continue;
+            const std::string e = "accessors[" + std::to_string(i) + "].type";
+            ctx.warn(e, type.dump() + " is not SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4; nothing may read this "
+                                      "accessor");
+            ctx.unknownAccessorTypes[static_cast<int>(i)] = type.dump();
+            edit()["accessors"][i]["type"] = "SCALAR";
+        }
+    }
+    // Buffers without data vitrine can read (readsAsZeros) become zeros, as the preflight warned.
+    if (const Json* buffers = member(ctx.doc, "buffers")) {
+        for (size_t i = 0; i < buffers->size(); ++i) {
+            if (!readsAsZeros(ctx, (*buffers)[i], i)) continue;
+            const size_t length = (*buffers)[i]["byteLength"].get<size_t>();
+            edit()["buffers"][i]["uri"] =
+                "data:application/octet-stream;base64," + base64Encode(std::vector<uint8_t>(length, 0));
+        }
+    }
     // EXT_meshopt_compression, which tinygltf does not know: its views decoded into a buffer of their own.
     decodeMeshoptCompression(ctx, edit);
     // tinygltf refuses an index accessor without a bufferView (glTF: all zeros, plus sparse values).
@@ -652,6 +710,7 @@ void prepareTinygltfInput(LoadContext& ctx) {
                 edit()["meshes"][m]["primitives"][p].erase("indices");
         }
     }
+    if (!copy && ctx.integersRewritten) copy = ctx.doc; // tinygltf reads some integer properties as integers only
     if (!copy) return;
     // Invalid UTF-8 in a string (a name, say) is replaced rather than thrown on: tinygltf gets valid JSON either way.
     std::string text = copy->dump(-1, ' ', false, Json::error_handler_t::replace);
@@ -685,6 +744,73 @@ std::vector<uint8_t> readGltfFile(const LoadContext& ctx, const std::filesystem:
     return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+namespace {
+
+// glTF's integer properties (indices, counts, sizes, enums) wherever they stand, the core's and the extensions' that
+// vitrine reads.
+bool isIntegerKey(const std::string& key) {
+    static const std::set<std::string> keys = {"buffer",     "byteLength",
+                                               "byteOffset", "byteStride",
+                                               "count",      "componentType",
+                                               "mode",       "target",
+                                               "indices",    "material",
+                                               "mesh",       "skin",
+                                               "camera",     "node",
+                                               "sampler",    "input",
+                                               "output",     "source",
+                                               "index",      "texCoord",
+                                               "bufferView", "scene",
+                                               "children",   "joints",
+                                               "skeleton",   "inverseBindMatrices",
+                                               "magFilter",  "minFilter",
+                                               "wrapS",      "wrapT",
+                                               "nodes",      "light",
+                                               "variants"};
+    return keys.count(key) > 0;
+}
+
+// An integral number written as a float (1.0, 1e0, 10e-1), which JSON does not tell from 1 and the Khronos validator
+// accepts, made an integer. Whether it changed anything.
+bool makeInteger(Json& v) {
+    if (!v.is_number_float()) return false;
+    const double d = v.get<double>();
+    if (!std::isfinite(d) || d != std::trunc(d) || std::abs(d) > 9007199254740992.0) return false;
+    if (d >= 0.0)
+        v = static_cast<uint64_t>(d);
+    else
+        v = static_cast<int64_t>(d);
+    return true;
+}
+
+// makeInteger() on the integer properties under v (key: the property v is the value of); extras are the file's own.
+bool integersAsIntegers(Json& v, const std::string& key) {
+    bool changed = false;
+    if (v.is_object()) {
+        for (auto it = v.begin(); it != v.end(); ++it) {
+            if (it.key() == "extras") continue;
+            if (it.key() == "attributes" && it->is_object()) {
+                for (Json& a : *it)
+                    changed = makeInteger(a) || changed;
+            } else if (it.key() == "targets" && it->is_array()) {
+                for (Json& t : *it) {
+                    for (Json& a : t)
+                        changed = makeInteger(a) || changed;
+                }
+            } else {
+                changed = integersAsIntegers(*it, it.key()) || changed;
+            }
+        }
+    } else if (v.is_array()) {
+        for (Json& e : v)
+            changed = integersAsIntegers(e, key) || changed;
+    } else if (isIntegerKey(key)) {
+        changed = makeInteger(v);
+    }
+    return changed;
+}
+
+} // namespace
+
 void preflight(LoadContext& ctx, const std::filesystem::path& file, const std::vector<uint8_t>& bytes) {
     if (bytes.empty()) ctx.fail("file", "is empty; expected glTF JSON or a GLB container");
 
@@ -702,6 +828,7 @@ void preflight(LoadContext& ctx, const std::filesystem::path& file, const std::v
     }
     ctx.doc = std::move(*doc);
     if (!ctx.doc.is_object()) ctx.fail("(root)", "expected a JSON object");
+    ctx.integersRewritten = integersAsIntegers(ctx.doc, "");
     const Json* asset = object(ctx, ctx.doc, "asset", "");
     if (!asset) ctx.fail("asset", "missing; expected {\"version\": \"2.0\"}");
     std::string version = string(ctx, *asset, "version", "", "asset");

@@ -154,11 +154,49 @@ TEST_F(GltfErrors, MissingTextureFile) {
     expectUserError([&] { loadGltf(file); }, {"missing_texture.gltf", "images[0].uri", "'missing.png' not found"});
 }
 
-TEST_F(GltfErrors, UndecodableTexture) {
+// An image that does not decode (damaged, or a format stb_image lacks, such as WebP) is left out with a warning, and
+// the material is drawn without the textures that use it (the Khronos validator reports damaged data as an error; a
+// viewer still shows the rest).
+TEST_F(GltfErrors, UndecodableImageIsLeftOutWithAWarning) {
     test::writeText(mDir / "not_a.png", "this is not a PNG");
     mDoc["images"][0] = {{"uri", "not_a.png"}};
     auto file = write("bad_texture.gltf", mDoc);
-    expectUserError([&] { loadGltf(file); }, {"bad_texture.gltf"});
+    std::vector<std::string> warnings;
+    Scene scene = loadGltf(file, warnings);
+    EXPECT_TRUE(scene.images.empty());
+    EXPECT_TRUE(scene.textures.empty());
+    ASSERT_FALSE(warnings.empty());
+    EXPECT_NE(warnings.front().find("images[0]: could not be decoded ('not_a.png')"), std::string::npos)
+        << warnings.front();
+}
+
+// A texCoord beyond TEXCOORD_1 (legal glTF; vitrine's vertices keep two sets): that texture is left out of the
+// material, with a warning; the others stay.
+TEST_F(GltfErrors, ThirdUvSetLeavesTheTextureOut) {
+    mDoc["materials"][0]["normalTexture"]["texCoord"] = 2;
+    std::vector<std::string> warnings;
+    Scene scene = loadGltf(write("third_uv.gltf", mDoc), warnings);
+    ASSERT_EQ(scene.materials.size(), 1u);
+    EXPECT_FALSE(scene.materials[0].layers[0].normal.texture.valid());
+    EXPECT_TRUE(scene.materials[0].layers[0].albedo.texture.valid());
+    ASSERT_FALSE(warnings.empty());
+    EXPECT_NE(warnings.front().find("materials[0].normalTexture.texCoord: 2"), std::string::npos) << warnings.front();
+}
+
+// tinygltf's own messages named no element for these; the preflight names them.
+TEST_F(GltfErrors, LightsAndTopLevelElementsAreNamed) {
+    Json doc = mDoc;
+    doc["materials"][0] = "material";
+    expectUserError([&] { loadGltf(write("string_material.gltf", doc)); },
+                    {"string_material.gltf", "materials[0]", "/materials/0", "expected a JSON object"});
+    doc = mDoc;
+    doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    doc["extensions"]["KHR_lights_punctual"]["lights"] = {Json::object()};
+    expectUserError([&] { loadGltf(write("typeless_light.gltf", doc)); },
+                    {"/extensions/KHR_lights_punctual/lights/0/type", "directional, point or spot"});
+    doc["extensions"]["KHR_lights_punctual"]["lights"][0]["type"] = "spot";
+    expectUserError([&] { loadGltf(write("spotless_spot.gltf", doc)); },
+                    {"/extensions/KHR_lights_punctual/lights/0/spot", "innerConeAngle, outerConeAngle"});
 }
 
 TEST_F(GltfErrors, AccessorBeyondItsBufferView) {

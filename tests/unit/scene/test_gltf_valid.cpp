@@ -247,5 +247,126 @@ TEST_F(GltfValid, ReportingPrintsWarningsOnceAndStrictRefuses) {
     loadGltfReporting(write("clean.gltf", triangleDoc(base64Uri(triangleBytes()))), true);
 }
 
+// Whether one of warnings has every part.
+bool warned(const std::vector<std::string>& warnings, std::initializer_list<const char*> parts) {
+    for (const std::string& w : warnings) {
+        bool all = true;
+        for (const char* p : parts)
+            all = all && w.find(p) != std::string::npos;
+        if (all) return true;
+    }
+    return false;
+}
+
+// Files the Khronos validator (main at 434283b, test/) reports with 0 errors that vitrine refused: now each loads
+// with a warning naming what is not drawn, at its JSON pointer. Textures without a `source` (a texture-source
+// extension, or none), a texCoord beyond the two UV sets vitrine keeps, buffers with no data vitrine can read (no
+// uri outside a .glb's first buffer, or a remote uri: zeros), weights that sum to 0 (drawn unskinned), a primitive
+// without POSITION (skipped), TRIANGLES whose count is not a multiple of 3 (the rest dropped), yfov >= π, an
+// accessor type glTF does not define (while nothing reads it).
+TEST_F(GltfValid, WhatTheValidatorAcceptsLoadsWithWarnings) {
+    const std::string uri = base64Uri(triangleBytes());
+    {
+        Json doc = triangleDoc(uri);
+        doc["textures"] = {{{"name", "basisu only"}}, {{"source", 0}}};
+        doc["images"] = {{{"uri", base64Uri({0x89, 'P', 'N', 'G'})}}}; // not decodable either
+        doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}},
+                             {"normalTexture", {{"index", 1}}},
+                             {"emissiveTexture", {{"index", 1}, {"texCoord", 2}}}}};
+        doc["meshes"][0]["primitives"][0]["material"] = 0;
+        std::vector<std::string> warnings;
+        Scene scene = loadGltf(write("sourceless.gltf", doc), warnings);
+        expectTriangle(scene);
+        EXPECT_TRUE(scene.textures.empty());
+        EXPECT_TRUE(scene.images.empty());
+        EXPECT_TRUE(warned(warnings, {"/textures/0/source", "drawn without it"}));
+        EXPECT_TRUE(warned(warnings, {"/images/0", "could not be decoded"}));
+        EXPECT_TRUE(warned(warnings, {"/materials/0/emissiveTexture/texCoord", "TEXCOORD_0 and TEXCOORD_1"}));
+    }
+    {
+        // TEXCOORD_0 on a buffer without a uri, COLOR_0 on a remote one: zeros, each warned once.
+        Json doc = triangleDoc(uri);
+        doc["buffers"].push_back({{"byteLength", 24}});
+        doc["buffers"].push_back({{"uri", "https://example.com/colour.bin"}, {"byteLength", 48}});
+        doc["bufferViews"].push_back({{"buffer", 1}, {"byteLength", 24}});
+        doc["bufferViews"].push_back({{"buffer", 2}, {"byteLength", 48}});
+        doc["accessors"].push_back({{"bufferView", 2}, {"componentType", 5126}, {"count", 3}, {"type", "VEC2"}});
+        doc["accessors"].push_back({{"bufferView", 3}, {"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});
+        doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 2;
+        doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 3;
+        std::vector<std::string> warnings;
+        Scene scene = loadGltf(write("no_uri.gltf", doc), warnings);
+        expectTriangle(scene);
+        for (const Vertex& v : scene.vertices) {
+            EXPECT_EQ(v.uv0, glm::vec2(0.0f));
+            EXPECT_EQ(glm::vec3(v.color), glm::vec3(0.0f));
+        }
+        EXPECT_TRUE(warned(warnings, {"/buffers/1", "has no uri", "(24) read as zeros"}));
+        EXPECT_TRUE(warned(warnings, {"/buffers/2", "https://example.com/colour.bin", "not a local file"}));
+        doc["buffers"][1]["byteLength"] = 1ll << 40;
+        expectUserError([&] { loadGltf(write("huge_no_uri.gltf", doc)); }, {"/buffers/1", "no data vitrine can read"});
+    }
+    {
+        // A skin whose weights are all 0 (the accessor has no bufferView), a primitive without POSITION, four vertices
+        // of TRIANGLES, a 4-radian yfov and an unused accessor of type "NotaVEC3".
+        Json doc = triangleDoc(uri);
+        doc["accessors"].push_back({{"componentType", 5121}, {"count", 3}, {"type", "VEC4"}});     // JOINTS_0: 2
+        doc["accessors"].push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC4"}});     // WEIGHTS_0: 3
+        doc["accessors"].push_back({{"componentType", 5126}, {"count", 4}, {"type", "VEC3"}});     // 4 zeros: 4
+        doc["accessors"].push_back({{"componentType", 5126}, {"count", 1}, {"type", "NotaVEC3"}}); // 5
+        doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = 2;
+        doc["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = 3;
+        doc["meshes"][0]["primitives"].push_back({{"attributes", {{"NORMAL", 1}}}});
+        doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 4}}}});
+        doc["skins"] = {{{"joints", {1}}}};
+        doc["nodes"][0]["skin"] = 0;
+        doc["nodes"].push_back({{"camera", 0}});
+        doc["scenes"][0]["nodes"].push_back(1);
+        doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 4.0}, {"znear", 0.1}}}}};
+        std::vector<std::string> warnings;
+        Scene scene = loadGltf(write("odd.gltf", doc), warnings);
+        ASSERT_EQ(scene.primitives.size(), 2u);
+        EXPECT_FALSE(scene.primitives[0].skinned);
+        EXPECT_EQ(scene.vertices[1].position, glm::vec3(1, 0, 0)); // where the file puts it, not collapsed
+        EXPECT_EQ(scene.primitives[1].indexCount, 3u);
+        ASSERT_EQ(scene.cameras.size(), 1u);
+        EXPECT_FLOAT_EQ(scene.cameras[0].yfov, 3.14f);
+        EXPECT_TRUE(warned(warnings, {"/meshes/0/primitives/0/attributes/WEIGHTS_0", "3 of 3", "unskinned"}));
+        EXPECT_TRUE(warned(warnings, {"/meshes/0/primitives/1/attributes", "no POSITION", "skipped"}));
+        EXPECT_TRUE(warned(warnings, {"/meshes/0/primitives/2", "not a multiple of 3", "last 1"}));
+        EXPECT_TRUE(warned(warnings, {"/cameras/0/perspective/yfov", "3.14"}));
+        EXPECT_TRUE(warned(warnings, {"/accessors/5/type", "NotaVEC3", "nothing may read"}));
+        // Read, the accessor of unknown type is an error naming it.
+        doc["meshes"][0]["primitives"][2]["attributes"]["POSITION"] = 5;
+        expectUserError([&] { loadGltf(write("read_unknown.gltf", doc)); },
+                        {"/meshes/0/primitives/2/attributes/POSITION", "accessors[5]", "'\"NotaVEC3\"'"});
+    }
+}
+
+// JSON has one kind of number: 1.0, 1e0 and 10e-1 are the integer 1 wherever glTF wants an integer (the validator's
+// json/integer_written_as_float.gltf). The triangle loads as from integers, and tinygltf reads the rewritten JSON.
+TEST_F(GltfValid, IntegersWrittenAsFloats) {
+    Json doc = triangleDoc(base64Uri(triangleBytes()));
+    doc["scene"] = 0.0;
+    doc["scenes"][0]["nodes"][0] = 0.0;
+    doc["nodes"][0]["mesh"] = 1e0;
+    doc["nodes"][0]["mesh"] = 0.0;
+    doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 0.0;
+    doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 1.0;
+    doc["buffers"][0]["byteLength"] = 72.0;
+    doc["bufferViews"][1]["byteOffset"] = 36.0;
+    doc["accessors"][0]["componentType"] = 5126.0;
+    doc["accessors"][0]["count"] = 3.0;
+    std::vector<std::string> warnings;
+    Scene scene = loadGltf(write("floats.gltf", doc), warnings);
+    expectTriangle(scene);
+    EXPECT_EQ(scene.vertices[2].normal, glm::vec3(0, 0, 1));
+    EXPECT_TRUE(warnings.empty()) << warnings.front();
+    // Not integral: still refused, naming it.
+    doc["accessors"][0]["count"] = 2.5;
+    expectUserError([&] { loadGltf(write("fraction.gltf", doc)); },
+                    {"fraction.gltf", "accessors[0].count", "/accessors/0/count", "expected an integer, got 2.5"});
+}
+
 } // namespace
 } // namespace vitrine::scene
