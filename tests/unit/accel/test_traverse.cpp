@@ -72,18 +72,32 @@ TEST(BvhTraversal, ClosestHitMatchesBruteForceAfterARefit) {
 }
 
 // Deforming meshes (scene::Deformation: a moving skin, animated morph weights) get bottom levels of their own, refit
-// to the posed vertices (SceneBvh::refit): the corpus's two-bone bend (a dynamic node) and morphing cube (a static
-// node whose weights are animated), at rest and posed, are hit where brute force over their posed triangles hits
-// them. Three quarters of the rays aim at posed triangles, which a BVH left at rest would miss.
+// to the posed vertices (SceneBvh::refit): the corpus's two-bone bend and morphing cube (whose nodes the animation
+// makes dynamic), and a second, unanimated node drawing the same cube 3 m above (a static instance whose vertices
+// still deform: the weights are the mesh's), at rest and posed, are hit where brute force over their posed triangles
+// hits them. Three quarters of the rays aim at posed triangles, which a BVH left at rest would miss.
 TEST(BvhDeforming, SkinnedAndMorphedMeshesAreHitWhereTheyArePosed) {
     for (const char* file : {"skin_bend.gltf", "morph_animated.gltf"}) {
         SCOPED_TRACE(file);
-        const scene::Scene s = scene::loadGltf(std::filesystem::path(VITRINE_CORPUS_DIR) / file);
+        scene::Scene s = scene::loadGltf(std::filesystem::path(VITRINE_CORPUS_DIR) / file);
+        if (std::string(file) == "morph_animated.gltf") {
+            const auto cube =
+                std::find_if(s.nodes.begin(), s.nodes.end(), [](const scene::Node& n) { return n.mesh >= 0; });
+            ASSERT_NE(cube, s.nodes.end());
+            scene::Node still = *cube;
+            still.local.translation += glm::vec3(0.0f, 3.0f, 0.0f);
+            s.roots.push_back(static_cast<uint32_t>(s.nodes.size()));
+            s.nodes.push_back(still);
+            s.finalize();
+            ASSERT_EQ(s.instances.size(), 2u);
+            EXPECT_FALSE(s.instances[1].dynamic);
+        }
         const scene::Deformation deformation(s);
         ASSERT_TRUE(deformation.any());
         SceneBvh bvh = SceneBvh::build(s);
         ASSERT_EQ(bvh.deformedLevels().size(), 1u);
-        EXPECT_EQ(bvh.levels()[0].triangleCount, 0u); // nothing static: the one mesh deforms
+        EXPECT_EQ(bvh.levels()[0].triangleCount, 0u); // nothing static: every instance's mesh deforms
+        EXPECT_EQ(bvh.dynamicInstances().size(), s.instances.size());
         float largestMove = 0.0f;
         for (double t : {0.0, 0.4, 1.0, 2.0}) {
             const scene::ScenePose pose = s.evaluate(t);
