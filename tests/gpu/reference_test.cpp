@@ -610,7 +610,9 @@ TEST_F(Reference, TwinsMatchLightingDeferredUnderAPrefilteredSky) {
             EXPECT_NEAR(results[0].sumRatio, 1.0, 0.03);
             EXPECT_LT(results[0].blockError, 0.06);
         }
-        if (!sun) EXPECT_LT(results[0].blockError, 0.75 * results[1].blockError);
+        if (!sun) {
+            EXPECT_LT(results[0].blockError, 0.75 * results[1].blockError);
+        }
     }
 }
 

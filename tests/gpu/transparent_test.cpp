@@ -711,7 +711,9 @@ TEST_F(Transparent, LightBehindRoughGlassShinesThroughItsTransmissionLobe) {
         EXPECT_GE(count, 300);
         EXPECT_GT(peakShare, 0.3);
         EXPECT_GT(pointPeak, 0.05);
-        if (occluded) EXPECT_GE(shadedCount, 200);
+        if (occluded) {
+            EXPECT_GE(shadedCount, 200);
+        }
     }
 }
 

@@ -63,7 +63,9 @@ TEST(LightmapBake, VolumeCoversTheStaticSceneWithinItsBudget) {
         const IrradianceVolume v = planIrradianceVolume(s, 2.0f, budget);
         ASSERT_GT(v.probeCount(), 0u);
         EXPECT_LE(v.probeCount(), budget);
-        if (budget == 100000u) EXPECT_FLOAT_EQ(v.spacing, 2.0f);
+        if (budget == 100000u) {
+            EXPECT_FLOAT_EQ(v.spacing, 2.0f);
+        }
         const glm::vec3 lo = v.position(0, 0, 0), hi = v.position(v.counts.x - 1, v.counts.y - 1, v.counts.z - 1);
         for (int a = 0; a < 3; ++a) {
             EXPECT_LE(lo[a], bounds.min[a] + 1e-3f);
