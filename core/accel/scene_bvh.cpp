@@ -48,9 +48,11 @@ std::vector<GpuBvhPrimitive> SceneBvh::primitivesOf(const scene::Scene& scene) {
     return out;
 }
 
-std::vector<uint32_t> SceneBvh::deformedLevelsOf(const scene::Scene& scene,
-                                                 const std::vector<BvhDynamicInstance>& dynamic) {
-    const scene::Deformation deformation(scene);
+namespace {
+
+// The levels of dynamic's instances whose mesh deforms, ascending, each once.
+std::vector<uint32_t> levelsThatDeform(const scene::Scene& scene, const scene::Deformation& deformation,
+                                       const std::vector<BvhDynamicInstance>& dynamic) {
     std::vector<uint32_t> levels;
     for (const BvhDynamicInstance& d : dynamic) {
         if (d.instance < scene.instances.size() && deformation.meshDeforms(scene.instances[d.instance].mesh))
@@ -59,6 +61,13 @@ std::vector<uint32_t> SceneBvh::deformedLevelsOf(const scene::Scene& scene,
     std::sort(levels.begin(), levels.end());
     levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
     return levels;
+}
+
+} // namespace
+
+std::vector<uint32_t> SceneBvh::deformedLevelsOf(const scene::Scene& scene,
+                                                 const std::vector<BvhDynamicInstance>& dynamic) {
+    return levelsThatDeform(scene, scene::Deformation(scene), dynamic);
 }
 
 SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& options) {
@@ -90,7 +99,7 @@ SceneBvh SceneBvh::build(const scene::Scene& scene, const BvhBuildOptions& optio
         }
         bvh.mDynamic.push_back({i, it->second, inst.world});
     }
-    bvh.mDeformedLevels = deformedLevelsOf(scene, bvh.mDynamic);
+    bvh.mDeformedLevels = levelsThatDeform(scene, deformation, bvh.mDynamic);
     bvh.mBuildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

@@ -591,11 +591,10 @@ void loadNodesAndScene(LoadContext& ctx) {
 
 // tinygltf's image decoder (stb_image), except that an image it cannot decode (WebP, KTX2, damaged data) is left empty
 // instead of failing the whole file: loadImagesAndTextures() warns and draws the textures using it without it.
-bool decodeOrLeaveEmpty(tinygltf::Image* image, int index, std::string* err, std::string* warn, int width, int height,
+bool decodeOrLeaveEmpty(tinygltf::Image* image, int index, std::string*, std::string* warn, int width, int height,
                         const unsigned char* bytes, int size, void*) {
     std::string ignored;
     if (tinygltf::LoadImageData(image, index, &ignored, warn, width, height, bytes, size, nullptr)) return true;
-    (void)err;
     image->image.clear();
     image->width = image->height = 0;
     return true;
