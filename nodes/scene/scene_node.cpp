@@ -28,6 +28,10 @@ void addSceneNodeSchema(NodeSchema& s) {
                         "first glTF camera, else a view framing the scene"});
     s.params.push_back({"fps", ParamType::Float, 24.0, 1.0, 1000.0, {}, "Frames per second of the frame clock"});
     s.params.push_back({"start", ParamType::Float, 0.0, -1e6, 1e6, {}, "Time of frame 0 in seconds"});
+    const char* holdDoc = "Hold the clock at `start`: every frame shows the same instant, still (zero velocity), while "
+                          "the jitter and lens samples still move per frame (temporal AA's or accumulation's steady "
+                          "state of one shot)";
+    s.params.push_back({"hold", ParamType::Bool, false, {}, {}, {}, holdDoc});
     s.params.push_back({"anisotropy", ParamType::Float, -1.0, -1.0, 16.0, {},
                         "Anisotropic texture filtering (1 = off). -1: 8x on GPUs, off on CPU devices (lavapipe's "
                         "software anisotropic filtering takes minutes per frame)"});
@@ -99,6 +103,7 @@ void SceneNode::publish(SetupContext& ctx, std::shared_ptr<const scene::Scene> s
     scene = withProbeFile(ctx, std::move(scene));
     mFps = p.getFloat("fps");
     mStart = p.getFloat("start");
+    mHold = p.getBool("hold");
     mJitter = static_cast<scene::JitterPattern>(p.getEnumIndex("jitter"));
     mJitterGrid = scene::jitterGridFor(static_cast<uint32_t>(p.getInt("jitter_grid")), ctx.frame().frames);
     mVertexJitterThreshold = p.getString("jitter_space") == "vertex" ? p.getFloat("vertex_jitter_threshold") : 0.0f;
@@ -208,7 +213,7 @@ void SceneNode::applyLens(scene::CameraState& state, glm::mat4& proj, glm::vec2 
 void SceneNode::execute(ExecuteContext& ctx) {
     const scene::Scene& s = mScene->scene();
     const uint32_t frame = ctx.frameIndex();
-    const double dt = 1.0 / mFps;
+    const double dt = mHold ? 0.0 : 1.0 / mFps;
     const double t = mStart + frame * dt;
     GpuScene& gpu = mScene->gpu(ctx.gpu(), ctx.shaders());
     CameraFrame& c = mCamera->current;

@@ -43,6 +43,7 @@ private:
     int mCameraNode = -1;
     float mFps = 24.0f;
     float mStart = 0.0f;
+    bool mHold = false;
     scene::JitterPattern mJitter = scene::JitterPattern::Off;
     uint32_t mJitterGrid = 16;
     float mVertexJitterThreshold = 0.0f; // 0: frustum jitter

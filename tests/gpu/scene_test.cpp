@@ -361,6 +361,48 @@ TEST_F(SceneGpu, MuseumGbufferFromTheWalkthroughIsPlausible) {
     EXPECT_LT(st.maxSpeed, 20.0);
 }
 
+// scene.hold: every frame is the instant `start`. Four frames of the walkthrough held at 12.5 s (where the camera
+// walks and turns and the robot moves) give the G-buffer of frame 0 exactly, with no velocity; the jitter still
+// moves the projection each frame (what TAA and aa.accumulate need of a held shot).
+TEST_F(SceneGpu, HoldShowsOneInstantInEveryFrame) {
+    auto graph = [](bool hold, int frames, const char* jitter) {
+        json g = museumGraph("walkthrough", 12.5);
+        g["frame"]["frames"] = frames;
+        g["nodes"]["scene"]["params"]["hold"] = hold;
+        g["nodes"]["scene"]["params"]["jitter"] = jitter;
+        return g;
+    };
+    auto first = runGraph(graph(false, 1, "off"));
+    auto held = runGraph(graph(true, 4, "off"));
+    auto moving = runGraph(graph(false, 4, "off"));
+    auto heldJittered = runGraph(graph(true, 4, "halton"));
+    auto maxDiff = [](const Image& a, const Image& b, int channels) {
+        double d = 0.0;
+        for (int y = 0; y < a.height; ++y)
+            for (int x = 0; x < a.width; ++x)
+                for (int c = 0; c < channels; ++c)
+                    d = std::max(d, std::fabs(double(a.at(x, y)[c]) - b.at(x, y)[c]));
+        return d;
+    };
+    auto maxSpeed = [](const Image& v) {
+        double s = 0.0;
+        for (int y = 0; y < v.height; ++y)
+            for (int x = 0; x < v.width; ++x)
+                s = std::max(s, std::hypot(double(v.at(x, y)[0]), double(v.at(x, y)[1])));
+        return s;
+    };
+    for (const char* name : {"normal", "base", "material", "depth"})
+        EXPECT_EQ(maxDiff(held[name], first[name], 4), 0.0) << name << ": frame 3 of the held shot is not frame 0";
+    EXPECT_EQ(maxSpeed(held["velocity"]), 0.0);
+    // Without hold the same frames move: the test sees motion where there is some.
+    EXPECT_GT(maxDiff(moving["depth"], first["depth"], 1), 0.01);
+    EXPECT_GT(maxSpeed(moving["velocity"]), 0.3);
+    EXPECT_GT(maxSpeed(first["velocity"]), 0.3); // frame 0 of the walk has the motion of the frame before
+    // Held and jittered: the projection moves by the sub-pixel jitter, the scene does not.
+    EXPECT_GT(maxDiff(heldJittered["depth"], first["depth"], 1), 1e-4);
+    EXPECT_LT(maxSpeed(heldJittered["velocity"]), 1e-3);
+}
+
 // ---------------------------------------------------------------------------------------------
 // User errors
 
